@@ -1,0 +1,1 @@
+//! Scene building: graphics state to a plain scene description.

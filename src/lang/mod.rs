@@ -1,0 +1,1 @@
+//! Scene language: tokens, directives, parameter lists, Include splicing and diagnostics.

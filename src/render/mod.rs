@@ -1,0 +1,13 @@
+//! The render core: geometry, shapes, acceleration, materials, lights,
+//! samplers, integrators and film. It consumes a [`crate::scene::SceneDescription`].
+
+pub mod accel;
+pub mod camera;
+pub mod film;
+pub mod geometry;
+pub mod integrators;
+pub mod lights;
+pub mod materials;
+pub mod samplers;
+pub mod sampling;
+pub mod shapes;

@@ -1,0 +1,231 @@
+//! The plain scene description: what the scene language and scene building hand
+//! to the render core. Nothing here knows about text, spans or graphics state,
+//! and nothing here knows about rendering: it is data, with pbrt-v3's defaults
+//! already applied and every colour already reduced to linear RGB.
+//!
+//! Transforms are `f64` so that long chains of scene-file transforms do not lose
+//! precision before the render core converts geometry to `f32` world space.
+
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A whole scene, ready to be compiled for rendering.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    pub camera: CameraDesc,
+    pub film: FilmDesc,
+    pub filter: FilterDesc,
+    pub sampler: SamplerDesc,
+    pub integrator: IntegratorDesc,
+    /// Materials referenced by shapes (by index). Only referenced ones are built.
+    pub materials: Vec<MaterialDesc>,
+    /// Shapes in world space (their `object_to_world` maps to world).
+    pub shapes: Vec<ShapeDesc>,
+    /// Lights other than area lights (area lights live on their shapes).
+    pub lights: Vec<LightDesc>,
+    /// Object definitions that are instanced at least once.
+    pub objects: Vec<ObjectDesc>,
+    /// Placements of objects.
+    pub instances: Vec<InstanceDesc>,
+    /// Human-readable notes on what was left out and why (unreferenced named
+    /// materials, objects never instanced, ...), for `--check` and `--stats`.
+    pub skipped: Vec<String>,
+}
+
+/// Index into [`SceneDescription::materials`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct MaterialId(pub u32);
+
+#[derive(Clone, Debug)]
+pub struct CameraDesc {
+    /// Camera-to-world transform: inverse of the CTM at the `Camera` directive.
+    /// Camera space is pbrt's left-handed one: +z looks forward, +y up, +x right
+    /// as seen in the image before any handedness flip in the CTM.
+    pub camera_to_world: DMat4,
+    pub kind: CameraKind,
+    pub shutter_open: f32,
+    pub shutter_close: f32,
+}
+
+#[derive(Clone, Debug)]
+pub enum CameraKind {
+    Perspective {
+        /// Full field of view in degrees, spanning the shorter image axis
+        /// (after `halffov` was folded in).
+        fov: f32,
+        lens_radius: f32,
+        focal_distance: f32,
+        /// `frameaspectratio`, if given.
+        frame_aspect_ratio: Option<f32>,
+        /// `screenwindow` as [xmin, xmax, ymin, ymax], if given.
+        screen_window: Option<[f32; 4]>,
+    },
+}
+
+#[derive(Clone, Debug)]
+pub struct FilmDesc {
+    pub xresolution: u32,
+    pub yresolution: u32,
+    /// [x0, x1, y0, y1] in NDC, already clamped to [0,1] and ordered.
+    pub cropwindow: [f32; 4],
+    /// Output file name as written in the scene (relative to the working
+    /// directory, as pbrt-v3 does); the command line may override it.
+    pub filename: PathBuf,
+    pub scale: f32,
+    pub max_sample_luminance: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterDesc {
+    /// Radius per axis (pbrt's `xwidth`/`ywidth`, which are radii).
+    Box { radius: Vec2 },
+    Gaussian { radius: Vec2, alpha: f32 },
+    Triangle { radius: Vec2 },
+    Mitchell { radius: Vec2, b: f32, c: f32 },
+    LanczosSinc { radius: Vec2, tau: f32 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    Halton,
+    Random,
+    Sobol,
+    /// Stratified with jitter; `pixelsamples` is xsamples*ysamples.
+    Stratified { jitter: bool, xsamples: u32, ysamples: u32 },
+    ZeroTwoSequence,
+    MaxMinDist,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SamplerDesc {
+    pub kind: SamplerKind,
+    pub pixel_samples: u32,
+    /// Halton's `samplepixelcenter`.
+    pub sample_pixel_center: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSampleStrategy {
+    Uniform,
+    Power,
+    Spatial,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectStrategy {
+    All,
+    One,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntegratorDesc {
+    Path {
+        max_depth: u32,
+        rr_threshold: f32,
+        light_sample_strategy: LightSampleStrategy,
+    },
+    DirectLighting {
+        max_depth: u32,
+        strategy: DirectStrategy,
+    },
+    Whitted {
+        max_depth: u32,
+    },
+}
+
+/// Materials as linear RGB constants (textures are reduced to constants or
+/// substituted with a warning by scene building).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialDesc {
+    /// `sigma` in degrees; 0 means Lambertian.
+    Matte { kd: Vec3, sigma: f32 },
+    Glass { kr: Vec3, kt: Vec3, eta: f32 },
+    Mirror { kr: Vec3 },
+    /// `Material ""` / `"none"`: no BSDF, the surface only delimits media.
+    None,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaLightDesc {
+    /// Emitted radiance, `L` times `scale`.
+    pub l: Vec3,
+    pub two_sided: bool,
+    pub n_samples: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct ShapeDesc {
+    pub geometry: Geometry,
+    pub object_to_world: DMat4,
+    pub reverse_orientation: bool,
+    pub material: MaterialId,
+    pub area_light: Option<AreaLightDesc>,
+}
+
+#[derive(Clone, Debug)]
+pub enum Geometry {
+    /// Vertices in object space.
+    TriangleMesh(Arc<MeshData>),
+    Sphere {
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        /// Degrees, (0, 360].
+        phi_max: f32,
+    },
+}
+
+/// Triangle mesh data in object space, shared between shapes and instances.
+#[derive(Clone, Debug, Default)]
+pub struct MeshData {
+    pub positions: Vec<Vec3>,
+    /// Three per triangle, every index < positions.len().
+    pub indices: Vec<u32>,
+    /// Per-vertex normals (same length as positions) if given.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex uv (same length as positions) if given.
+    pub uvs: Option<Vec<Vec2>>,
+}
+
+impl MeshData {
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum LightDesc {
+    /// Position in world space, intensity `I`·`scale`.
+    Point { position: DVec3, intensity: Vec3 },
+    Spot {
+        /// Light-to-world, already including the from/to frame.
+        light_to_world: DMat4,
+        intensity: Vec3,
+        /// Degrees.
+        cone_angle: f32,
+        cone_delta_angle: f32,
+    },
+    /// `direction` is the world-space direction the light travels *from*
+    /// (pbrt's `from - to`, transformed), normalised.
+    Distant { radiance: Vec3, direction: DVec3 },
+    Infinite {
+        radiance: Vec3,
+        light_to_world: DMat4,
+        n_samples: u32,
+    },
+}
+
+#[derive(Clone, Debug)]
+pub struct ObjectDesc {
+    pub name: String,
+    /// Shapes with transforms relative to the object's space.
+    pub shapes: Vec<ShapeDesc>,
+}
+
+#[derive(Clone, Debug)]
+pub struct InstanceDesc {
+    /// Index into [`SceneDescription::objects`].
+    pub object: usize,
+    pub instance_to_world: DMat4,
+}
