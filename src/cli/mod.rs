@@ -1,5 +1,49 @@
 //! The command line: options, dispatch, progress and statistics.
 
+use clap::Parser;
+use std::path::PathBuf;
+
+mod check;
+mod render;
+
+/// pbrs: render a pbrt-v3 scene.
+#[derive(Parser, Debug, Clone)]
+#[command(name = "pbrs", version, about = "A physically based renderer for pbrt-v3 scenes")]
+pub struct Args {
+    /// The scene file (pbrt-v3 format).
+    pub scene: PathBuf,
+    /// Parse and build the scene, print warnings and a summary, do not render.
+    #[arg(long)]
+    pub check: bool,
+    /// Output image (.exr, .png or .pfm); overrides the Film's filename.
+    #[arg(long, short = 'o')]
+    pub outfile: Option<PathBuf>,
+    /// Samples per pixel; overrides the sampler's pixelsamples.
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Seed for the sampler's scrambling and random dimensions.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Crop window in NDC: x0 x1 y0 y1; overrides the Film's cropwindow.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], allow_negative_numbers = true)]
+    pub cropwindow: Option<Vec<f32>>,
+    /// No progress bar, no summary.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+    /// Print detailed statistics: what was built and skipped, rays, timings.
+    #[arg(long)]
+    pub stats: bool,
+}
+
+/// Runs the command line; returns the process exit status.
 pub fn main() -> i32 {
-    0
+    let args = Args::parse();
+    if args.check {
+        check::run(&args)
+    } else {
+        render::run(&args)
+    }
 }
