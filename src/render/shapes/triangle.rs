@@ -1,0 +1,200 @@
+use super::{ShapeSample, SurfacePoint};
+use crate::render::geometry::{face_forward, gamma, Bounds3};
+use crate::render::sampling::uniform_sample_triangle;
+use glam::{Vec2, Vec3};
+
+/// A triangle mesh with vertices in world space. Vertex arrays are shared by
+/// all triangles (32-bit indices).
+#[derive(Clone, Debug)]
+pub struct TriangleMesh {
+    pub p: Vec<Vec3>,
+    /// Per-vertex normals in world space (unnormalised allowed).
+    pub n: Option<Vec<Vec3>>,
+    pub uv: Option<Vec<Vec2>>,
+    pub indices: Vec<u32>,
+    /// ReverseOrientation XOR the transform swaps handedness.
+    pub flip_normal: bool,
+    pub material: u32,
+    /// Index of the area light of this mesh's first triangle; triangle `i`
+    /// has light `first_light + i` (one light per triangle, as pbrt-v3).
+    pub first_light: Option<u32>,
+}
+
+impl TriangleMesh {
+    #[inline]
+    pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
+        let i = 3 * tri as usize;
+        [
+            self.p[self.indices[i] as usize],
+            self.p[self.indices[i + 1] as usize],
+            self.p[self.indices[i + 2] as usize],
+        ]
+    }
+
+    pub fn triangle_count(&self) -> u32 {
+        (self.indices.len() / 3) as u32
+    }
+
+    pub fn area(&self, tri: u32) -> f32 {
+        let [p0, p1, p2] = self.vertices(tri);
+        0.5 * (p1 - p0).cross(p2 - p0).length()
+    }
+
+    pub fn bounds(&self, tri: u32) -> Bounds3 {
+        let [p0, p1, p2] = self.vertices(tri);
+        Bounds3::from_point(p0).union_point(p1).union_point(p2)
+    }
+
+    /// True if the triangle has zero area or non-finite vertices: such
+    /// triangles are left out of the scene (they can never be seen).
+    pub fn is_degenerate(&self, tri: u32) -> bool {
+        let [p0, p1, p2] = self.vertices(tri);
+        let c = (p0 - p2).cross(p1 - p2);
+        !(p0.is_finite() && p1.is_finite() && p2.is_finite()) || !(c.length_squared() > 0.0) || !c.length_squared().is_finite()
+    }
+
+    /// Oriented normals at barycentrics (b0, b1, b2), as pbrt-v3's triangle.cpp.
+    #[inline]
+    fn normals_at(&self, tri: u32, b: [f32; 3], geometric: Vec3) -> (Vec3, Vec3) {
+        let mut n = geometric;
+        if self.flip_normal {
+            n = -n;
+        }
+        if let Some(normals) = &self.n {
+            let i = 3 * tri as usize;
+            let ns = b[0] * normals[self.indices[i] as usize]
+                + b[1] * normals[self.indices[i + 1] as usize]
+                + b[2] * normals[self.indices[i + 2] as usize];
+            let l2 = ns.length_squared();
+            if l2 > 0.0 && l2.is_finite() {
+                let ns = ns / l2.sqrt();
+                // Per-vertex normals are authoritative for orientation.
+                return (face_forward(geometric, ns), ns);
+            }
+        }
+        (n, n)
+    }
+
+    /// The surface point at barycentrics `b` (b0 + b1 + b2 = 1).
+    #[inline]
+    pub fn surface_point(&self, tri: u32, b: [f32; 3]) -> SurfacePoint {
+        let [p0, p1, p2] = self.vertices(tri);
+        let p = b[0] * p0 + b[1] * p1 + b[2] * p2;
+        let p_error = gamma(7) * ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs());
+        let geometric = (p0 - p2).cross(p1 - p2).normalize();
+        let (n, ns) = self.normals_at(tri, b, geometric);
+        SurfacePoint { p, p_error, n, ns }
+    }
+
+    /// Uniform sample by area (pbrt-v3 Triangle::Sample).
+    pub fn sample_area(&self, tri: u32, u: Vec2) -> ShapeSample {
+        let b = uniform_sample_triangle(u);
+        let b = [b.x, b.y, 1.0 - b.x - b.y];
+        let mut point = self.surface_point(tri, b);
+        let [p0, p1, p2] = self.vertices(tri);
+        point.p_error = gamma(6) * ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs());
+        ShapeSample { point, pdf: 1.0 / self.area(tri) }
+    }
+}
+
+/// pbrt-v3's watertight ray–triangle test with its conservative check that
+/// t is positive. Returns (t, [b0, b1, b2]).
+#[inline]
+pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, [f32; 3])> {
+    // Translate to the ray origin, permute so z is the largest direction axis.
+    let mut p0t = p0 - o;
+    let mut p1t = p1 - o;
+    let mut p2t = p2 - o;
+    let ad = d.abs();
+    let kz = if ad.x > ad.y {
+        if ad.x > ad.z { 0 } else { 2 }
+    } else if ad.y > ad.z {
+        1
+    } else {
+        2
+    };
+    let kx = if kz == 2 { 0 } else { kz + 1 };
+    let ky = if kx == 2 { 0 } else { kx + 1 };
+    let perm = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
+    let dp = perm(d);
+    p0t = perm(p0t);
+    p1t = perm(p1t);
+    p2t = perm(p2t);
+    // Shear so the ray runs along +z.
+    let sz = 1.0 / dp.z;
+    let sx = -dp.x * sz;
+    let sy = -dp.y * sz;
+    p0t.x += sx * p0t.z;
+    p0t.y += sy * p0t.z;
+    p1t.x += sx * p1t.z;
+    p1t.y += sy * p1t.z;
+    p2t.x += sx * p2t.z;
+    p2t.y += sy * p2t.z;
+    let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
+    let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
+    let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        // Exactly on an edge in f32: decide in f64 (watertightness).
+        e0 = (p1t.x as f64 * p2t.y as f64 - p1t.y as f64 * p2t.x as f64) as f32;
+        e1 = (p2t.x as f64 * p0t.y as f64 - p2t.y as f64 * p0t.x as f64) as f32;
+        e2 = (p0t.x as f64 * p1t.y as f64 - p0t.y as f64 * p1t.x as f64) as f32;
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    p0t.z *= sz;
+    p1t.z *= sz;
+    p2t.z *= sz;
+    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    // Conservatively reject hits whose t cannot be told apart from zero.
+    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    let delta_z = gamma(3) * max_zt;
+    let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
+    let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t {
+        return None;
+    }
+    Some((t, [e0 * inv_det, e1 * inv_det, e2 * inv_det]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_inside_misses_outside() {
+        let (p0, p1, p2) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
+        let h = intersect_triangle(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, f32::INFINITY, p0, p1, p2).unwrap();
+        assert!((h.0 - 1.0).abs() < 1e-6);
+        let p = h.1[0] * p0 + h.1[1] * p1 + h.1[2] * p2;
+        assert!((p - Vec3::new(0.2, 0.2, 0.0)).length() < 1e-6);
+        assert!(intersect_triangle(Vec3::new(0.8, 0.8, 1.0), -Vec3::Z, f32::INFINITY, p0, p1, p2).is_none());
+        assert!(intersect_triangle(Vec3::new(0.2, 0.2, 1.0), Vec3::Z, f32::INFINITY, p0, p1, p2).is_none());
+        assert!(intersect_triangle(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 0.5, p0, p1, p2).is_none());
+    }
+
+    #[test]
+    fn degenerate_triangle_never_hits() {
+        let (p0, p1, p2) = (Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
+        for d in [-Vec3::Z, Vec3::new(0.1, 0.0, -1.0), Vec3::Y] {
+            assert!(intersect_triangle(Vec3::new(0.5, 0.0, 1.0), d, f32::INFINITY, p0, p1, p2).is_none());
+        }
+    }
+}
