@@ -1,1 +1,12 @@
-//! sampling
+//! The sampling toolkit: random numbers, piecewise-constant distributions,
+//! warps from the unit square with their densities, MIS heuristics, and a
+//! reusable chi-square harness ([`chi2`]) to test any of them.
+
+pub mod chi2;
+pub mod distribution;
+pub mod rng;
+pub mod warps;
+
+pub use distribution::{Distribution1D, Distribution2D};
+pub use rng::{Pcg32, ONE_MINUS_EPSILON};
+pub use warps::*;

@@ -1,0 +1,210 @@
+//! Piecewise-constant 1D and 2D distributions (pbrt-v3 core/sampling.h),
+//! made robust to degenerate input: negative or NaN values count as 0, and an
+//! all-zero function samples uniformly (with the matching pdf) instead of
+//! producing zero pdfs.
+
+use super::rng::ONE_MINUS_EPSILON;
+use glam::Vec2;
+
+/// Piecewise-constant distribution over `[0, 1)` with `count()` equal bins.
+#[derive(Clone, Debug)]
+pub struct Distribution1D {
+    /// Sanitised function values (finite, >= 0).
+    func: Vec<f32>,
+    /// Density per bin over [0,1] (integrates to 1).
+    pdf: Vec<f32>,
+    /// `count + 1` entries, `cdf[0] == 0`, `cdf[count] == 1`.
+    cdf: Vec<f32>,
+    /// Integral of the (sanitised) function over [0,1]: `Σ f / n`.
+    func_int: f32,
+}
+
+#[inline]
+fn sanitise(v: f32) -> f32 {
+    if v.is_finite() && v > 0.0 {
+        v
+    } else if v == f32::INFINITY {
+        f32::MAX
+    } else {
+        0.0
+    }
+}
+
+/// Index of the last `i` in `[0, cdf.len() - 2]` with `cdf[i] <= u`
+/// (pbrt's `FindInterval`).
+#[inline]
+fn find_interval(cdf: &[f32], u: f32) -> usize {
+    // partition_point: first index where cdf[i] > u.
+    let first_greater = cdf.partition_point(|&c| c <= u);
+    first_greater.saturating_sub(1).min(cdf.len() - 2)
+}
+
+/// `(offset + du) / n` strictly inside bin `offset` and strictly below 1, so
+/// that `pdf(x)` finds the bin the sample came from.
+#[inline]
+fn point_in_bin(offset: usize, du: f32, n: usize) -> f32 {
+    let nf = n as f32;
+    let mut x = ((offset as f32 + du) / nf).min(ONE_MINUS_EPSILON);
+    // Rounding can push x onto the next bin's edge: step down until it maps back.
+    while x > 0.0 && ((x * nf) as usize).min(n - 1) > offset {
+        x = f32::from_bits(x.to_bits() - 1);
+    }
+    x
+}
+
+impl Distribution1D {
+    /// Builds the distribution. An empty slice behaves as a single zero bin.
+    pub fn new(f: &[f32]) -> Self {
+        let func: Vec<f32> = if f.is_empty() {
+            vec![0.0]
+        } else {
+            f.iter().map(|&v| sanitise(v)).collect()
+        };
+        let n = func.len();
+        let mut cdf = vec![0.0f32; n + 1];
+        // Accumulate in f64 so long distributions keep their precision.
+        let mut acc = 0.0f64;
+        let mut sums = Vec::with_capacity(n + 1);
+        sums.push(0.0f64);
+        for &v in &func {
+            acc += v as f64;
+            sums.push(acc);
+        }
+        let total = acc;
+        let func_int = (total / n as f64) as f32;
+        let pdf: Vec<f32>;
+        if total > 0.0 && total.is_finite() {
+            for i in 1..=n {
+                cdf[i] = (sums[i] / total) as f32;
+            }
+            let inv = n as f64 / total;
+            pdf = func.iter().map(|&v| (v as f64 * inv) as f32).collect();
+        } else {
+            for (i, c) in cdf.iter_mut().enumerate() {
+                *c = i as f32 / n as f32;
+            }
+            pdf = vec![1.0; n];
+        }
+        cdf[n] = 1.0;
+        Self {
+            func,
+            pdf,
+            cdf,
+            func_int,
+        }
+    }
+
+    /// Number of bins.
+    #[inline]
+    pub fn count(&self) -> usize {
+        self.func.len()
+    }
+
+    /// Integral of the function over [0,1] (0 for an all-zero function, which
+    /// is nevertheless sampled uniformly).
+    #[inline]
+    pub fn func_int(&self) -> f32 {
+        self.func_int
+    }
+
+    /// The sanitised function values.
+    #[inline]
+    pub fn func(&self) -> &[f32] {
+        &self.func
+    }
+
+    /// Samples `x` in `[0,1)`; returns `(x, pdf(x), bin index)`.
+    #[inline]
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let offset = find_interval(&self.cdf, u);
+        let c0 = self.cdf[offset];
+        let width = self.cdf[offset + 1] - c0;
+        let mut du = u - c0;
+        if width > 0.0 {
+            du /= width;
+        }
+        let du = du.clamp(0.0, ONE_MINUS_EPSILON);
+        let x = point_in_bin(offset, du, self.count());
+        (x, self.pdf[offset], offset)
+    }
+
+    /// Samples a bin; returns `(index, probability, u remapped to [0,1))`.
+    #[inline]
+    pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let offset = find_interval(&self.cdf, u);
+        let c0 = self.cdf[offset];
+        let width = self.cdf[offset + 1] - c0;
+        let ur = if width > 0.0 {
+            ((u - c0) / width).clamp(0.0, ONE_MINUS_EPSILON)
+        } else {
+            0.0
+        };
+        (offset, self.discrete_pdf(offset), ur)
+    }
+
+    /// Probability of bin `i` under `sample_discrete`.
+    #[inline]
+    pub fn discrete_pdf(&self, i: usize) -> f32 {
+        self.pdf[i] / self.count() as f32
+    }
+
+    /// Density at `x` in `[0,1]` (values outside are clamped to the end bins).
+    #[inline]
+    pub fn pdf(&self, x: f32) -> f32 {
+        self.pdf[self.bin(x)]
+    }
+
+    #[inline]
+    fn bin(&self, x: f32) -> usize {
+        let n = self.count();
+        let i = (x * n as f32) as isize; // NaN -> 0, saturating
+        i.clamp(0, n as isize - 1) as usize
+    }
+}
+
+/// Piecewise-constant distribution over `[0,1)^2`: a marginal over rows (v)
+/// and one conditional per row (u).
+#[derive(Clone, Debug)]
+pub struct Distribution2D {
+    conditional: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// `f` is row-major: `nv` rows of `nu` values (`f.len()` must be `nu * nv`).
+    pub fn new(f: &[f32], nu: usize, nv: usize) -> Self {
+        assert!(nu > 0 && nv > 0, "Distribution2D needs at least one bin");
+        assert_eq!(f.len(), nu * nv, "Distribution2D: f.len() != nu * nv");
+        let conditional: Vec<Distribution1D> =
+            f.chunks_exact(nu).map(Distribution1D::new).collect();
+        let marginal_func: Vec<f32> = conditional.iter().map(|d| d.func_int()).collect();
+        let marginal = Distribution1D::new(&marginal_func);
+        Self {
+            conditional,
+            marginal,
+        }
+    }
+
+    /// Samples a point; returns `(p, pdf(p))`.
+    #[inline]
+    pub fn sample_continuous(&self, u: Vec2) -> (Vec2, f32) {
+        let (d1, pdf1, v) = self.marginal.sample_continuous(u.y);
+        let (d0, pdf0, _) = self.conditional[v].sample_continuous(u.x);
+        (Vec2::new(d0, d1), pdf0 * pdf1)
+    }
+
+    /// Density at `p` in `[0,1]^2`.
+    #[inline]
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let iv = self.marginal.bin(p.y);
+        self.marginal.pdf[iv] * self.conditional[iv].pdf(p.x)
+    }
+
+    pub fn marginal(&self) -> &Distribution1D {
+        &self.marginal
+    }
+
+    pub fn conditional(&self, v: usize) -> &Distribution1D {
+        &self.conditional[v]
+    }
+}
