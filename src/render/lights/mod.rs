@@ -1,1 +1,174 @@
-//! lights
+//! Lights: diffuse area lights (one per triangle, as pbrt-v3, or per sphere),
+//! point, spot, distant and constant infinite lights; and the distributions
+//! that choose which light to sample.
+
+mod distribution;
+
+pub use distribution::{LightSampler, LightSamplerKind};
+
+use crate::render::accel::Geometry;
+use crate::render::geometry::{luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray};
+use crate::render::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
+use crate::render::shapes::SurfacePoint;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// The shape an area light sits on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AreaShape {
+    Triangle { mesh: u32, tri: u32 },
+    Sphere(u32),
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Light {
+    Area { shape: AreaShape, l: Vec3, two_sided: bool, n_samples: u32, area: f32 },
+    Point { p: Vec3, intensity: Vec3 },
+    Spot { p: Vec3, frame: Frame, intensity: Vec3, cos_total: f32, cos_falloff_start: f32 },
+    /// `w` points towards the light.
+    Distant { w: Vec3, l: Vec3, scene_radius: f32 },
+    Infinite { l: Vec3, n_samples: u32, scene_radius: f32 },
+}
+
+/// A light sample as seen from a reference point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    pub li: Vec3,
+    pub wi: Vec3,
+    /// Solid-angle density (1 for delta lights).
+    pub pdf: f32,
+    /// The shadow ray to test; unoccluded means the light is seen.
+    pub shadow: Ray,
+}
+
+impl Light {
+    /// Delta lights cannot be hit by rays (no BSDF sample for them in MIS).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. })
+    }
+
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Infinite { .. })
+    }
+
+    pub fn n_samples(&self) -> u32 {
+        match *self {
+            Light::Area { n_samples, .. } | Light::Infinite { n_samples, .. } => n_samples.max(1),
+            _ => 1,
+        }
+    }
+
+    /// Luminance of the emitted power (pbrt-v3's `Power().y()`).
+    pub fn power(&self) -> f32 {
+        let p = match *self {
+            Light::Area { l, two_sided, area, .. } => l * area * PI * if two_sided { 2.0 } else { 1.0 },
+            Light::Point { intensity, .. } => 4.0 * PI * intensity,
+            Light::Spot { intensity, cos_total, cos_falloff_start, .. } => {
+                intensity * 2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total))
+            }
+            Light::Distant { l, scene_radius, .. } | Light::Infinite { l, scene_radius, .. } => {
+                l * PI * scene_radius * scene_radius
+            }
+        };
+        luminance(p).max(0.0)
+    }
+
+    /// Emitted radiance of an area light at a point with normal `n`, towards `w`.
+    #[inline]
+    pub fn emitted(&self, n: Vec3, w: Vec3) -> Vec3 {
+        match *self {
+            Light::Area { l, two_sided, .. } if two_sided || n.dot(w) > 0.0 => l,
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// Radiance arriving along a ray that escapes the scene.
+    #[inline]
+    pub fn le_escaped(&self) -> Vec3 {
+        match *self {
+            Light::Infinite { l, .. } => l,
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// Sample incident light at `r` (pbrt-v3's Sample_Li). Visibility is not
+    /// tested here: the caller traces `shadow`.
+    #[inline]
+    pub fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample> {
+        match *self {
+            Light::Area { shape, l, two_sided, .. } => {
+                let s = match shape {
+                    AreaShape::Triangle { mesh, tri } => {
+                        let s = geom.meshes[mesh as usize].sample_area(tri, u);
+                        crate::render::shapes::to_solid_angle(r.p, s)?
+                    }
+                    AreaShape::Sphere(i) => geom.spheres[i as usize].sample_from(r.p, r.p_error, r.n, u)?,
+                };
+                let d = s.point.p - r.p;
+                if d.length_squared() == 0.0 || !(s.pdf > 0.0) {
+                    return None;
+                }
+                let wi = d.normalize();
+                let li = if two_sided || s.point.n.dot(-wi) > 0.0 { l } else { Vec3::ZERO };
+                let shadow = spawn_ray_to(r.p, r.p_error, r.n, s.point.p, s.point.p_error, s.point.n);
+                Some(LightSample { li, wi, pdf: s.pdf, shadow })
+            }
+            Light::Point { p, intensity } => {
+                let d = p - r.p;
+                let d2 = d.length_squared();
+                if d2 == 0.0 {
+                    return None;
+                }
+                Some(LightSample { li: intensity / d2, wi: d / d2.sqrt(), pdf: 1.0, shadow: spawn_ray_to_point(r.p, r.p_error, r.n, p) })
+            }
+            Light::Spot { p, frame, intensity, cos_total, cos_falloff_start } => {
+                let d = p - r.p;
+                let d2 = d.length_squared();
+                if d2 == 0.0 {
+                    return None;
+                }
+                let wi = d / d2.sqrt();
+                let cos = frame.to_local(-wi).z;
+                let falloff = if cos < cos_total {
+                    0.0
+                } else if cos > cos_falloff_start {
+                    1.0
+                } else {
+                    let delta = (cos - cos_total) / (cos_falloff_start - cos_total);
+                    (delta * delta) * (delta * delta)
+                };
+                Some(LightSample { li: intensity * falloff / d2, wi, pdf: 1.0, shadow: spawn_ray_to_point(r.p, r.p_error, r.n, p) })
+            }
+            Light::Distant { w, l, scene_radius } => {
+                let far = r.p + w * (2.0 * scene_radius);
+                Some(LightSample { li: l, wi: w, pdf: 1.0, shadow: spawn_ray_to_point(r.p, r.p_error, r.n, far) })
+            }
+            Light::Infinite { l, .. } => {
+                let wi = uniform_sample_sphere(u);
+                // Anything in the way occludes an infinitely distant light.
+                let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
+                Some(LightSample { li: l, wi, pdf: uniform_sphere_pdf(), shadow })
+            }
+        }
+    }
+
+    /// Solid-angle density of `sample_li` for direction `wi` from `r`, given
+    /// where that direction hits this light (`hit`; None for escaped rays).
+    #[inline]
+    pub fn pdf_li(&self, r: &SurfacePoint, hit: Option<&SurfacePoint>, geom: &Geometry) -> f32 {
+        match *self {
+            Light::Area { shape, area, .. } => {
+                let Some(h) = hit else { return 0.0 };
+                match shape {
+                    AreaShape::Triangle { .. } => {
+                        crate::render::shapes::area_to_solid_angle(r.p, h.p, h.n, 1.0 / area)
+                    }
+                    AreaShape::Sphere(i) => geom.spheres[i as usize].pdf_from(r.p, r.p_error, r.n, h.p, h.n),
+                }
+            }
+            Light::Infinite { .. } => uniform_sphere_pdf(),
+            _ => 0.0,
+        }
+    }
+}

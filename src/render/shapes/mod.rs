@@ -5,6 +5,7 @@ mod sphere;
 mod triangle;
 
 pub use sphere::Sphere;
+pub use sphere::{area_to_solid_angle, to_solid_angle};
 pub use triangle::{intersect_triangle, TriangleMesh};
 
 use glam::Vec3;

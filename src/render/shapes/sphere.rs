@@ -241,14 +241,14 @@ impl Sphere {
 }
 
 /// Convert an area sample to a solid-angle density as seen from `p`.
-pub(crate) fn to_solid_angle(p: Vec3, mut s: ShapeSample) -> Option<ShapeSample> {
+pub fn to_solid_angle(p: Vec3, mut s: ShapeSample) -> Option<ShapeSample> {
     s.pdf = area_to_solid_angle(p, s.point.p, s.point.n, s.pdf);
     (s.pdf > 0.0).then_some(s)
 }
 
 /// pdf_A · r² / |cos θ'|; 0 when degenerate or infinite.
 #[inline]
-pub(crate) fn area_to_solid_angle(p: Vec3, q: Vec3, nq: Vec3, pdf_area: f32) -> f32 {
+pub fn area_to_solid_angle(p: Vec3, q: Vec3, nq: Vec3, pdf_area: f32) -> f32 {
     let d = q - p;
     let dist2 = d.length_squared();
     if dist2 == 0.0 {

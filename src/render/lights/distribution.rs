@@ -1,0 +1,156 @@
+//! Which light to sample at a point (pbrt-v3's LightDistribution): uniform,
+//! by power, or spatial (a voxel grid over the scene bounds whose per-voxel
+//! distributions are built lazily, on first use, safely across threads).
+//!
+//! Lights with zero power are never chosen: they could not contribute.
+
+use super::Light;
+use crate::render::accel::Geometry;
+use crate::render::geometry::{luminance, Bounds3};
+use crate::render::sampling::Distribution1D;
+use crate::render::shapes::SurfacePoint;
+use glam::{Vec2, Vec3};
+use std::sync::OnceLock;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSamplerKind {
+    Uniform,
+    Power,
+    Spatial,
+}
+
+pub struct LightSampler {
+    kind: LightSamplerKind,
+    /// Indices of lights that can emit, in scene order.
+    active: Vec<u32>,
+    power: Option<Distribution1D>,
+    spatial: Option<SpatialGrid>,
+}
+
+struct SpatialGrid {
+    bounds: Bounds3,
+    n: [i32; 3],
+    voxels: Vec<OnceLock<Box<Distribution1D>>>,
+}
+
+const MAX_VOXELS: f32 = 64.0;
+
+fn radical_inverse(base: u32, mut a: u64) -> f32 {
+    let inv = 1.0 / base as f64;
+    let (mut rev, mut f) = (0u64, 1.0f64);
+    while a > 0 {
+        rev = rev * base as u64 + a % base as u64;
+        f *= inv;
+        a /= base as u64;
+    }
+    ((rev as f64 * f) as f32).min(crate::render::sampling::ONE_MINUS_EPSILON)
+}
+
+impl LightSampler {
+    /// Builds only what the strategy needs: nothing for one light or uniform,
+    /// a power table, or an (initially empty) voxel grid.
+    pub fn new(kind: LightSamplerKind, lights: &[Light], geom: &Geometry) -> LightSampler {
+        let active: Vec<u32> = (0..lights.len() as u32).filter(|&i| lights[i as usize].power() > 0.0).collect();
+        let kind = if active.len() <= 1 { LightSamplerKind::Uniform } else { kind };
+        let power = (kind == LightSamplerKind::Power).then(|| {
+            let p: Vec<f32> = active.iter().map(|&i| lights[i as usize].power()).collect();
+            Distribution1D::new(&p)
+        });
+        let spatial = (kind == LightSamplerKind::Spatial).then(|| {
+            let bounds = if geom.bounds.is_empty() { Bounds3::from_point(Vec3::ZERO) } else { geom.bounds };
+            let diag = bounds.diagonal();
+            let max_extent = diag.max_element();
+            let mut n = [1i32; 3];
+            for (i, ni) in n.iter_mut().enumerate() {
+                if max_extent > 0.0 {
+                    *ni = ((diag[i] / max_extent * MAX_VOXELS).round() as i32).max(1);
+                }
+            }
+            let count = (n[0] * n[1] * n[2]) as usize;
+            SpatialGrid { bounds, n, voxels: (0..count).map(|_| OnceLock::new()).collect() }
+        });
+        LightSampler { kind, active, power, spatial }
+    }
+
+    pub fn kind(&self) -> LightSamplerKind {
+        self.kind
+    }
+
+    pub fn active_count(&self) -> usize {
+        self.active.len()
+    }
+
+    /// Number of voxel distributions built so far (spatial only).
+    pub fn voxels_built(&self) -> usize {
+        self.spatial.as_ref().map_or(0, |s| s.voxels.iter().filter(|v| v.get().is_some()).count())
+    }
+
+    /// Choose a light for shading point `p`: (light index, probability).
+    #[inline]
+    pub fn sample(&self, p: Vec3, u: f32, lights: &[Light], geom: &Geometry) -> Option<(u32, f32)> {
+        let n = self.active.len();
+        if n == 0 {
+            return None;
+        }
+        let (i, pmf) = match self.kind {
+            LightSamplerKind::Uniform => (((u * n as f32) as usize).min(n - 1), 1.0 / n as f32),
+            LightSamplerKind::Power => {
+                let (i, pmf, _) = self.power.as_ref()?.sample_discrete(u);
+                (i, pmf)
+            }
+            LightSamplerKind::Spatial => {
+                let (i, pmf, _) = self.spatial.as_ref()?.lookup(p, &self.active, lights, geom).sample_discrete(u);
+                (i, pmf)
+            }
+        };
+        (pmf > 0.0).then(|| (self.active[i], pmf))
+    }
+}
+
+impl SpatialGrid {
+    fn lookup(&self, p: Vec3, active: &[u32], lights: &[Light], geom: &Geometry) -> &Distribution1D {
+        let o = self.bounds.offset(p);
+        let mut v = [0i32; 3];
+        for i in 0..3 {
+            let x = (o[i] * self.n[i] as f32) as i32; // NaN → 0
+            v[i] = x.clamp(0, self.n[i] - 1);
+        }
+        let idx = ((v[2] * self.n[1] + v[1]) * self.n[0] + v[0]) as usize;
+        self.voxels[idx].get_or_init(|| Box::new(self.compute(v, active, lights, geom)))
+    }
+
+    /// pbrt-v3's SpatialLightDistribution::ComputeDistribution: estimate each
+    /// light's contribution (Li/pdf, visibility ignored) at 128 Halton points
+    /// of the voxel, and floor every light at 0.1% of the average.
+    fn compute(&self, v: [i32; 3], active: &[u32], lights: &[Light], geom: &Geometry) -> Distribution1D {
+        let d = self.bounds.diagonal();
+        let vmin = self.bounds.min + d * Vec3::new(v[0] as f32 / self.n[0] as f32, v[1] as f32 / self.n[1] as f32, v[2] as f32 / self.n[2] as f32);
+        let vmax = self.bounds.min
+            + d * Vec3::new((v[0] + 1) as f32 / self.n[0] as f32, (v[1] + 1) as f32 / self.n[1] as f32, (v[2] + 1) as f32 / self.n[2] as f32);
+        let voxel = Bounds3 { min: vmin, max: vmax };
+        const N: u64 = 128;
+        let mut contrib = vec![0.0f32; active.len()];
+        for i in 0..N {
+            let po = voxel.lerp(Vec3::new(radical_inverse(2, i), radical_inverse(3, i), radical_inverse(5, i)));
+            let r = SurfacePoint { p: po, p_error: Vec3::ZERO, n: Vec3::ZERO, ns: Vec3::ZERO };
+            let u = Vec2::new(radical_inverse(7, i), radical_inverse(11, i));
+            for (j, &l) in active.iter().enumerate() {
+                if let Some(s) = lights[l as usize].sample_li(&r, u, geom) {
+                    if s.pdf > 0.0 {
+                        let c = luminance(s.li) / s.pdf;
+                        if c.is_finite() {
+                            contrib[j] += c;
+                        }
+                    }
+                }
+            }
+        }
+        let sum: f32 = contrib.iter().sum();
+        let avg = sum / (N as f32 * contrib.len() as f32);
+        let min = if avg > 0.0 { 0.001 * avg } else { 1.0 };
+        for c in &mut contrib {
+            *c = c.max(min);
+        }
+        Distribution1D::new(&contrib)
+    }
+}
