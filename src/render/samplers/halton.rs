@@ -111,10 +111,9 @@ impl HaltonSampler {
                 pixel.x.rem_euclid(MAX_RESOLUTION),
                 pixel.y.rem_euclid(MAX_RESOLUTION),
             ];
-            for i in 0..2 {
+            for (i, &pm_i) in pm.iter().enumerate() {
                 let base = if i == 0 { 2 } else { 3 };
-                let dim_offset =
-                    inverse_radical_inverse(base, pm[i] as u64, self.base_exponents[i]);
+                let dim_offset = inverse_radical_inverse(base, pm_i as u64, self.base_exponents[i]);
                 offset +=
                     dim_offset * (self.sample_stride / self.base_scales[i]) * self.mult_inverse[i];
             }
