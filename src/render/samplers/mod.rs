@@ -1,1 +1,209 @@
-//! samplers
+//! Samplers: where the sample values of every pixel sample come from.
+//!
+//! [`Sampler`] is an enum (no dynamic dispatch per sample), `Clone + Send`:
+//! each tile clones one. Positioning is stateless: after
+//! [`Sampler::start_pixel_sample`]`(pixel, index)` the values returned are a
+//! function of (pixel, index, seed) and of the calls made since, never of
+//! earlier pixels or of the thread. Every value is in `[0, 1)`.
+//!
+//! Halton follows pbrt-v3's `HaltonSampler` + `GlobalSampler`: one global
+//! sequence over the image whose first two dimensions are the pixel position.
+
+pub mod halton;
+pub mod lowdiscrepancy;
+pub mod random;
+pub mod stratified;
+
+pub use halton::HaltonSampler;
+pub use random::RandomSampler;
+pub use stratified::StratifiedSampler;
+
+use crate::render::geometry::Bounds2i;
+use crate::scene::{SamplerDesc, SamplerKind};
+use glam::{IVec2, Vec2};
+
+/// What a camera needs to generate a ray.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct CameraSample {
+    /// Position on the film in raster coordinates (pixel + offset in [0,1)).
+    pub p_film: Vec2,
+    pub p_lens: Vec2,
+    pub time: f32,
+}
+
+#[derive(Clone, Debug)]
+pub enum Sampler {
+    Halton(HaltonSampler),
+    Random(RandomSampler),
+    Stratified(StratifiedSampler),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Sampler::Halton($s) => $e,
+            Sampler::Random($s) => $e,
+            Sampler::Stratified($s) => $e,
+        }
+    };
+}
+
+impl Sampler {
+    /// Builds the sampler for `desc`. Kinds not implemented (sobol,
+    /// 02sequence, maxmindist) map to Halton. `sample_bounds` is the film's
+    /// sample bounds; `seed` changes scrambling and random streams (seed 0 is
+    /// pbrt-v3's own Halton permutations).
+    pub fn new(desc: &SamplerDesc, sample_bounds: Bounds2i, seed: u64) -> Sampler {
+        let spp = desc.pixel_samples.max(1);
+        match desc.kind {
+            SamplerKind::Random => Sampler::Random(RandomSampler::new(spp, seed)),
+            SamplerKind::Stratified {
+                jitter,
+                xsamples,
+                ysamples,
+            } => Sampler::Stratified(StratifiedSampler::new(
+                xsamples, ysamples, spp, jitter, seed,
+            )),
+            SamplerKind::Halton
+            | SamplerKind::Sobol
+            | SamplerKind::ZeroTwoSequence
+            | SamplerKind::MaxMinDist => Sampler::Halton(HaltonSampler::new(
+                spp,
+                sample_bounds,
+                desc.sample_pixel_center,
+                seed,
+            )),
+        }
+    }
+
+    pub fn samples_per_pixel(&self) -> u32 {
+        dispatch!(self, s => s.samples_per_pixel())
+    }
+
+    /// Asks for an array of `n` 1D values per sample. Call before rendering,
+    /// in the same order as the later `get_1d_array` calls.
+    pub fn request_1d_array(&mut self, n: u32) {
+        dispatch!(self, s => s.request_1d_array(n))
+    }
+
+    pub fn request_2d_array(&mut self, n: u32) {
+        dispatch!(self, s => s.request_2d_array(n))
+    }
+
+    /// The array size to request for `n` wanted values (no rounding needed
+    /// by the samplers here).
+    pub fn round_count(&self, n: u32) -> u32 {
+        n
+    }
+
+    /// Positions the sampler at sample `sample_index` of `pixel`.
+    #[inline]
+    pub fn start_pixel_sample(&mut self, pixel: IVec2, sample_index: u32) {
+        dispatch!(self, s => s.start_pixel_sample(pixel, sample_index))
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self) -> f32 {
+        dispatch!(self, s => s.get_1d())
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self) -> Vec2 {
+        dispatch!(self, s => s.get_2d())
+    }
+
+    /// pbrt-v3's order: `p_film = pixel + get_2d()`, `time = get_1d()`,
+    /// `p_lens = get_2d()`. Call right after `start_pixel_sample`.
+    #[inline]
+    pub fn get_camera_sample(&mut self, pixel: IVec2) -> CameraSample {
+        let base = pixel.as_vec2();
+        // Keep p_film inside the pixel even when `pixel + offset` rounds up.
+        let top = Vec2::new(next_below(base.x + 1.0), next_below(base.y + 1.0));
+        let p_film = (base + self.get_2d()).min(top);
+        let time = self.get_1d();
+        let p_lens = self.get_2d();
+        CameraSample {
+            p_film,
+            p_lens,
+            time,
+        }
+    }
+
+    /// The next requested 1D array, if it has `n` entries; `None` once all
+    /// requested arrays were consumed for this sample (or on a size mismatch).
+    #[inline]
+    pub fn get_1d_array(&mut self, n: u32) -> Option<&[f32]> {
+        dispatch!(self, s => s.get_1d_array(n))
+    }
+
+    #[inline]
+    pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
+        dispatch!(self, s => s.get_2d_array(n))
+    }
+}
+
+/// The largest `f32` below `x` (for finite, positive-step values).
+#[inline]
+fn next_below(x: f32) -> f32 {
+    if x > 0.0 {
+        f32::from_bits(x.to_bits() - 1)
+    } else if x == 0.0 {
+        -f32::from_bits(1)
+    } else {
+        f32::from_bits(x.to_bits() + 1)
+    }
+}
+
+/// Requested sample arrays and their current contents.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ArrayStore {
+    pub sizes_1d: Vec<u32>,
+    pub sizes_2d: Vec<u32>,
+    /// Each holds `size * copies` values: `copies` is 1 for samplers that fill
+    /// arrays per sample, `spp` for those that fill them per pixel.
+    pub data_1d: Vec<Vec<f32>>,
+    pub data_2d: Vec<Vec<Vec2>>,
+    pub next_1d: usize,
+    pub next_2d: usize,
+}
+
+impl ArrayStore {
+    pub fn request_1d(&mut self, n: u32, copies: u32) {
+        self.sizes_1d.push(n);
+        self.data_1d.push(vec![0.0; n as usize * copies as usize]);
+    }
+
+    pub fn request_2d(&mut self, n: u32, copies: u32) {
+        self.sizes_2d.push(n);
+        self.data_2d
+            .push(vec![Vec2::ZERO; n as usize * copies as usize]);
+    }
+
+    #[inline]
+    pub fn reset(&mut self) {
+        self.next_1d = 0;
+        self.next_2d = 0;
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self, n: u32, copy: usize) -> Option<&[f32]> {
+        let i = self.next_1d;
+        if i >= self.sizes_1d.len() || self.sizes_1d[i] != n {
+            return None;
+        }
+        self.next_1d += 1;
+        let start = copy * n as usize;
+        self.data_1d[i].get(start..start + n as usize)
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self, n: u32, copy: usize) -> Option<&[Vec2]> {
+        let i = self.next_2d;
+        if i >= self.sizes_2d.len() || self.sizes_2d[i] != n {
+            return None;
+        }
+        self.next_2d += 1;
+        let start = copy * n as usize;
+        self.data_2d[i].get(start..start + n as usize)
+    }
+}

@@ -1,0 +1,229 @@
+//! pbrt-v3's `HaltonSampler` (samplers/halton.cpp) with `GlobalSampler`'s
+//! dimension and array handling (core/sampler.cpp).
+
+use super::lowdiscrepancy::{
+    inverse_radical_inverse, multiplicative_inverse, radical_inverse, radical_inverse_base2,
+    scrambled_radical_inverse, DigitBase, PermutationTables, PRIME_TABLE_SIZE,
+};
+use super::ArrayStore;
+use crate::render::geometry::Bounds2i;
+use crate::render::sampling::rng::{hash_to_unit, mix64};
+use glam::{IVec2, Vec2};
+use std::sync::Arc;
+
+/// Resolution at which the pixel-position dimensions repeat (pbrt-v3's kMaxResolution).
+const MAX_RESOLUTION: i32 = 128;
+/// First dimension used by sample arrays (GlobalSampler's arrayStartDim).
+const ARRAY_START_DIM: u32 = 5;
+const BASE3: DigitBase = DigitBase::new(3);
+
+#[derive(Clone, Debug)]
+pub struct HaltonSampler {
+    tables: Arc<PermutationTables>,
+    spp: u32,
+    seed_hash: u64,
+    sample_at_pixel_center: bool,
+    base_scales: [u64; 2],
+    base_exponents: [u32; 2],
+    sample_stride: u64,
+    mult_inverse: [u64; 2],
+    // Per-pixel cache of GetIndexForSample's offset.
+    pixel_for_offset: Option<IVec2>,
+    offset_for_pixel: u64,
+    // Current sample.
+    sample_index: u32,
+    interval_index: u64,
+    dimension: u32,
+    array_end_dim: u32,
+    arrays: ArrayStore,
+}
+
+impl HaltonSampler {
+    pub fn new(spp: u32, sample_bounds: Bounds2i, sample_at_pixel_center: bool, seed: u64) -> Self {
+        let res = sample_bounds.max - sample_bounds.min;
+        let mut base_scales = [1u64; 2];
+        let mut base_exponents = [0u32; 2];
+        for i in 0..2 {
+            let base = if i == 0 { 2 } else { 3 };
+            let (mut scale, mut exp) = (1i32, 0u32);
+            while scale < res[i].min(MAX_RESOLUTION) {
+                scale *= base;
+                exp += 1;
+            }
+            base_scales[i] = scale as u64;
+            base_exponents[i] = exp;
+        }
+        let sample_stride = base_scales[0] * base_scales[1];
+        let mult_inverse = [
+            multiplicative_inverse(base_scales[1] as i64, base_scales[0] as i64),
+            multiplicative_inverse(base_scales[0] as i64, base_scales[1] as i64),
+        ];
+        Self {
+            tables: PermutationTables::shared(seed),
+            spp: spp.max(1),
+            seed_hash: mix64(seed ^ 0x4a61_6c74_6f6e_5f68),
+            sample_at_pixel_center,
+            base_scales,
+            base_exponents,
+            sample_stride,
+            mult_inverse,
+            pixel_for_offset: None,
+            offset_for_pixel: 0,
+            sample_index: 0,
+            interval_index: 0,
+            dimension: 0,
+            array_end_dim: ARRAY_START_DIM,
+            arrays: ArrayStore::default(),
+        }
+    }
+
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.spp
+    }
+
+    pub fn request_1d_array(&mut self, n: u32) {
+        self.arrays.request_1d(n, 1);
+        self.update_array_end();
+    }
+
+    pub fn request_2d_array(&mut self, n: u32) {
+        self.arrays.request_2d(n, 1);
+        self.update_array_end();
+    }
+
+    fn update_array_end(&mut self) {
+        self.array_end_dim = ARRAY_START_DIM
+            + self.arrays.sizes_1d.len() as u32
+            + 2 * self.arrays.sizes_2d.len() as u32;
+    }
+
+    /// pbrt-v3's `GetIndexForSample`: the global index of sample `sample_num`
+    /// of the current pixel.
+    #[inline]
+    fn index_for_sample(&self, sample_num: u64) -> u64 {
+        self.offset_for_pixel + sample_num * self.sample_stride
+    }
+
+    fn compute_pixel_offset(&mut self, pixel: IVec2) {
+        let mut offset = 0u64;
+        if self.sample_stride > 1 {
+            let pm = [
+                pixel.x.rem_euclid(MAX_RESOLUTION),
+                pixel.y.rem_euclid(MAX_RESOLUTION),
+            ];
+            for (i, &pm_i) in pm.iter().enumerate() {
+                let base = if i == 0 { 2 } else { 3 };
+                let dim_offset = inverse_radical_inverse(base, pm_i as u64, self.base_exponents[i]);
+                offset +=
+                    dim_offset * (self.sample_stride / self.base_scales[i]) * self.mult_inverse[i];
+            }
+            offset %= self.sample_stride;
+        }
+        self.offset_for_pixel = offset;
+        self.pixel_for_offset = Some(pixel);
+    }
+
+    /// pbrt-v3's `SampleDimension`, extended past the last prime with
+    /// hashed values.
+    #[inline]
+    fn sample_dimension(&self, index: u64, dim: u32) -> f32 {
+        if self.sample_at_pixel_center && dim < 2 {
+            return 0.5;
+        }
+        match dim {
+            0 => radical_inverse_base2(index >> self.base_exponents[0]),
+            1 => radical_inverse(&BASE3, index / self.base_scales[1]),
+            d if (d as usize) < PRIME_TABLE_SIZE => {
+                let (b, perm) = self.tables.dimension(d as usize);
+                scrambled_radical_inverse(b, perm, index)
+            }
+            d => hash_to_unit(mix64(
+                mix64(index ^ self.seed_hash)
+                    .wrapping_add((d as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)),
+            )),
+        }
+    }
+
+    pub fn start_pixel_sample(&mut self, pixel: IVec2, sample_index: u32) {
+        if self.pixel_for_offset != Some(pixel) {
+            self.compute_pixel_offset(pixel);
+        }
+        self.sample_index = sample_index;
+        self.dimension = 0;
+        self.interval_index = self.index_for_sample(sample_index as u64);
+        // Arrays: entry k of this sample's array is sample `index * n + k` of
+        // the pixel, as GlobalSampler::StartPixel lays them out.
+        let mut arrays = std::mem::take(&mut self.arrays);
+        for (i, (&n, data)) in arrays
+            .sizes_1d
+            .iter()
+            .zip(arrays.data_1d.iter_mut())
+            .enumerate()
+        {
+            let first = sample_index as u64 * n as u64;
+            for (k, v) in data.iter_mut().enumerate() {
+                *v = self.sample_dimension(
+                    self.index_for_sample(first + k as u64),
+                    ARRAY_START_DIM + i as u32,
+                );
+            }
+        }
+        let mut dim = ARRAY_START_DIM + arrays.sizes_1d.len() as u32;
+        for (&n, data) in arrays.sizes_2d.iter().zip(arrays.data_2d.iter_mut()) {
+            let first = sample_index as u64 * n as u64;
+            for (k, v) in data.iter_mut().enumerate() {
+                let idx = self.index_for_sample(first + k as u64);
+                *v = Vec2::new(
+                    self.sample_dimension(idx, dim),
+                    self.sample_dimension(idx, dim + 1),
+                );
+            }
+            dim += 2;
+        }
+        arrays.reset();
+        self.arrays = arrays;
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self) -> f32 {
+        if self.dimension >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
+            self.dimension = self.array_end_dim;
+        }
+        let v = self.sample_dimension(self.interval_index, self.dimension);
+        self.dimension += 1;
+        v
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self) -> Vec2 {
+        if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
+            self.dimension = self.array_end_dim;
+        }
+        let p = Vec2::new(
+            self.sample_dimension(self.interval_index, self.dimension),
+            self.sample_dimension(self.interval_index, self.dimension + 1),
+        );
+        self.dimension += 2;
+        p
+    }
+
+    #[inline]
+    pub fn get_1d_array(&mut self, n: u32) -> Option<&[f32]> {
+        self.arrays.get_1d(n, 0)
+    }
+
+    #[inline]
+    pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
+        self.arrays.get_2d(n, 0)
+    }
+
+    /// The global Halton index of the current sample (for tests and debugging).
+    pub fn global_index(&self) -> u64 {
+        self.interval_index
+    }
+
+    /// The current dimension (next one `get_1d` would use, before array skipping).
+    pub fn dimension(&self) -> u32 {
+        self.dimension
+    }
+}

@@ -1,0 +1,276 @@
+//! Radical inverses and pbrt-v3's digit-permutation tables
+//! (core/lowdiscrepancy.{h,cpp}), with integer digit extraction by
+//! multiply-high instead of division.
+
+use crate::render::sampling::rng::{Pcg32, ONE_MINUS_EPSILON};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Number of primes in the table, as pbrt-v3's `PrimeTableSize`.
+pub const PRIME_TABLE_SIZE: usize = 1000;
+
+const fn compute_primes() -> [u32; PRIME_TABLE_SIZE] {
+    let mut primes = [0u32; PRIME_TABLE_SIZE];
+    let mut count = 0;
+    let mut n = 2u32;
+    while count < PRIME_TABLE_SIZE {
+        let mut is_prime = true;
+        let mut i = 0;
+        while i < count {
+            let p = primes[i];
+            if p * p > n {
+                break;
+            }
+            if n.is_multiple_of(p) {
+                is_prime = false;
+                break;
+            }
+            i += 1;
+        }
+        if is_prime {
+            primes[count] = n;
+            count += 1;
+        }
+        n += 1;
+    }
+    primes
+}
+
+/// The first 1000 primes (2 ..= 7919).
+pub static PRIMES: [u32; PRIME_TABLE_SIZE] = compute_primes();
+
+/// Radical inverse in base 2 by bit reversal: `a` mirrored about the binary point.
+#[inline]
+pub fn radical_inverse_base2(a: u64) -> f32 {
+    let v = (a.reverse_bits() >> 11) as f64 * (1.0 / 9_007_199_254_740_992.0);
+    (v as f32).min(ONE_MINUS_EPSILON)
+}
+
+/// Per-dimension constants of the (scrambled) radical inverse.
+#[derive(Clone, Copy, Debug)]
+pub struct DigitBase {
+    pub base: u32,
+    /// `ceil(2^64 / base)`: `(n * magic) >> 64 == n / base` for every `n < 2^32`.
+    magic: u64,
+    inv_base: f64,
+}
+
+impl DigitBase {
+    pub const fn new(base: u32) -> Self {
+        Self {
+            base,
+            magic: u64::MAX / base as u64 + 1,
+            inv_base: 1.0 / base as f64,
+        }
+    }
+
+    /// `(a / base, a % base)`.
+    #[inline(always)]
+    fn div_rem(&self, a: u64) -> (u64, u64) {
+        let q = if a <= u32::MAX as u64 {
+            ((a as u128 * self.magic as u128) >> 64) as u64
+        } else {
+            a / self.base as u64
+        };
+        (q, a - q * self.base as u64)
+    }
+}
+
+/// Unscrambled radical inverse of `a` in `b.base`.
+#[inline]
+pub fn radical_inverse(b: &DigitBase, mut a: u64) -> f32 {
+    let mut reversed: u64 = 0;
+    let mut inv_base_n = 1.0f64;
+    let base = b.base as u64;
+    while a != 0 {
+        let (next, digit) = b.div_rem(a);
+        reversed = reversed.wrapping_mul(base).wrapping_add(digit);
+        inv_base_n *= b.inv_base;
+        a = next;
+    }
+    ((reversed as f64 * inv_base_n) as f32).min(ONE_MINUS_EPSILON)
+}
+
+/// Radical inverse with every digit (including the infinitely many leading
+/// zeros) mapped through `perm` (pbrt-v3's `ScrambledRadicalInverse`).
+#[inline]
+pub fn scrambled_radical_inverse(b: &DigitBase, perm: &[u16], mut a: u64) -> f32 {
+    let base = b.base as u64;
+    debug_assert_eq!(perm.len(), b.base as usize);
+    let mut reversed: u64 = 0;
+    let mut inv_base_n = 1.0f64;
+    while a != 0 {
+        let (next, digit) = b.div_rem(a);
+        reversed = reversed
+            .wrapping_mul(base)
+            .wrapping_add(perm[digit as usize] as u64);
+        inv_base_n *= b.inv_base;
+        a = next;
+    }
+    // The tail of permuted zero digits sums to perm[0] / (base - 1).
+    let tail = perm[0] as f64 / (base - 1) as f64;
+    ((inv_base_n * (reversed as f64 + tail)) as f32).min(ONE_MINUS_EPSILON)
+}
+
+/// Inverse of the radical inverse on the first `n_digits` digits
+/// (pbrt-v3's `InverseRadicalInverse<base>`).
+#[inline]
+pub fn inverse_radical_inverse(base: u64, mut inverse: u64, n_digits: u32) -> u64 {
+    let mut index = 0;
+    for _ in 0..n_digits {
+        let digit = inverse % base;
+        inverse /= base;
+        index = index * base + digit;
+    }
+    index
+}
+
+/// Digit permutations for every prime base, concatenated (pbrt-v3's
+/// `ComputeRadicalInversePermutations`), with per-dimension bases.
+#[derive(Debug)]
+pub struct PermutationTables {
+    perms: Vec<u16>,
+    offsets: Vec<u32>,
+    bases: Vec<DigitBase>,
+}
+
+impl PermutationTables {
+    /// Tables generated from `rng` exactly as pbrt-v3 does (it passes a
+    /// default-constructed `RNG`).
+    pub fn generate(rng: &mut Pcg32) -> Self {
+        let total: usize = PRIMES.iter().map(|&p| p as usize).sum();
+        let mut perms = vec![0u16; total];
+        let mut offsets = Vec::with_capacity(PRIME_TABLE_SIZE);
+        let mut off = 0usize;
+        for &p in PRIMES.iter() {
+            offsets.push(off as u32);
+            let slice = &mut perms[off..off + p as usize];
+            for (j, v) in slice.iter_mut().enumerate() {
+                *v = j as u16;
+            }
+            // pbrt-v3's Shuffle(p, count, 1, rng).
+            for i in 0..p as usize {
+                let other = i + rng.uniform_u32_below(p - i as u32) as usize;
+                slice.swap(i, other);
+            }
+            off += p as usize;
+        }
+        let bases = PRIMES.iter().map(|&p| DigitBase::new(p)).collect();
+        Self {
+            perms,
+            offsets,
+            bases,
+        }
+    }
+
+    /// Shared tables for a seed: seed 0 gives pbrt-v3's own permutations
+    /// (default `RNG`); other seeds use the PCG32 stream `seed`.
+    pub fn shared(seed: u64) -> Arc<PermutationTables> {
+        static DEFAULT: OnceLock<Arc<PermutationTables>> = OnceLock::new();
+        static OTHERS: Mutex<Vec<(u64, Arc<PermutationTables>)>> = Mutex::new(Vec::new());
+        if seed == 0 {
+            return DEFAULT
+                .get_or_init(|| Arc::new(Self::generate(&mut Pcg32::new())))
+                .clone();
+        }
+        let mut others = OTHERS.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, t)) = others.iter().find(|(s, _)| *s == seed) {
+            return t.clone();
+        }
+        let t = Arc::new(Self::generate(&mut Pcg32::with_sequence(seed)));
+        if others.len() >= 8 {
+            others.remove(0);
+        }
+        others.push((seed, t.clone()));
+        t
+    }
+
+    /// Permutation and base of prime dimension `dim` (< PRIME_TABLE_SIZE).
+    #[inline(always)]
+    pub fn dimension(&self, dim: usize) -> (&DigitBase, &[u16]) {
+        let b = &self.bases[dim];
+        let off = self.offsets[dim] as usize;
+        (b, &self.perms[off..off + b.base as usize])
+    }
+}
+
+/// pbrt-v3's `multiplicativeInverse(a, n)` via the extended Euclid algorithm.
+pub fn multiplicative_inverse(a: i64, n: i64) -> u64 {
+    fn extended_gcd(a: i64, b: i64) -> (i64, i64) {
+        if b == 0 {
+            return (1, 0);
+        }
+        let d = a / b;
+        let (xp, yp) = extended_gcd(b, a % b);
+        (yp, xp - d * yp)
+    }
+    let (x, _) = extended_gcd(a, n);
+    x.rem_euclid(n) as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn primes_table() {
+        assert_eq!(&PRIMES[..6], &[2, 3, 5, 7, 11, 13]);
+        assert_eq!(PRIMES[PRIME_TABLE_SIZE - 1], 7919);
+    }
+
+    #[test]
+    fn magic_division_is_exact() {
+        let mut r = Pcg32::with_sequence(5);
+        for &p in PRIMES.iter().step_by(7) {
+            let b = DigitBase::new(p);
+            for k in 0..2000u64 {
+                let a = if k < 1000 {
+                    u32::MAX as u64 - k
+                } else {
+                    r.uniform_u32() as u64
+                };
+                assert_eq!(b.div_rem(a), (a / p as u64, a % p as u64));
+            }
+            let a = u64::MAX - 3;
+            assert_eq!(b.div_rem(a), (a / p as u64, a % p as u64));
+        }
+    }
+
+    #[test]
+    fn radical_inverses() {
+        assert_eq!(radical_inverse_base2(1), 0.5);
+        assert_eq!(radical_inverse_base2(3), 0.75);
+        assert_eq!(radical_inverse_base2(6), 0.375);
+        let b3 = DigitBase::new(3);
+        assert!((radical_inverse(&b3, 1) - 1.0 / 3.0).abs() < 1e-7);
+        assert!((radical_inverse(&b3, 5) - 7.0 / 9.0).abs() < 1e-7); // 5 = 12_3 -> 0.21_3
+        let b2 = DigitBase::new(2);
+        for a in 0..1000 {
+            assert_eq!(radical_inverse(&b2, a), radical_inverse_base2(a));
+        }
+        // Identity permutation: scrambled == plain.
+        let id: Vec<u16> = (0..7).collect();
+        let b7 = DigitBase::new(7);
+        for a in 0..500 {
+            assert!(
+                (scrambled_radical_inverse(&b7, &id, a) - radical_inverse(&b7, a)).abs() < 1e-7
+            );
+        }
+        assert_eq!(inverse_radical_inverse(3, 5, 2), 7); // digits 12 -> 21
+        assert_eq!(multiplicative_inverse(3, 7), 5);
+        assert_eq!(multiplicative_inverse(128, 243) * 128 % 243, 1);
+    }
+
+    #[test]
+    fn permutations_are_permutations() {
+        let t = PermutationTables::shared(0);
+        for dim in [0, 1, 2, 10, 999] {
+            let (b, p) = t.dimension(dim);
+            let mut s: Vec<u16> = p.to_vec();
+            s.sort();
+            assert_eq!(s, (0..b.base as u16).collect::<Vec<_>>());
+        }
+        assert!(Arc::ptr_eq(&t, &PermutationTables::shared(0)));
+        let t7 = PermutationTables::shared(7);
+        assert_ne!(t7.dimension(5).1, t.dimension(5).1);
+    }
+}
