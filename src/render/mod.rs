@@ -10,4 +10,5 @@ pub mod lights;
 pub mod materials;
 pub mod samplers;
 pub mod sampling;
+pub mod scene;
 pub mod shapes;

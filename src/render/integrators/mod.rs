@@ -1,1 +1,379 @@
-//! integrators
+//! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
+//! power-heuristic MIS, Russian roulette), `directlighting` (strategy all or
+//! one, specular lobes followed recursively) and `whitted`.
+
+use crate::render::accel::SurfaceHit;
+use crate::render::geometry::{spawn_ray, Ray};
+use crate::render::lights::{LightSampler, LightSamplerKind};
+use crate::render::materials::{Bsdf, LobeFilter};
+use crate::render::samplers::Sampler;
+use crate::render::sampling::power_heuristic;
+use crate::render::scene::RenderScene;
+use crate::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
+use glam::{Vec2, Vec3};
+
+/// Rays traced, counted per tile and summed at the end (no shared counters).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayCounts {
+    /// Closest-hit rays (camera rays included).
+    pub closest: u64,
+    /// Occlusion (shadow) rays.
+    pub shadow: u64,
+}
+
+impl RayCounts {
+    pub fn add(&mut self, o: &RayCounts) {
+        self.closest += o.closest;
+        self.shadow += o.shadow;
+    }
+    pub fn total(&self) -> u64 {
+        self.closest + self.shadow
+    }
+}
+
+/// Per-tile scratch space, so the per-sample path never allocates.
+#[derive(Default)]
+pub struct Scratch {
+    u_light: Vec<Vec2>,
+    counts: RayCounts,
+}
+
+impl Scratch {
+    pub fn counts(&self) -> RayCounts {
+        self.counts
+    }
+}
+
+/// Rays crossing more than this many `Material "none"` surfaces in a row stop.
+const MAX_PASS_THROUGH: u32 = 256;
+
+pub enum Integrator {
+    Path { max_depth: u32, rr_threshold: f32, lights: LightSampler },
+    Direct { max_depth: u32, strategy: DirectStrategy, lights: LightSampler, n_light_samples: Vec<u32> },
+    Whitted { max_depth: u32 },
+}
+
+impl Integrator {
+    /// Builds the integrator and only the light distribution it uses.
+    pub fn new(desc: &IntegratorDesc, scene: &RenderScene) -> Integrator {
+        match *desc {
+            IntegratorDesc::Path { max_depth, rr_threshold, light_sample_strategy } => {
+                let kind = match light_sample_strategy {
+                    LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
+                    LightSampleStrategy::Power => LightSamplerKind::Power,
+                    LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
+                };
+                Integrator::Path { max_depth, rr_threshold, lights: LightSampler::new(kind, &scene.lights, &scene.geometry) }
+            }
+            IntegratorDesc::DirectLighting { max_depth, strategy } => Integrator::Direct {
+                max_depth,
+                strategy,
+                // pbrt-v3's directlighting chooses uniformly for strategy "one".
+                lights: LightSampler::new(LightSamplerKind::Uniform, &scene.lights, &scene.geometry),
+                n_light_samples: Vec::new(),
+            },
+            IntegratorDesc::Whitted { max_depth } => Integrator::Whitted { max_depth },
+        }
+    }
+
+    /// Requests the sampler arrays the integrator uses (pbrt-v3's Preprocess).
+    pub fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
+        if let Integrator::Direct { max_depth, strategy: DirectStrategy::All, n_light_samples, .. } = self {
+            *n_light_samples = scene.lights.iter().map(|l| sampler.round_count(l.n_samples())).collect();
+            for _ in 0..*max_depth {
+                for &n in n_light_samples.iter() {
+                    sampler.request_2d_array(n);
+                    sampler.request_2d_array(n);
+                }
+            }
+        }
+    }
+
+    pub fn light_sampler(&self) -> Option<&LightSampler> {
+        match self {
+            Integrator::Path { lights, .. } | Integrator::Direct { lights, .. } => Some(lights),
+            Integrator::Whitted { .. } => None,
+        }
+    }
+
+    /// Radiance arriving at the camera along `ray`.
+    #[inline]
+    pub fn li(&self, ray: Ray, scene: &RenderScene, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
+        match self {
+            Integrator::Path { max_depth, rr_threshold, lights } => {
+                path_li(ray, scene, sampler, scratch, *max_depth, *rr_threshold, lights)
+            }
+            Integrator::Direct { .. } | Integrator::Whitted { .. } => self.recursive_li(ray, scene, sampler, scratch, 0, 0),
+        }
+    }
+
+    /// directlighting and whitted: pbrt-v3's recursive Li.
+    fn recursive_li(&self, ray: Ray, scene: &RenderScene, sampler: &mut Sampler, scratch: &mut Scratch, depth: u32, pass: u32) -> Vec3 {
+        scratch.counts.closest += 1;
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            return escaped(scene);
+        };
+        let s = scene.geometry.surface(&hit);
+        let material = &scene.materials[s.material as usize];
+        if material.is_none() {
+            if pass >= MAX_PASS_THROUGH {
+                return Vec3::ZERO;
+            }
+            let next = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            return self.recursive_li(next, scene, sampler, scratch, depth, pass + 1);
+        }
+        let wo = -ray.d;
+        let bsdf = material.bsdf(s.point.ns, s.point.n, false);
+        let mut l = emitted(scene, &s, wo);
+        let max_depth = match *self {
+            Integrator::Direct { max_depth, strategy, ref lights, ref n_light_samples } => {
+                if !scene.lights.is_empty() {
+                    l += match strategy {
+                        DirectStrategy::All => sample_all_lights(scene, &s, &bsdf, wo, sampler, scratch, n_light_samples),
+                        DirectStrategy::One => sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights),
+                    };
+                }
+                max_depth
+            }
+            Integrator::Whitted { max_depth } => {
+                for light in &scene.lights {
+                    let u = sampler.get_2d();
+                    let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else { continue };
+                    if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
+                        continue;
+                    }
+                    let f = bsdf.f(wo, ls.wi);
+                    if f != Vec3::ZERO {
+                        scratch.counts.shadow += 1;
+                        if !scene.geometry.occluded(&ls.shadow) {
+                            l += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
+                        }
+                    }
+                }
+                max_depth
+            }
+            Integrator::Path { .. } => unreachable!("path is not recursive"),
+        };
+        if depth + 1 < max_depth {
+            for filter in [LobeFilter::SpecularReflection, LobeFilter::SpecularTransmission] {
+                let u = sampler.get_2d();
+                if let Some(bs) = bsdf.sample(wo, u, filter) {
+                    let cos = bs.wi.dot(s.point.ns).abs();
+                    if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
+                        let next = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                        l += bs.f * self.recursive_li(next, scene, sampler, scratch, depth + 1, 0) * cos / bs.pdf;
+                    }
+                }
+            }
+        }
+        l
+    }
+}
+
+/// Emission of the surface towards `wo` (zero unless it is an area light).
+#[inline]
+fn emitted(scene: &RenderScene, s: &SurfaceHit, wo: Vec3) -> Vec3 {
+    match s.light {
+        Some(i) => scene.lights[i as usize].emitted(s.point.n, wo),
+        None => Vec3::ZERO,
+    }
+}
+
+/// Radiance of rays that leave the scene.
+#[inline]
+fn escaped(scene: &RenderScene) -> Vec3 {
+    scene.infinite_lights.iter().map(|&i| scene.lights[i as usize].le_escaped()).sum()
+}
+
+/// pbrt-v3's PathIntegrator::Li.
+fn path_li(
+    mut ray: Ray,
+    scene: &RenderScene,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+    max_depth: u32,
+    rr_threshold: f32,
+    lights: &LightSampler,
+) -> Vec3 {
+    let mut l = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    let mut specular_bounce = false;
+    let mut eta_scale = 1.0f32;
+    let mut bounces = 0u32;
+    let mut pass = 0u32;
+    loop {
+        scratch.counts.closest += 1;
+        let hit = scene.geometry.intersect(&ray);
+        let Some(hit) = hit else {
+            if bounces == 0 || specular_bounce {
+                l += beta * escaped(scene);
+            }
+            break;
+        };
+        let s = scene.geometry.surface(&hit);
+        let wo = -ray.d;
+        if bounces == 0 || specular_bounce {
+            l += beta * emitted(scene, &s, wo);
+        }
+        if bounces >= max_depth {
+            break;
+        }
+        let material = &scene.materials[s.material as usize];
+        if material.is_none() {
+            // Pass through without counting a bounce (pbrt-v3: bounces--).
+            pass += 1;
+            if pass > MAX_PASS_THROUGH {
+                break;
+            }
+            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            continue;
+        }
+        let bsdf = material.bsdf(s.point.ns, s.point.n, true);
+        if bsdf.has_non_specular() {
+            l += beta * sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights);
+        }
+        let u = sampler.get_2d();
+        let Some(bs) = bsdf.sample(wo, u, LobeFilter::All) else { break };
+        if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+            break;
+        }
+        beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
+        specular_bounce = bs.specular;
+        if bs.specular && bs.transmission {
+            let eta2 = bsdf.eta * bsdf.eta;
+            eta_scale *= if wo.dot(s.point.n) > 0.0 { eta2 } else { 1.0 / eta2 };
+        }
+        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+        // Russian roulette after bounce 3 on max(β·etaScale).
+        let rr = (beta * eta_scale).max_element();
+        if rr < rr_threshold && bounces > 3 {
+            let q = (1.0 - rr).max(0.05);
+            if sampler.get_1d() < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+        bounces += 1;
+    }
+    l
+}
+
+/// pbrt-v3's UniformSampleOneLight with a light distribution.
+#[inline]
+fn sample_one_light(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+    lights: &LightSampler,
+) -> Vec3 {
+    if scene.lights.is_empty() {
+        return Vec3::ZERO;
+    }
+    let u = sampler.get_1d();
+    let Some((light, pmf)) = lights.sample(s.point.p, u, &scene.lights, &scene.geometry) else {
+        return Vec3::ZERO;
+    };
+    let u_light = sampler.get_2d();
+    let u_scatter = sampler.get_2d();
+    estimate_direct(scene, s, bsdf, wo, light, u_light, u_scatter, scratch) / pmf
+}
+
+/// pbrt-v3's UniformSampleAllLights with per-pixel sample arrays.
+fn sample_all_lights(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+    n_light_samples: &[u32],
+) -> Vec3 {
+    let mut l = Vec3::ZERO;
+    for (j, &n) in n_light_samples.iter().enumerate() {
+        let light = j as u32;
+        // The two arrays are consecutive; copy the first into reused scratch.
+        let mut u_light = std::mem::take(&mut scratch.u_light);
+        u_light.clear();
+        let got_light = sampler.get_2d_array(n).map(|a| u_light.extend_from_slice(a)).is_some();
+        let ld = if let (true, Some(u_scatter)) = (got_light, sampler.get_2d_array(n)) {
+            let mut sum = Vec3::ZERO;
+            for k in 0..n as usize {
+                sum += estimate_direct(scene, s, bsdf, wo, light, u_light[k], u_scatter[k], scratch);
+            }
+            sum / n as f32
+        } else {
+            let ul = sampler.get_2d();
+            let us = sampler.get_2d();
+            estimate_direct(scene, s, bsdf, wo, light, ul, us, scratch)
+        };
+        scratch.u_light = u_light;
+        l += ld;
+    }
+    l
+}
+
+/// pbrt-v3's EstimateDirect: one light sample and one BSDF sample combined
+/// with the power heuristic; the BSDF sample is skipped for delta lights.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn estimate_direct(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    light_index: u32,
+    u_light: Vec2,
+    u_scatter: Vec2,
+    scratch: &mut Scratch,
+) -> Vec3 {
+    let light = &scene.lights[light_index as usize];
+    let geom = &scene.geometry;
+    let ns = s.point.ns;
+    let mut ld = Vec3::ZERO;
+    if let Some(ls) = light.sample_li(&s.point, u_light, geom) {
+        if ls.pdf > 0.0 && ls.li != Vec3::ZERO {
+            let f = bsdf.f(wo, ls.wi) * ls.wi.dot(ns).abs();
+            if f != Vec3::ZERO {
+                scratch.counts.shadow += 1;
+                if !geom.occluded(&ls.shadow) {
+                    if light.is_delta() {
+                        ld += f * ls.li / ls.pdf;
+                    } else {
+                        let scattering_pdf = bsdf.pdf(wo, ls.wi);
+                        ld += f * ls.li * power_heuristic(1, ls.pdf, 1, scattering_pdf) / ls.pdf;
+                    }
+                }
+            }
+        }
+    }
+    if !light.is_delta() {
+        if let Some(bs) = bsdf.sample(wo, u_scatter, LobeFilter::NonSpecular) {
+            let f = bs.f * bs.wi.dot(ns).abs();
+            if f != Vec3::ZERO && bs.pdf > 0.0 {
+                let light_pdf = light.pdf_li(&s.point, bs.wi, geom);
+                if light_pdf == 0.0 {
+                    return ld;
+                }
+                let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
+                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                scratch.counts.closest += 1;
+                let li = match geom.intersect(&ray) {
+                    Some(h) => {
+                        let hs = geom.surface(&h);
+                        if hs.light == Some(light_index) {
+                            light.emitted(hs.point.n, -bs.wi)
+                        } else {
+                            Vec3::ZERO
+                        }
+                    }
+                    None => light.le_escaped(),
+                };
+                ld += f * li * weight / bs.pdf;
+            }
+        }
+    }
+    ld
+}

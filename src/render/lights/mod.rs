@@ -9,7 +9,7 @@ pub use distribution::{LightSampler, LightSamplerKind};
 use crate::render::accel::Geometry;
 use crate::render::geometry::{luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray};
 use crate::render::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
-use crate::render::shapes::SurfacePoint;
+use crate::render::shapes::{area_to_solid_angle, intersect_triangle, SurfacePoint};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -153,18 +153,30 @@ impl Light {
         }
     }
 
-    /// Solid-angle density of `sample_li` for direction `wi` from `r`, given
-    /// where that direction hits this light (`hit`; None for escaped rays).
+    /// Solid-angle density of `sample_li` producing direction `wi` from `r`
+    /// (pbrt-v3's Pdf_Li: for area lights, the ray is tested against the
+    /// light's own shape only). 0 when `wi` cannot come from this light.
     #[inline]
-    pub fn pdf_li(&self, r: &SurfacePoint, hit: Option<&SurfacePoint>, geom: &Geometry) -> f32 {
+    pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
         match *self {
             Light::Area { shape, area, .. } => {
-                let Some(h) = hit else { return 0.0 };
+                let ray = spawn_ray(r.p, r.p_error, r.n, wi);
                 match shape {
-                    AreaShape::Triangle { .. } => {
-                        crate::render::shapes::area_to_solid_angle(r.p, h.p, h.n, 1.0 / area)
+                    AreaShape::Triangle { mesh, tri } => {
+                        let m = &geom.meshes[mesh as usize];
+                        let [p0, p1, p2] = m.vertices(tri);
+                        match intersect_triangle(ray.o, ray.d, ray.t_max, p0, p1, p2) {
+                            Some((_, b)) => {
+                                let h = m.surface_point(tri, b);
+                                area_to_solid_angle(r.p, h.p, h.n, 1.0 / area)
+                            }
+                            None => 0.0,
+                        }
                     }
-                    AreaShape::Sphere(i) => geom.spheres[i as usize].pdf_from(r.p, r.p_error, r.n, h.p, h.n),
+                    AreaShape::Sphere(i) => {
+                        let s = &geom.spheres[i as usize];
+                        s.pdf_from(r.p, r.p_error, r.n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
+                    }
                 }
             }
             Light::Infinite { .. } => uniform_sphere_pdf(),

@@ -230,13 +230,21 @@ impl Sphere {
         to_solid_angle(p, s)
     }
 
-    /// Density by solid angle of `sample_from` producing a direction that
-    /// hits this sphere at `hit` (a world-space point with normal `hit_n`).
-    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, hit: Vec3, hit_n: Vec3) -> f32 {
+    /// Density by solid angle of `sample_from` producing direction `wi`
+    /// from `p` (pbrt-v3's Sphere::Pdf): the cone density when the sphere is
+    /// seen from outside, else the area density at the first hit of `wi`.
+    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3, hit: impl Fn(Vec3, Vec3) -> Option<(f32, DVec3)>) -> f32 {
         if let Some((_, _, cos_max)) = self.cone_from(p, p_error, n) {
             return uniform_cone_pdf(cos_max);
         }
-        area_to_solid_angle(p, hit, hit_n, self.pdf_area(hit))
+        let o = offset_ray_origin(p, p_error, n, wi);
+        match hit(o, wi) {
+            Some((_, p_obj)) => {
+                let h = self.surface_point(p_obj);
+                area_to_solid_angle(p, h.p, h.n, self.pdf_area(h.p))
+            }
+            None => 0.0,
+        }
     }
 }
 
