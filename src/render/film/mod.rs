@@ -1,1 +1,343 @@
-//! film
+//! The film: reconstruction filters, film tiles, the final image, image
+//! files and image comparison metrics.
+//!
+//! Follows pbrt-v3's `Film`/`FilmTile` (core/film.{h,cpp}): a 16×16 table of
+//! the filter over the positive quadrant, the same sample footprint and table
+//! lookups, sums in `f64`. Tiles are filled independently and merged by the
+//! caller in a fixed order with plain additions, so an image does not depend
+//! on the number of threads.
+
+pub mod compare;
+pub mod filter;
+pub mod io;
+
+pub use filter::Filter;
+
+use crate::render::geometry::Bounds2i;
+use crate::scene::{FilmDesc, FilterDesc};
+use glam::{IVec2, Vec2, Vec3};
+
+/// Width of the precomputed filter table (pbrt-v3's `filterTableWidth`).
+pub const FILTER_TABLE_WIDTH: usize = 16;
+const TABLE_SIZE: usize = FILTER_TABLE_WIDTH * FILTER_TABLE_WIDTH;
+
+/// Luminance of linear RGB (pbrt-v3's `RGBSpectrum::y()`).
+#[inline]
+pub fn luminance(rgb: Vec3) -> f32 {
+    0.212671 * rgb.x + 0.715160 * rgb.y + 0.072169 * rgb.z
+}
+
+/// A linear RGB image: `data` holds `width * height` RGB triples, rows from
+/// top to bottom.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub data: Vec<f32>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Image {
+        Image {
+            width,
+            height,
+            data: vec![0.0; width as usize * height as usize * 3],
+        }
+    }
+
+    #[inline]
+    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
+        let i = 3 * (y as usize * self.width as usize + x as usize);
+        Vec3::new(self.data[i], self.data[i + 1], self.data[i + 2])
+    }
+
+    #[inline]
+    pub fn set_pixel(&mut self, x: u32, y: u32, v: Vec3) {
+        let i = 3 * (y as usize * self.width as usize + x as usize);
+        self.data[i..i + 3].copy_from_slice(&v.to_array());
+    }
+}
+
+/// Running sums of one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSums {
+    /// Σ filter weight · sample weight · L, per channel.
+    pub contrib: [f64; 3],
+    /// Σ filter weight.
+    pub weight: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Film {
+    full_resolution: IVec2,
+    pixel_bounds: Bounds2i,
+    filter: Filter,
+    filter_table: [f32; TABLE_SIZE],
+    scale: f32,
+    max_sample_luminance: f32,
+    pixels: Vec<PixelSums>,
+}
+
+impl Film {
+    pub fn new(film: &FilmDesc, filter: &FilterDesc) -> Film {
+        let res = IVec2::new(film.xresolution as i32, film.yresolution as i32);
+        let [cx0, cx1, cy0, cy1] = film.cropwindow;
+        // pbrt-v3 computes these in Float.
+        let pixel_bounds = Bounds2i::new(
+            IVec2::new(
+                (res.x as f32 * cx0).ceil() as i32,
+                (res.y as f32 * cy0).ceil() as i32,
+            ),
+            IVec2::new(
+                (res.x as f32 * cx1).ceil() as i32,
+                (res.y as f32 * cy1).ceil() as i32,
+            ),
+        );
+        let filter = Filter::new(filter);
+        let r = filter.radius();
+        let mut filter_table = [0.0f32; TABLE_SIZE];
+        for y in 0..FILTER_TABLE_WIDTH {
+            for x in 0..FILTER_TABLE_WIDTH {
+                let p = Vec2::new(
+                    (x as f32 + 0.5) * r.x / FILTER_TABLE_WIDTH as f32,
+                    (y as f32 + 0.5) * r.y / FILTER_TABLE_WIDTH as f32,
+                );
+                filter_table[y * FILTER_TABLE_WIDTH + x] = filter.evaluate(p);
+            }
+        }
+        let max_sample_luminance = if film.max_sample_luminance > 0.0 {
+            film.max_sample_luminance
+        } else {
+            f32::INFINITY
+        };
+        Film {
+            full_resolution: res,
+            pixel_bounds,
+            filter,
+            filter_table,
+            scale: film.scale,
+            max_sample_luminance,
+            pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
+        }
+    }
+
+    pub fn full_resolution(&self) -> IVec2 {
+        self.full_resolution
+    }
+
+    /// The (cropped) pixels written to the image.
+    pub fn pixel_bounds(&self) -> Bounds2i {
+        self.pixel_bounds
+    }
+
+    pub fn filter(&self) -> &Filter {
+        &self.filter
+    }
+
+    /// The precomputed filter table (row-major, 16×16, positive quadrant).
+    pub fn filter_table(&self) -> &[f32; TABLE_SIZE] {
+        &self.filter_table
+    }
+
+    /// Pixels whose samples can reach the pixel bounds (pbrt-v3's `GetSampleBounds`).
+    pub fn sample_bounds(&self) -> Bounds2i {
+        let r = self.filter.radius();
+        let min = (self.pixel_bounds.min.as_vec2() + Vec2::splat(0.5) - r).floor();
+        let max = (self.pixel_bounds.max.as_vec2() - Vec2::splat(0.5) + r).ceil();
+        Bounds2i::new(min.as_ivec2(), max.as_ivec2())
+    }
+
+    /// Tiles of `tile_size × tile_size` pixels covering the sample bounds, in
+    /// row-major order (the order to render and merge them in).
+    pub fn tiles(&self, tile_size: i32) -> Vec<Bounds2i> {
+        let ts = tile_size.max(1);
+        let sb = self.sample_bounds();
+        let (nx, ny) = ((sb.width() + ts - 1) / ts, (sb.height() + ts - 1) / ts);
+        let mut out = Vec::with_capacity((nx * ny).max(0) as usize);
+        for ty in 0..ny {
+            for tx in 0..nx {
+                let min = sb.min + IVec2::new(tx * ts, ty * ts);
+                let max = (min + IVec2::splat(ts)).min(sb.max);
+                out.push(Bounds2i::new(min, max));
+            }
+        }
+        out
+    }
+
+    /// A tile for samples taken in `tile_sample_bounds` (pbrt-v3's `GetFilmTile`).
+    pub fn tile(&self, tile_sample_bounds: Bounds2i) -> FilmTile {
+        let r = self.filter.radius();
+        let half = Vec2::splat(0.5);
+        let p0 = (tile_sample_bounds.min.as_vec2() - half - r)
+            .ceil()
+            .as_ivec2();
+        let p1 = (tile_sample_bounds.max.as_vec2() - half + r)
+            .floor()
+            .as_ivec2()
+            + IVec2::ONE;
+        let pixel_bounds = Bounds2i::new(p0, p1).intersect(&self.pixel_bounds);
+        FilmTile {
+            pixel_bounds,
+            radius: r,
+            inv_radius: Vec2::ONE / r,
+            filter_table: self.filter_table,
+            max_sample_luminance: self.max_sample_luminance,
+            pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
+        }
+    }
+
+    /// Adds a tile's sums into the film (plain additions: merge tiles in a
+    /// fixed order for bit-identical images).
+    pub fn merge_tile(&mut self, tile: FilmTile) {
+        let fw = self.pixel_bounds.width() as usize;
+        let tw = tile.pixel_bounds.width() as usize;
+        if tw == 0 {
+            return;
+        }
+        for (ty, row) in tile.pixels.chunks_exact(tw).enumerate() {
+            let y = tile.pixel_bounds.min.y + ty as i32;
+            let fy = (y - self.pixel_bounds.min.y) as usize;
+            let fx0 = (tile.pixel_bounds.min.x - self.pixel_bounds.min.x) as usize;
+            let dst = &mut self.pixels[fy * fw + fx0..fy * fw + fx0 + tw];
+            for (d, s) in dst.iter_mut().zip(row) {
+                for c in 0..3 {
+                    d.contrib[c] += s.contrib[c];
+                }
+                d.weight += s.weight;
+            }
+        }
+    }
+
+    /// Sums of a pixel inside the pixel bounds.
+    pub fn pixel_sums(&self, p: IVec2) -> PixelSums {
+        debug_assert!(self.pixel_bounds.contains(p));
+        let w = self.pixel_bounds.width();
+        let o = p - self.pixel_bounds.min;
+        self.pixels[(o.y * w + o.x) as usize]
+    }
+
+    /// Resets all sums to zero.
+    pub fn clear(&mut self) {
+        self.pixels.fill(PixelSums::default());
+    }
+
+    /// The image over the pixel bounds: `max(0, Σ wL / Σ w) × scale` per
+    /// channel, 0 where `Σ w == 0`.
+    pub fn image(&self) -> Image {
+        let w = self.pixel_bounds.width() as u32;
+        let h = self.pixel_bounds.height() as u32;
+        let mut data = Vec::with_capacity(self.pixels.len() * 3);
+        let scale = self.scale as f64;
+        for p in &self.pixels {
+            if p.weight != 0.0 {
+                let inv = 1.0 / p.weight;
+                for c in 0..3 {
+                    data.push(((p.contrib[c] * inv).max(0.0) * scale) as f32);
+                }
+            } else {
+                data.extend([0.0; 3]);
+            }
+        }
+        Image {
+            width: w,
+            height: h,
+            data,
+        }
+    }
+}
+
+/// The part of the film that the samples of one tile can touch.
+#[derive(Clone, Debug)]
+pub struct FilmTile {
+    pixel_bounds: Bounds2i,
+    radius: Vec2,
+    inv_radius: Vec2,
+    filter_table: [f32; TABLE_SIZE],
+    max_sample_luminance: f32,
+    pixels: Vec<PixelSums>,
+}
+
+/// Footprints up to this many pixels per axis use a stack cache of table
+/// offsets; larger ones compute offsets inline.
+const MAX_CACHED_FOOTPRINT: usize = 32;
+
+impl FilmTile {
+    pub fn pixel_bounds(&self) -> Bounds2i {
+        self.pixel_bounds
+    }
+
+    /// Splats radiance `l` seen through raster position `p_film` onto the
+    /// pixels within the filter radius. Non-finite radiance counts as black
+    /// (the sample still adds its filter weight), as pbrt-v3's integrator does.
+    #[inline]
+    pub fn add_sample(&mut self, p_film: Vec2, l: Vec3, sample_weight: f32) {
+        let mut l = if l.is_finite() { l } else { Vec3::ZERO };
+        let y = luminance(l);
+        if y > self.max_sample_luminance {
+            l *= self.max_sample_luminance / y;
+        }
+        let p_discrete = p_film - Vec2::splat(0.5);
+        let p0 = (p_discrete - self.radius)
+            .ceil()
+            .as_ivec2()
+            .max(self.pixel_bounds.min);
+        let p1 =
+            ((p_discrete + self.radius).floor().as_ivec2() + IVec2::ONE).min(self.pixel_bounds.max);
+        if p0.x >= p1.x || p0.y >= p1.y {
+            return;
+        }
+        let n_x = (p1.x - p0.x) as usize;
+        let n_y = (p1.y - p0.y) as usize;
+        let scale = FILTER_TABLE_WIDTH as f32;
+        let offset = |d: f32, inv_r: f32| -> usize {
+            (((d * inv_r * scale).abs()).floor() as usize).min(FILTER_TABLE_WIDTH - 1)
+        };
+        let lw = (l * sample_weight).as_dvec3();
+        let width = self.pixel_bounds.width() as usize;
+        if n_x <= MAX_CACHED_FOOTPRINT && n_y <= MAX_CACHED_FOOTPRINT {
+            let mut ifx = [0usize; MAX_CACHED_FOOTPRINT];
+            let mut ify = [0usize; MAX_CACHED_FOOTPRINT];
+            for (i, v) in ifx[..n_x].iter_mut().enumerate() {
+                *v = offset((p0.x + i as i32) as f32 - p_discrete.x, self.inv_radius.x);
+            }
+            for (i, v) in ify[..n_y].iter_mut().enumerate() {
+                *v = offset((p0.y + i as i32) as f32 - p_discrete.y, self.inv_radius.y)
+                    * FILTER_TABLE_WIDTH;
+            }
+            for (j, &oy) in ify[..n_y].iter().enumerate() {
+                let row = (p0.y - self.pixel_bounds.min.y) as usize + j;
+                let base = row * width + (p0.x - self.pixel_bounds.min.x) as usize;
+                let pixels = &mut self.pixels[base..base + n_x];
+                for (px, &ox) in pixels.iter_mut().zip(&ifx[..n_x]) {
+                    let fw = self.filter_table[oy + ox] as f64;
+                    px.contrib[0] += lw.x * fw;
+                    px.contrib[1] += lw.y * fw;
+                    px.contrib[2] += lw.z * fw;
+                    px.weight += fw;
+                }
+            }
+        } else {
+            for y in p0.y..p1.y {
+                let oy = offset(y as f32 - p_discrete.y, self.inv_radius.y) * FILTER_TABLE_WIDTH;
+                for x in p0.x..p1.x {
+                    let ox = offset(x as f32 - p_discrete.x, self.inv_radius.x);
+                    let fw = self.filter_table[oy + ox] as f64;
+                    let i = (y - self.pixel_bounds.min.y) as usize * width
+                        + (x - self.pixel_bounds.min.x) as usize;
+                    let px = &mut self.pixels[i];
+                    px.contrib[0] += lw.x * fw;
+                    px.contrib[1] += lw.y * fw;
+                    px.contrib[2] += lw.z * fw;
+                    px.weight += fw;
+                }
+            }
+        }
+    }
+
+    /// Sums of a pixel inside the tile's pixel bounds.
+    pub fn pixel_sums(&self, p: IVec2) -> PixelSums {
+        let w = self.pixel_bounds.width();
+        let o = p - self.pixel_bounds.min;
+        self.pixels[(o.y * w + o.x) as usize]
+    }
+}
