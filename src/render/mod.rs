@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod driver;
 pub mod film;
 pub mod geometry;
 pub mod integrators;

@@ -1,0 +1,164 @@
+//! Rendering a scene description to an image: compile the scene, render
+//! 16×16 tiles in parallel with rayon, merge them in a fixed order (so the
+//! image is bit-identical for any thread count), and count what happened.
+
+use crate::render::film::{luminance, Film, FilmTile, Image};
+use crate::render::geometry::Bounds2i;
+use crate::render::integrators::{Integrator, RayCounts, Scratch};
+use crate::render::samplers::Sampler;
+use crate::render::scene::RenderScene;
+use crate::scene::SceneDescription;
+use glam::Vec3;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Options that do not change the expected image.
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions {
+    /// Worker threads; None = all cores.
+    pub threads: Option<usize>,
+    /// Seed for the sampler's scrambling and random dimensions.
+    pub seed: u64,
+}
+
+/// What a render did.
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    pub build_time: Duration,
+    pub render_time: Duration,
+    pub rays: RayCounts,
+    pub samples: u64,
+    pub nan_samples: u64,
+    pub inf_samples: u64,
+    pub negative_samples: u64,
+    pub threads: usize,
+    /// What was built and what was left out.
+    pub notes: Vec<String>,
+}
+
+impl RenderStats {
+    pub fn dropped_samples(&self) -> u64 {
+        self.nan_samples + self.inf_samples + self.negative_samples
+    }
+    pub fn mrays_per_sec(&self) -> f64 {
+        self.rays.total() as f64 / self.render_time.as_secs_f64().max(1e-9) / 1e6
+    }
+}
+
+#[derive(Default)]
+struct TileCounts {
+    rays: RayCounts,
+    samples: u64,
+    nan: u64,
+    inf: u64,
+    negative: u64,
+}
+
+/// Renders `desc` (with its film, sampler and integrator settings as given:
+/// apply command-line overrides to the description first). `progress` is
+/// called after each tile with (tiles done, tiles total).
+pub fn render(desc: &SceneDescription, opts: &RenderOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<(Image, RenderStats), String> {
+    let t0 = Instant::now();
+    let scene = RenderScene::new(desc);
+    let mut integrator = Integrator::new(&desc.integrator, &scene);
+    let mut film = Film::new(&desc.film, &desc.filter);
+    let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
+    integrator.prepare_sampler(&scene, &mut sampler);
+    let build_time = t0.elapsed();
+
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let threads = pool.current_num_threads();
+    let tiles = film.tiles(16);
+    let total = tiles.len();
+    let t1 = Instant::now();
+    let mut counts = TileCounts::default();
+    // Chunks bound the memory held by finished tiles awaiting their merge.
+    let chunk = (threads * 8).max(1);
+    let mut done = 0usize;
+    for group in tiles.chunks(chunk) {
+        let rendered: Vec<(FilmTile, TileCounts)> = pool.install(|| {
+            group
+                .par_iter()
+                .map(|&tb| render_tile(&scene, &integrator, &film, &sampler, tb))
+                .collect()
+        });
+        for (tile, c) in rendered {
+            film.merge_tile(tile);
+            counts.rays.add(&c.rays);
+            counts.samples += c.samples;
+            counts.nan += c.nan;
+            counts.inf += c.inf;
+            counts.negative += c.negative;
+        }
+        done += group.len();
+        progress(done, total);
+    }
+    let render_time = t1.elapsed();
+    let mut notes = scene.notes.clone();
+    if let Some(ls) = integrator.light_sampler() {
+        notes.push(format!(
+            "light selection: {:?} over {} lights that emit{}",
+            ls.kind(),
+            ls.active_count(),
+            match ls.kind() {
+                crate::render::lights::LightSamplerKind::Spatial => format!(", {} voxel distributions built", ls.voxels_built()),
+                _ => String::new(),
+            }
+        ));
+    }
+    let stats = RenderStats {
+        build_time,
+        render_time,
+        rays: counts.rays,
+        samples: counts.samples,
+        nan_samples: counts.nan,
+        inf_samples: counts.inf,
+        negative_samples: counts.negative,
+        threads,
+        notes,
+    };
+    Ok((film.image(), stats))
+}
+
+fn render_tile(scene: &RenderScene, integrator: &Integrator, film: &Film, proto: &Sampler, bounds: Bounds2i) -> (FilmTile, TileCounts) {
+    let mut tile = film.tile(bounds);
+    let mut sampler = proto.clone();
+    let mut scratch = Scratch::default();
+    let mut c = TileCounts::default();
+    let spp = sampler.samples_per_pixel();
+    for pixel in bounds.iter() {
+        for i in 0..spp {
+            sampler.start_pixel_sample(pixel, i);
+            let cs = sampler.get_camera_sample(pixel);
+            let ray = scene.camera.generate_ray(&cs);
+            let mut l = integrator.li(ray, scene, &mut sampler, &mut scratch);
+            // pbrt-v3: samples with NaN, infinite or negative radiance are
+            // zeroed (their weight is kept) and counted.
+            if l.is_nan() {
+                c.nan += 1;
+                l = Vec3::ZERO;
+            } else if !l.is_finite() {
+                c.inf += 1;
+                l = Vec3::ZERO;
+            } else if luminance(l) < -1e-5 {
+                c.negative += 1;
+                l = Vec3::ZERO;
+            }
+            tile.add_sample(cs.p_film, l, 1.0);
+            c.samples += 1;
+        }
+    }
+    c.rays = scratch.counts();
+    (tile, c)
+}
+
+/// Peak resident memory of this process in bytes (Linux), if known.
+pub fn peak_memory_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
