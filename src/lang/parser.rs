@@ -342,7 +342,10 @@ impl<'l> Parser<'l> {
     /// Skips to the next token that names a directive.
     fn recover(&mut self) {
         while let Some(t) = self.peek() {
-            if t.kind == TokKind::Bare && directive_kind(self.text(t)).is_some() {
+            // Stop at a directive, or at a word that may be a misspelt one.
+            if t.kind == TokKind::Bare
+                && self.text(t).starts_with(|c: char| c.is_ascii_alphabetic())
+            {
                 return;
             }
             self.next();
@@ -752,7 +755,12 @@ impl<'l> Parser<'l> {
         let parsed =
             split_declaration(&decl_text).map(|(_, (t, n))| (t.to_string(), n.to_string()));
         // Values are read in any case, so that the stream stays in step.
-        let (nums, strs, values_loc) = self.values(decl)?;
+        let quoted = parsed
+            .as_ref()
+            .ok()
+            .and_then(|(t, _)| ParamType::from_name(t))
+            .is_some_and(ParamType::wants_strings);
+        let (nums, strs, values_loc) = self.values(decl, quoted)?;
         let (ty_name, name) = match parsed {
             Ok(x) => x,
             Err(_) => {
@@ -843,7 +851,7 @@ impl<'l> Parser<'l> {
     }
 
     /// Reads `[ v… ]` or one value. Returns numbers, strings and their span.
-    fn values(&mut self, decl: Token) -> PResult<(Vec<f64>, Vec<String>, Loc)> {
+    fn values(&mut self, decl: Token, quoted: bool) -> PResult<(Vec<f64>, Vec<String>, Loc)> {
         let Some(t) = self.next() else {
             let loc = self.eof_loc();
             self.error(
@@ -866,6 +874,16 @@ impl<'l> Parser<'l> {
                         decl.loc,
                         "parameter has no value",
                         "a value or `[` must follow",
+                        None,
+                    );
+                    return Err(());
+                }
+                if quoted && parse_number(self.text(t).as_bytes()).is_err() {
+                    let w = self.text(t).to_string();
+                    self.error(
+                        t.loc,
+                        format!("value `{w}` must be in double quotes (\"{w}\")"),
+                        "expected a quoted string",
                         None,
                     );
                     return Err(());
@@ -916,7 +934,15 @@ impl<'l> Parser<'l> {
                                     );
                                     return Err(());
                                 }
-                                if ok {
+                                if ok && quoted {
+                                    let w = self.text(v).to_string();
+                                    self.error(
+                                        v.loc,
+                                        format!("value `{w}` must be in double quotes (\"{w}\")"),
+                                        "expected a quoted string",
+                                        None,
+                                    );
+                                } else if ok {
                                     self.bad_number(v, e);
                                 }
                                 ok = false;
