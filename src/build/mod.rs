@@ -1,1 +1,229 @@
 //! Scene building: graphics state to a plain scene description.
+//!
+//! - [`state`]: the walk over statements with pbrt-v3's graphics state.
+//! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
+//!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
+//! - [`color`]: spectra to linear RGB; [`ply`]: the PLY reader for `plymesh`.
+//! - [`summary`]: what `pbrs --check` prints.
+
+pub mod color;
+pub mod entities;
+pub mod ply;
+pub mod state;
+pub mod summary;
+
+use crate::lang::params::ParamList;
+use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
+use crate::lang::{Diags, Loc, SourceMap};
+use crate::scene::SceneDescription;
+use miette::Severity;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+pub use summary::Summary;
+
+/// A scene that loaded, with its warnings and a summary for `--check`.
+pub struct LoadedScene {
+    pub scene: SceneDescription,
+    pub warnings: Vec<miette::Report>,
+    pub summary: Summary,
+}
+
+/// A scene that did not load: at least one error.
+pub struct LoadFailure {
+    pub errors: Vec<miette::Report>,
+    pub warnings: Vec<miette::Report>,
+}
+
+impl std::fmt::Debug for LoadFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for e in &self.errors {
+            writeln!(f, "error: {e}")?;
+        }
+        Ok(())
+    }
+}
+
+/// What building needs besides the statements: sources for diagnostics, where
+/// files are, and the diagnostics gathered so far.
+pub struct Ctx {
+    pub sources: SourceMap,
+    pub diags: Diags,
+    pub base_dir: PathBuf,
+    pub loader: Box<dyn FileLoader>,
+}
+
+impl Ctx {
+    pub fn warn(&mut self, loc: Loc, msg: impl Into<String>, label: impl Into<String>) {
+        let r = self
+            .sources
+            .report(Severity::Warning, loc, msg, label, None);
+        self.diags.warnings.push(r);
+    }
+
+    pub fn error(
+        &mut self,
+        loc: Loc,
+        msg: impl Into<String>,
+        label: impl Into<String>,
+        help: Option<String>,
+    ) {
+        let r = self.sources.report(Severity::Error, loc, msg, label, help);
+        self.diags.errors.push(r);
+    }
+
+    /// pbrt-v3's `ReportUnused`: a warning for each parameter never looked up.
+    pub fn report_unused(&mut self, p: &ParamList, what: &str) {
+        self.report_unused_except(p, what, &[]);
+    }
+
+    pub fn report_unused_except(&mut self, p: &ParamList, what: &str, except: &[&str]) {
+        for q in p.unused() {
+            if except.contains(&q.name.as_str()) {
+                continue;
+            }
+            q.used.set(true);
+            let r = self.sources.report(
+                Severity::Warning,
+                q.loc,
+                format!(
+                    "parameter \"{} {}\" not used by {what}",
+                    q.type_name, q.name
+                ),
+                "unused parameter",
+                None,
+            );
+            self.diags.warnings.push(r);
+        }
+    }
+}
+
+/// Reads, parses and builds a scene file.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadFailure> {
+    let text = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) => {
+            return Err(plain_failure(
+                path,
+                format!("cannot read scene file \"{}\": {e}", path.display()),
+            ))
+        }
+    };
+    if text.len() >= u32::MAX as usize {
+        return Err(plain_failure(
+            path,
+            format!("scene file \"{}\" is larger than 4 GiB", path.display()),
+        ));
+    }
+    match to_text(text) {
+        Ok(t) => load(path, t, Box::new(DiskLoader)),
+        Err(at) => Err(plain_failure(
+            path,
+            format!(
+                "scene file \"{}\" is not UTF-8 text (invalid byte at offset {at})",
+                path.display()
+            ),
+        )),
+    }
+}
+
+/// Same, from text in memory; `path` names it in diagnostics and its parent dir
+/// resolves Includes and meshes.
+pub fn load_scene_str(text: &str, path: &Path) -> Result<LoadedScene, LoadFailure> {
+    load(path, Arc::from(text), Box::new(DiskLoader))
+}
+
+/// Same, with files (Includes, PLY meshes) read through `loader`.
+pub fn load_scene_with(
+    text: &str,
+    path: &Path,
+    loader: Box<dyn FileLoader>,
+) -> Result<LoadedScene, LoadFailure> {
+    load(path, Arc::from(text), loader)
+}
+
+fn plain_failure(path: &Path, msg: String) -> LoadFailure {
+    LoadFailure {
+        errors: vec![miette::miette!("{}:1:1: {msg}", path.display())],
+        warnings: Vec::new(),
+    }
+}
+
+fn load(
+    path: &Path,
+    text: Arc<str>,
+    loader: Box<dyn FileLoader>,
+) -> Result<LoadedScene, LoadFailure> {
+    let mut parser = Parser::new(path, text, loader.as_ref());
+    let stmts = parser.parse();
+    let base_dir = parser.base_dir().to_path_buf();
+    let Parser { sources, diags, .. } = parser;
+    let mut ctx = Ctx {
+        sources,
+        diags,
+        base_dir,
+        loader,
+    };
+    if !ctx.diags.errors.is_empty() {
+        return Err(LoadFailure {
+            errors: ctx.diags.errors,
+            warnings: ctx.diags.warnings,
+        });
+    }
+    let mut b = state::Builder::new(&stmts, &mut ctx);
+    b.run();
+    let (camera, film, filter, sampler, integrator) = b.finish();
+    let scene = SceneDescription {
+        camera,
+        film,
+        filter,
+        sampler,
+        integrator,
+        materials: std::mem::take(&mut b.scene_materials),
+        shapes: std::mem::take(&mut b.shapes),
+        lights: std::mem::take(&mut b.lights),
+        objects: std::mem::take(&mut b.scene_objects),
+        instances: std::mem::take(&mut b.instances),
+        skipped: std::mem::take(&mut b.skipped),
+    };
+    let kinds = std::mem::take(&mut b.material_kinds);
+    drop(b);
+    if !ctx.diags.errors.is_empty() {
+        return Err(LoadFailure {
+            errors: ctx.diags.errors,
+            warnings: ctx.diags.warnings,
+        });
+    }
+    let summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
+    Ok(LoadedScene {
+        scene,
+        warnings: ctx.diags.warnings,
+        summary,
+    })
+}
+
+/// Prints diagnostics to stderr with miette's graphical handler (no colour when
+/// stderr is not a terminal or `NO_COLOR` is set). Each message starts with
+/// `FILE:LINE:COL`, and the help lists the Include chain.
+pub fn print_diagnostics(reports: &[miette::Report]) {
+    let color = std::io::stderr().is_terminal()
+        && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
+    let theme = if color {
+        miette::GraphicalTheme::unicode()
+    } else {
+        miette::GraphicalTheme::unicode_nocolor()
+    };
+    let handler = miette::GraphicalReportHandler::new_themed(theme)
+        .with_wrap_lines(false)
+        .with_links(false);
+    let mut out = String::new();
+    for r in reports {
+        let mut s = String::new();
+        if handler.render_report(&mut s, r.as_ref()).is_err() {
+            s = format!("{r}\n");
+        }
+        out.push_str(&s);
+    }
+    eprint!("{out}");
+}

@@ -8,7 +8,11 @@ mod render;
 
 /// pbrs: render a pbrt-v3 scene.
 #[derive(Parser, Debug, Clone)]
-#[command(name = "pbrs", version, about = "A physically based renderer for pbrt-v3 scenes")]
+#[command(
+    name = "pbrs",
+    version,
+    about = "A physically based renderer for pbrt-v3 scenes"
+)]
 pub struct Args {
     /// The scene file (pbrt-v3 format).
     pub scene: PathBuf,

@@ -79,11 +79,25 @@ pub struct FilmDesc {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FilterDesc {
     /// Radius per axis (pbrt's `xwidth`/`ywidth`, which are radii).
-    Box { radius: Vec2 },
-    Gaussian { radius: Vec2, alpha: f32 },
-    Triangle { radius: Vec2 },
-    Mitchell { radius: Vec2, b: f32, c: f32 },
-    LanczosSinc { radius: Vec2, tau: f32 },
+    Box {
+        radius: Vec2,
+    },
+    Gaussian {
+        radius: Vec2,
+        alpha: f32,
+    },
+    Triangle {
+        radius: Vec2,
+    },
+    Mitchell {
+        radius: Vec2,
+        b: f32,
+        c: f32,
+    },
+    LanczosSinc {
+        radius: Vec2,
+        tau: f32,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,7 +106,11 @@ pub enum SamplerKind {
     Random,
     Sobol,
     /// Stratified with jitter; `pixelsamples` is xsamples*ysamples.
-    Stratified { jitter: bool, xsamples: u32, ysamples: u32 },
+    Stratified {
+        jitter: bool,
+        xsamples: u32,
+        ysamples: u32,
+    },
     ZeroTwoSequence,
     MaxMinDist,
 }
@@ -139,9 +157,18 @@ pub enum IntegratorDesc {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MaterialDesc {
     /// `sigma` in degrees; 0 means Lambertian.
-    Matte { kd: Vec3, sigma: f32 },
-    Glass { kr: Vec3, kt: Vec3, eta: f32 },
-    Mirror { kr: Vec3 },
+    Matte {
+        kd: Vec3,
+        sigma: f32,
+    },
+    Glass {
+        kr: Vec3,
+        kt: Vec3,
+        eta: f32,
+    },
+    Mirror {
+        kr: Vec3,
+    },
     /// `Material ""` / `"none"`: no BSDF, the surface only delimits media.
     None,
 }

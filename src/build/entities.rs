@@ -1,0 +1,1260 @@
+//! Objects made from one directive's parameters, with pbrt-v3's defaults:
+//! cameras, film, filters, samplers, integrators, materials, textures, lights and
+//! shapes. Every lookup marks its parameter used.
+
+use super::color::{blackbody_to_rgb, sampled_to_rgb, xyz_to_rgb};
+use super::ply::read_ply;
+use super::Ctx;
+use crate::lang::params::{Param, ParamList, ParamType};
+use crate::lang::parser::{resolve, Name};
+use crate::lang::Loc;
+use crate::scene::*;
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::rc::Rc;
+use std::sync::Arc;
+
+pub const MAX_RESOLUTION: i64 = 32768;
+pub const MAX_SAMPLES: i64 = 1 << 24;
+
+// ---------------------------------------------------------------- lookups
+
+fn one<'a>(p: &'a ParamList, name: &str, ty: impl Fn(ParamType) -> bool) -> Option<&'a Param> {
+    p.items
+        .iter()
+        .find(|q| q.name == name && ty(q.ty) && q.count() == 1)
+        .inspect(|q| q.used.set(true))
+}
+
+pub fn float(p: &ParamList, name: &str, def: f64) -> f64 {
+    one(p, name, |t| t == ParamType::Float)
+        .map(|q| q.nums()[0])
+        .unwrap_or(def)
+}
+
+fn float_opt(p: &ParamList, name: &str) -> Option<(f64, Loc)> {
+    one(p, name, |t| t == ParamType::Float).map(|q| (q.nums()[0], q.values_loc))
+}
+
+pub fn int(p: &ParamList, name: &str, def: i64) -> (i64, Option<Loc>) {
+    one(p, name, |t| t == ParamType::Integer)
+        .map(|q| (q.nums()[0] as i64, Some(q.values_loc)))
+        .unwrap_or((def, None))
+}
+
+pub fn boolean(p: &ParamList, name: &str, def: bool) -> bool {
+    one(p, name, |t| t == ParamType::Bool)
+        .map(|q| q.bools()[0])
+        .unwrap_or(def)
+}
+
+pub fn string<'a>(p: &'a ParamList, name: &str) -> Option<(&'a str, Loc)> {
+    one(p, name, |t| t == ParamType::String).map(|q| (q.strs()[0].as_str(), q.values_loc))
+}
+
+fn point3(p: &ParamList, name: &str, def: DVec3) -> DVec3 {
+    one(p, name, |t| t == ParamType::Point3)
+        .map(|q| DVec3::new(q.nums()[0], q.nums()[1], q.nums()[2]))
+        .unwrap_or(def)
+}
+
+/// A spectrum-typed parameter as linear RGB (`None` for spectrum file names, with a warning).
+fn spectrum_value(ctx: &mut Ctx, q: &Param) -> Option<Vec3> {
+    let v = q.nums();
+    match q.ty {
+        ParamType::Rgb => Some(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)),
+        ParamType::Xyz => Some(xyz_to_rgb(v[0], v[1], v[2])),
+        ParamType::Blackbody => Some(blackbody_to_rgb(v[0], v[1])),
+        ParamType::Spectrum if !q.strs().is_empty() => {
+            ctx.warn(q.values_loc, format!("spectrum file \"{}\" for \"{}\": spectrum files are not supported by pbrs; the default is used", q.strs()[0], q.name), "spectrum file not read");
+            None
+        }
+        ParamType::Spectrum => Some(sampled_to_rgb(v)),
+        _ => None,
+    }
+}
+
+fn find_spectrum<'a>(p: &'a ParamList, name: &str) -> Option<&'a Param> {
+    let q = p
+        .items
+        .iter()
+        .find(|q| q.name == name && q.ty.is_spectrum())?;
+    // One spectrum: one triple for rgb/xyz, one pair for blackbody, any pairs for spectrum.
+    let single = match q.ty {
+        ParamType::Spectrum => true,
+        _ => q.count() == 1,
+    };
+    if single {
+        q.used.set(true);
+        Some(q)
+    } else {
+        None
+    }
+}
+
+/// A spectrum parameter (rgb, color, xyz, blackbody or spectrum) as RGB.
+pub fn spectrum(ctx: &mut Ctx, p: &ParamList, name: &str, def: Vec3) -> Vec3 {
+    find_spectrum(p, name)
+        .and_then(|q| spectrum_value(ctx, q))
+        .unwrap_or(def)
+}
+
+/// Light `scale`: a spectrum in pbrt-v3; a plain float is accepted too.
+fn light_scale(ctx: &mut Ctx, p: &ParamList) -> Vec3 {
+    if let Some((f, _)) = float_opt(p, "scale") {
+        return Vec3::splat(f as f32);
+    }
+    spectrum(ctx, p, "scale", Vec3::ONE)
+}
+
+// ---------------------------------------------------------------- textures
+
+#[derive(Clone, Debug)]
+pub enum TexValue {
+    Float(f64),
+    Spectrum(Vec3),
+    /// A texture class pbrs does not evaluate.
+    Unsupported(String),
+}
+
+#[derive(Clone, Debug)]
+pub struct TexSpec {
+    pub value: TexValue,
+    pub loc: Loc,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Textures {
+    pub float: HashMap<String, Rc<TexSpec>>,
+    pub spectrum: HashMap<String, Rc<TexSpec>>,
+}
+
+const TEXTURE_CLASSES: &[&str] = &[
+    "constant",
+    "scale",
+    "mix",
+    "bilerp",
+    "imagemap",
+    "uv",
+    "checkerboard",
+    "dots",
+    "fbm",
+    "wrinkled",
+    "marble",
+    "windy",
+    "ptex",
+];
+
+/// `Texture name kind class params`: `Some((is_float, spec))` to record.
+pub fn texture(
+    ctx: &mut Ctx,
+    name: &Name,
+    kind: &Name,
+    class: &Name,
+    params: &ParamList,
+    _tex: &Textures,
+) -> Option<(bool, TexSpec)> {
+    let is_float = match kind.value.as_str() {
+        "float" => true,
+        "color" | "spectrum" => false,
+        other => {
+            params.mark_all_used();
+            ctx.warn(kind.loc, format!("texture type \"{other}\" is neither \"float\", \"color\" nor \"spectrum\": texture \"{}\" ignored", name.value), "unknown texture type");
+            return None;
+        }
+    };
+    let value = if class.value == "constant" {
+        let v = if is_float {
+            TexValue::Float(float(params, "value", 1.0))
+        } else {
+            TexValue::Spectrum(spectrum(ctx, params, "value", Vec3::ONE))
+        };
+        ctx.report_unused(params, &format!("Texture \"{}\"", name.value));
+        v
+    } else {
+        params.mark_all_used();
+        if TEXTURE_CLASSES.contains(&class.value.as_str()) {
+            ctx.warn(class.loc, format!("texture class \"{}\" is not supported by pbrs: material parameters that use texture \"{}\" get their default value", class.value, name.value), "only \"constant\" textures are evaluated");
+        } else {
+            ctx.warn(
+                class.loc,
+                format!(
+                    "unknown texture class \"{}\": texture \"{}\" ignored",
+                    class.value, name.value
+                ),
+                "not a pbrt-v3 texture class",
+            );
+            return None;
+        }
+        TexValue::Unsupported(class.value.clone())
+    };
+    Some((
+        is_float,
+        TexSpec {
+            value,
+            loc: name.loc,
+        },
+    ))
+}
+
+// ---------------------------------------------------------------- materials
+
+/// A material as declared (built lazily when a shape uses it).
+#[derive(Debug)]
+pub struct MaterialSpec {
+    pub ty: String,
+    /// The `Material`/`MakeNamedMaterial` statement; `None` for the initial matte.
+    pub stmt: Option<usize>,
+    pub loc: Loc,
+    pub textures: Rc<Textures>,
+    pub name: Option<String>,
+}
+
+impl MaterialSpec {
+    pub fn new(
+        ty: String,
+        stmt: Option<usize>,
+        loc: Loc,
+        textures: Rc<Textures>,
+        name: Option<String>,
+    ) -> Self {
+        MaterialSpec {
+            ty,
+            stmt,
+            loc,
+            textures,
+            name,
+        }
+    }
+    pub fn default_matte() -> Self {
+        MaterialSpec {
+            ty: "matte".into(),
+            stmt: None,
+            loc: Loc::default(),
+            textures: Rc::new(Textures::default()),
+            name: None,
+        }
+    }
+}
+
+/// Material parameter lookup: shape parameters first (if they override), then the material's.
+pub struct Lookup<'a> {
+    pub first: Option<&'a ParamList>,
+    pub second: &'a ParamList,
+    pub textures: &'a Textures,
+}
+
+impl Lookup<'_> {
+    fn lists(&self) -> impl Iterator<Item = &ParamList> {
+        self.first.into_iter().chain(std::iter::once(self.second))
+    }
+
+    fn texture_ref(&self, name: &str, l: &ParamList) -> Option<(String, Loc)> {
+        one(l, name, |t| t == ParamType::Texture).map(|q| (q.strs()[0].clone(), q.values_loc))
+    }
+
+    /// pbrt-v3 `GetSpectrumTexture` reduced to a constant.
+    fn spectrum(&self, ctx: &mut Ctx, name: &str, def: Vec3) -> Vec3 {
+        for l in self.lists() {
+            if let Some((tex, loc)) = self.texture_ref(name, l) {
+                return match self.textures.spectrum.get(&tex).map(|t| t.value.clone()) {
+                    Some(TexValue::Spectrum(v)) => v,
+                    Some(TexValue::Unsupported(class)) => {
+                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which pbrs does not evaluate: the default {def} is used"), "unsupported texture");
+                        def
+                    }
+                    _ => {
+                        ctx.warn(loc, format!("unknown spectrum texture \"{tex}\" for \"{name}\": the default {def} is used (as pbrt-v3)"), "no such \"color\" texture");
+                        def
+                    }
+                };
+            }
+            if let Some(q) = find_spectrum(l, name) {
+                return spectrum_value(ctx, q).unwrap_or(def);
+            }
+        }
+        def
+    }
+
+    /// pbrt-v3 `GetFloatTexture` reduced to a constant; `None` if absent.
+    fn float_opt(&self, ctx: &mut Ctx, name: &str) -> Option<f64> {
+        for l in self.lists() {
+            if let Some((tex, loc)) = self.texture_ref(name, l) {
+                return match self.textures.float.get(&tex).map(|t| t.value.clone()) {
+                    Some(TexValue::Float(v)) => Some(v),
+                    Some(TexValue::Unsupported(class)) => {
+                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which pbrs does not evaluate: the default is used"), "unsupported texture");
+                        None
+                    }
+                    _ => {
+                        ctx.warn(loc, format!("unknown float texture \"{tex}\" for \"{name}\": the default is used (as pbrt-v3)"), "no such \"float\" texture");
+                        None
+                    }
+                };
+            }
+            if let Some((v, _)) = float_opt(l, name) {
+                return Some(v);
+            }
+        }
+        None
+    }
+
+    fn float(&self, ctx: &mut Ctx, name: &str, def: f64) -> f64 {
+        self.float_opt(ctx, name).unwrap_or(def)
+    }
+
+    fn bumpmap(&self, ctx: &mut Ctx) {
+        for l in self.lists() {
+            if let Some((_, loc)) = self.texture_ref("bumpmap", l) {
+                ctx.warn(
+                    loc,
+                    "bump mapping is not supported by pbrs: \"bumpmap\" ignored",
+                    "ignored",
+                );
+            }
+        }
+    }
+
+    fn mark_all(&self) {
+        for l in self.lists() {
+            l.mark_all_used();
+        }
+    }
+}
+
+const OTHER_MATERIALS: &[&str] = &[
+    "plastic",
+    "translucent",
+    "hair",
+    "disney",
+    "mix",
+    "metal",
+    "substrate",
+    "uber",
+    "subsurface",
+    "kdsubsurface",
+    "fourier",
+];
+
+/// Builds a material: the description and its kind name for the summary.
+pub fn material(ctx: &mut Ctx, spec: &MaterialSpec, l: &Lookup) -> (MaterialDesc, &'static str) {
+    let what = match &spec.name {
+        Some(n) => format!("named material \"{n}\""),
+        None => format!("Material \"{}\"", spec.ty),
+    };
+    match spec.ty.as_str() {
+        "matte" => {
+            let kd = l.spectrum(ctx, "Kd", Vec3::splat(0.5));
+            let sigma = l.float(ctx, "sigma", 0.0).clamp(0.0, 90.0) as f32;
+            l.bumpmap(ctx);
+            (MaterialDesc::Matte { kd, sigma }, "matte")
+        }
+        "glass" => {
+            let kr = l.spectrum(ctx, "Kr", Vec3::ONE);
+            let kt = l.spectrum(ctx, "Kt", Vec3::ONE);
+            let eta = match l.float_opt(ctx, "eta") {
+                Some(e) => e,
+                None => l.float(ctx, "index", 1.5),
+            };
+            let ur = l.float(ctx, "uroughness", 0.0);
+            let vr = l.float(ctx, "vroughness", 0.0);
+            for p in l.lists() {
+                one(p, "remaproughness", |t| t == ParamType::Bool);
+            }
+            if ur > 0.0 || vr > 0.0 {
+                ctx.warn(spec.loc, format!("{what}: rough glass (uroughness {ur}, vroughness {vr}) is not supported: treated as smooth glass"), "rough glass");
+            }
+            l.bumpmap(ctx);
+            (
+                MaterialDesc::Glass {
+                    kr,
+                    kt,
+                    eta: eta as f32,
+                },
+                "glass",
+            )
+        }
+        "mirror" => {
+            let kr = l.spectrum(ctx, "Kr", Vec3::splat(0.9));
+            l.bumpmap(ctx);
+            (MaterialDesc::Mirror { kr }, "mirror")
+        }
+        "" | "none" => (MaterialDesc::None, "none"),
+        other => {
+            let kd = l.spectrum(ctx, "Kd", Vec3::splat(0.5));
+            let kept = l.lists().any(|p| p.get("Kd").is_some_and(|q| q.used.get()));
+            l.mark_all();
+            let keep = if kept {
+                format!("its Kd {kd}")
+            } else {
+                "the default Kd 0.5".to_string()
+            };
+            if OTHER_MATERIALS.contains(&other) {
+                ctx.warn(spec.loc, format!("{what}: material type \"{other}\" is not supported by pbrs: substituted by a matte with {keep}"), "substituted by matte");
+            } else {
+                ctx.warn(spec.loc, format!("{what}: unknown material type \"{other}\": using \"matte\" with {keep} (as pbrt-v3)"), "unknown material type");
+            }
+            (MaterialDesc::Matte { kd, sigma: 0.0 }, "matte")
+        }
+    }
+}
+
+/// pbrt-v3 `shapeMaySetMaterialParameters` (api.cpp): whether a shape's parameters
+/// may override its material's.
+pub fn shape_may_set_material_params(p: &ParamList) -> bool {
+    p.items.iter().any(|q| match q.ty {
+        ParamType::Texture => q.name != "alpha" && q.name != "shadowalpha",
+        ParamType::Float => q.count() == 1 && q.name != "radius",
+        ParamType::String => {
+            q.count() == 1 && !matches!(q.name.as_str(), "filename" | "type" | "scheme")
+        }
+        ParamType::Spectrum => true,
+        _ => q.count() == 1,
+    })
+}
+
+// ---------------------------------------------------------------- lights
+
+pub fn area_light(ctx: &mut Ctx, p: &ParamList) -> AreaLightDesc {
+    let l = spectrum(ctx, p, "L", Vec3::ONE) * light_scale(ctx, p);
+    let (ns, _) = int(p, "nsamples", 1);
+    let (n, _) = int(p, "samples", ns);
+    let two_sided = boolean(p, "twosided", false);
+    AreaLightDesc {
+        l,
+        two_sided,
+        n_samples: n.clamp(1, MAX_SAMPLES) as u32,
+    }
+}
+
+/// `LightSource`: point, spot, distant, infinite; others are warned about and skipped.
+pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<LightDesc> {
+    match name.value.as_str() {
+        "point" => {
+            let i = spectrum(ctx, p, "I", Vec3::ONE) * light_scale(ctx, p);
+            let from = point3(p, "from", DVec3::ZERO);
+            Some(LightDesc::Point {
+                position: ctm.transform_point3(from),
+                intensity: i,
+            })
+        }
+        "spot" => {
+            let i = spectrum(ctx, p, "I", Vec3::ONE) * light_scale(ctx, p);
+            let cone = float(p, "coneangle", 30.0);
+            let delta = float(p, "conedeltaangle", 5.0);
+            let from = point3(p, "from", DVec3::ZERO);
+            let to = point3(p, "to", DVec3::Z);
+            let dir = to - from;
+            if dir.length_squared() == 0.0 {
+                ctx.warn(
+                    name.loc,
+                    "spot light with \"from\" equal to \"to\" has no direction: skipped",
+                    "degenerate spot light",
+                );
+                return None;
+            }
+            let dir = dir.normalize();
+            // pbrt-v3 CoordinateSystem(dir, &du, &dv); light2world = CTM · Translate(from) · Inverse(dirToZ).
+            let du = if dir.x.abs() > dir.y.abs() {
+                DVec3::new(-dir.z, 0.0, dir.x) / (dir.x * dir.x + dir.z * dir.z).sqrt()
+            } else {
+                DVec3::new(0.0, dir.z, -dir.y) / (dir.y * dir.y + dir.z * dir.z).sqrt()
+            };
+            let dv = dir.cross(du);
+            let frame = DMat4::from_cols(
+                du.extend(0.0),
+                dv.extend(0.0),
+                dir.extend(0.0),
+                glam::DVec4::W,
+            );
+            let light_to_world = ctm * DMat4::from_translation(from) * frame;
+            Some(LightDesc::Spot {
+                light_to_world,
+                intensity: i,
+                cone_angle: cone as f32,
+                cone_delta_angle: delta as f32,
+            })
+        }
+        "distant" => {
+            let l = spectrum(ctx, p, "L", Vec3::ONE) * light_scale(ctx, p);
+            let from = point3(p, "from", DVec3::ZERO);
+            let to = point3(p, "to", DVec3::Z);
+            let d = ctm.transform_vector3(from - to);
+            if d.length_squared() == 0.0 || !d.is_finite() {
+                ctx.warn(
+                    name.loc,
+                    "distant light with \"from\" equal to \"to\" has no direction: skipped",
+                    "degenerate distant light",
+                );
+                return None;
+            }
+            Some(LightDesc::Distant {
+                radiance: l,
+                direction: d.normalize(),
+            })
+        }
+        "infinite" | "exinfinite" => {
+            let l = spectrum(ctx, p, "L", Vec3::ONE) * light_scale(ctx, p);
+            let (ns, _) = int(p, "nsamples", 1);
+            let (n, _) = int(p, "samples", ns);
+            if let Some((map, loc)) = string(p, "mapname") {
+                if !map.is_empty() {
+                    ctx.warn(loc, format!("environment map \"{map}\" is not supported by pbrs: the infinite light has the constant radiance L"), "map not loaded");
+                }
+            }
+            Some(LightDesc::Infinite {
+                radiance: l,
+                light_to_world: ctm,
+                n_samples: n.clamp(1, MAX_SAMPLES) as u32,
+            })
+        }
+        other => {
+            p.mark_all_used();
+            if matches!(other, "goniometric" | "projection") {
+                ctx.warn(
+                    name.loc,
+                    format!("light \"{other}\" is not supported by pbrs: ignored"),
+                    "light ignored",
+                );
+            } else {
+                ctx.warn(name.loc, format!("unknown light type \"{other}\": ignored (pbrt-v3 has point, spot, goniometric, projection, distant, infinite)"), "unknown light");
+            }
+            None
+        }
+    }
+}
+
+// ---------------------------------------------------------------- shapes
+
+const OTHER_SHAPES: &[&str] = &[
+    "cylinder",
+    "disk",
+    "cone",
+    "paraboloid",
+    "hyperboloid",
+    "curve",
+    "heightfield",
+    "loopsubdiv",
+    "nurbs",
+];
+
+/// The geometry of a `Shape`, or `None` (unsupported: warning; invalid: error).
+pub fn geometry(
+    ctx: &mut Ctx,
+    name: &Name,
+    p: &ParamList,
+    meshes: &mut HashMap<PathBuf, Option<Arc<MeshData>>>,
+) -> Option<Geometry> {
+    match name.value.as_str() {
+        "sphere" => {
+            let radius = float(p, "radius", 1.0);
+            if radius <= 0.0 {
+                let loc = p.get("radius").map(|q| q.values_loc).unwrap_or(name.loc);
+                ctx.error(
+                    loc,
+                    format!("sphere radius {radius} is not positive"),
+                    "radius must be > 0",
+                    None,
+                );
+                return None;
+            }
+            let zmin = float(p, "zmin", -radius);
+            let zmax = float(p, "zmax", radius);
+            let phimax = float(p, "phimax", 360.0).clamp(0.0, 360.0);
+            let (z0, z1) = (
+                zmin.min(zmax).clamp(-radius, radius),
+                zmin.max(zmax).clamp(-radius, radius),
+            );
+            if phimax <= 0.0 || z0 >= z1 {
+                ctx.warn(
+                    name.loc,
+                    "sphere with an empty extent (phimax 0 or zmin = zmax): skipped",
+                    "empty sphere",
+                );
+                return None;
+            }
+            if radius as f32 == f32::INFINITY {
+                ctx.error(
+                    name.loc,
+                    "sphere radius does not fit a 32-bit float",
+                    "radius too large",
+                    None,
+                );
+                return None;
+            }
+            Some(Geometry::Sphere {
+                radius: radius as f32,
+                z_min: z0 as f32,
+                z_max: z1 as f32,
+                phi_max: phimax as f32,
+            })
+        }
+        "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
+        "plymesh" => {
+            let Some((file, floc)) = string(p, "filename") else {
+                ctx.error(
+                    name.loc,
+                    "plymesh needs a \"string filename\" parameter",
+                    "no filename",
+                    None,
+                );
+                return None;
+            };
+            alpha_ignored(ctx, p);
+            let path = resolve(&ctx.base_dir, file);
+            if let Some(m) = meshes.get(&path) {
+                return m.clone().map(Geometry::TriangleMesh);
+            }
+            let result = match ctx.loader.load(&path) {
+                Err(e) => Err(format!("cannot read PLY file \"{}\": {e}", path.display())),
+                Ok(bytes) => {
+                    read_ply(&bytes).map_err(|e| format!("PLY file \"{}\": {e}", path.display()))
+                }
+            };
+            let mesh = match result {
+                Ok(m) => {
+                    for n in m.notes {
+                        ctx.warn(
+                            floc,
+                            format!("PLY file \"{}\": {n}", path.display()),
+                            "this mesh",
+                        );
+                    }
+                    if m.mesh.positions.iter().any(|v| !v.is_finite()) {
+                        ctx.error(
+                            floc,
+                            format!(
+                                "PLY file \"{}\" has a vertex that is not a finite 32-bit number",
+                                path.display()
+                            ),
+                            "this mesh",
+                            None,
+                        );
+                        None
+                    } else {
+                        Some(Arc::new(m.mesh))
+                    }
+                }
+                Err(e) => {
+                    ctx.error(floc, e, "this mesh", None);
+                    None
+                }
+            };
+            meshes.insert(path, mesh.clone());
+            mesh.map(Geometry::TriangleMesh)
+        }
+        other => {
+            p.mark_all_used();
+            if OTHER_SHAPES.contains(&other) {
+                ctx.warn(
+                    name.loc,
+                    format!("shape \"{other}\" is not supported by pbrs: skipped"),
+                    "shape skipped",
+                );
+            } else {
+                let all: Vec<&str> = ["sphere", "trianglemesh", "plymesh"]
+                    .iter()
+                    .chain(OTHER_SHAPES)
+                    .copied()
+                    .collect();
+                let hint = super::state::closest_name(other, &all)
+                    .map(|c| format!(" (did you mean \"{c}\"?)"))
+                    .unwrap_or_default();
+                ctx.warn(
+                    name.loc,
+                    format!("unknown shape \"{other}\"{hint}: skipped (as pbrt-v3)"),
+                    "unknown shape",
+                );
+            }
+            None
+        }
+    }
+}
+
+fn alpha_ignored(ctx: &mut Ctx, p: &ParamList) {
+    for n in ["alpha", "shadowalpha"] {
+        if let Some(q) = p
+            .items
+            .iter()
+            .find(|q| q.name == n && matches!(q.ty, ParamType::Float | ParamType::Texture))
+        {
+            q.used.set(true);
+            ctx.warn(
+                q.loc,
+                format!("\"{n}\": alpha masks are not supported by pbrs; ignored"),
+                "ignored",
+            );
+        }
+    }
+}
+
+fn to_vec3(v: &[f64]) -> Vec<Vec3> {
+    v.chunks_exact(3)
+        .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
+        .collect()
+}
+
+fn triangle_mesh(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> {
+    let Some(pp) = p
+        .items
+        .iter()
+        .find(|q| q.name == "P" && q.ty == ParamType::Point3)
+    else {
+        ctx.error(
+            name.loc,
+            "trianglemesh needs vertex positions \"point P\"",
+            "no \"point P\"",
+            None,
+        );
+        return None;
+    };
+    pp.used.set(true);
+    let positions = to_vec3(pp.nums());
+    let nv = positions.len();
+    if nv == 0 {
+        ctx.error(
+            pp.values_loc,
+            "trianglemesh has no vertices",
+            "empty \"point P\"",
+            None,
+        );
+        return None;
+    }
+    if positions.iter().any(|v| !v.is_finite()) {
+        ctx.error(
+            pp.values_loc,
+            "a vertex of \"P\" does not fit a 32-bit float",
+            "too large",
+            None,
+        );
+        return None;
+    }
+    let indices: Vec<u32> = match p
+        .items
+        .iter()
+        .find(|q| q.name == "indices" && q.ty == ParamType::Integer)
+    {
+        Some(q) => {
+            q.used.set(true);
+            let v = q.nums();
+            if v.len() % 3 != 0 {
+                ctx.error(
+                    q.values_loc,
+                    format!(
+                        "trianglemesh \"indices\" has {} values, not a multiple of 3",
+                        v.len()
+                    ),
+                    "indices",
+                    None,
+                );
+                return None;
+            }
+            if let Some((k, &bad)) = v
+                .iter()
+                .enumerate()
+                .find(|(_, &x)| x < 0.0 || x >= nv as f64)
+            {
+                let why = if bad < 0.0 {
+                    "negative"
+                } else {
+                    "out of range"
+                };
+                ctx.error(
+                    q.values_loc,
+                    format!(
+                        "trianglemesh index {bad} (entry {k}) is {why}: \"P\" has {nv} vertices"
+                    ),
+                    format!("{why} index"),
+                    None,
+                );
+                return None;
+            }
+            v.iter().map(|&x| x as u32).collect()
+        }
+        None if nv == 3 => vec![0, 1, 2],
+        None => {
+            ctx.error(name.loc, format!("trianglemesh needs \"integer indices\" (it has {nv} vertices; only a single triangle may omit them)"), "no \"integer indices\"", None);
+            return None;
+        }
+    };
+    let normals = match p
+        .items
+        .iter()
+        .find(|q| q.name == "N" && q.ty == ParamType::Normal)
+    {
+        Some(q) => {
+            q.used.set(true);
+            if q.count() != nv {
+                ctx.warn(q.values_loc, format!("\"N\" has {} normals but \"P\" has {nv} vertices: normals dropped (as pbrt-v3)", q.count()), "count mismatch");
+                None
+            } else {
+                Some(to_vec3(q.nums()))
+            }
+        }
+        None => None,
+    };
+    let uvq = ["uv", "st"].iter().find_map(|n| {
+        p.items
+            .iter()
+            .find(|q| q.name == *n && matches!(q.ty, ParamType::Point2 | ParamType::Float))
+    });
+    let uvs = match uvq {
+        Some(q) => {
+            q.used.set(true);
+            let v = q.nums();
+            if v.len() != 2 * nv {
+                ctx.warn(q.values_loc, format!("\"{}\" has {} numbers but \"P\" has {nv} vertices (expected {}): uvs dropped (as pbrt-v3)", q.name, v.len(), 2 * nv), "count mismatch");
+                None
+            } else {
+                Some(
+                    v.chunks_exact(2)
+                        .map(|c| Vec2::new(c[0] as f32, c[1] as f32))
+                        .collect(),
+                )
+            }
+        }
+        None => None,
+    };
+    alpha_ignored(ctx, p);
+    Some(MeshData {
+        positions,
+        indices,
+        normals,
+        uvs,
+    })
+}
+
+// ---------------------------------------------------------------- options
+
+type Ent<'a> = Option<(&'a Name, &'a ParamList)>;
+
+pub fn camera(ctx: &mut Ctx, c: Option<((&Name, &ParamList), DMat4)>) -> CameraDesc {
+    let empty = ParamList::default();
+    let ((name, p), ctm) = match c {
+        Some(x) => x,
+        None => return default_camera(),
+    };
+    let mut camera_to_world = ctm.inverse();
+    if !camera_to_world.is_finite() || ctm.determinant().abs() < 1e-300 {
+        ctx.error(
+            name.loc,
+            "the camera transform (the CTM at Camera) is singular: it cannot be inverted",
+            "this Camera",
+            None,
+        );
+        camera_to_world = DMat4::IDENTITY;
+    }
+    let p = match name.value.as_str() {
+        "perspective" => p,
+        "orthographic" | "realistic" | "environment" => {
+            p.mark_all_used();
+            ctx.warn(name.loc, format!("camera \"{}\" is not supported by pbrs: a perspective camera with default parameters is used", name.value), "substituted by perspective");
+            &empty
+        }
+        other => {
+            ctx.error(name.loc, format!("unknown camera \"{other}\" (pbrt-v3 has perspective, orthographic, realistic, environment)"), "unknown camera", None);
+            p.mark_all_used();
+            &empty
+        }
+    };
+    let mut fov = float(p, "fov", 90.0);
+    let half = float(p, "halffov", -1.0);
+    if half > 0.0 {
+        fov = 2.0 * half;
+    }
+    if !(fov > 0.0 && fov < 180.0) {
+        let loc = p.get("fov").map(|q| q.values_loc).unwrap_or(name.loc);
+        ctx.error(
+            loc,
+            format!("field of view {fov} is outside (0, 180) degrees"),
+            "bad fov",
+            None,
+        );
+        fov = 90.0;
+    }
+    let lens_radius = float(p, "lensradius", 0.0) as f32;
+    let focal_distance = float(p, "focaldistance", 1e6) as f32;
+    let frame_aspect_ratio = float_opt(p, "frameaspectratio").map(|(v, _)| v as f32);
+    let screen_window = match p
+        .items
+        .iter()
+        .find(|q| q.name == "screenwindow" && q.ty == ParamType::Float)
+    {
+        Some(q) => {
+            q.used.set(true);
+            let v = q.nums();
+            if v.len() == 4 {
+                Some([v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32])
+            } else {
+                ctx.warn(
+                    q.values_loc,
+                    format!(
+                        "\"screenwindow\" needs 4 values, found {}: ignored",
+                        v.len()
+                    ),
+                    "expected 4 values",
+                );
+                None
+            }
+        }
+        None => None,
+    };
+    let mut open = float(p, "shutteropen", 0.0) as f32;
+    let mut close = float(p, "shutterclose", 1.0) as f32;
+    if close < open {
+        ctx.warn(
+            name.loc,
+            "shutterclose < shutteropen: swapped (as pbrt-v3)",
+            "shutter",
+        );
+        std::mem::swap(&mut open, &mut close);
+    }
+    ctx.report_unused(p, &format!("Camera \"{}\"", name.value));
+    CameraDesc {
+        camera_to_world,
+        kind: CameraKind::Perspective {
+            fov: fov as f32,
+            lens_radius,
+            focal_distance,
+            frame_aspect_ratio,
+            screen_window,
+        },
+        shutter_open: open,
+        shutter_close: close,
+    }
+}
+
+pub fn default_camera() -> CameraDesc {
+    CameraDesc {
+        camera_to_world: DMat4::IDENTITY,
+        kind: CameraKind::Perspective {
+            fov: 90.0,
+            lens_radius: 0.0,
+            focal_distance: 1e6,
+            frame_aspect_ratio: None,
+            screen_window: None,
+        },
+        shutter_open: 0.0,
+        shutter_close: 1.0,
+    }
+}
+
+fn checked_count(ctx: &mut Ctx, p: &ParamList, name: &str, def: i64, max: i64, what: &str) -> u32 {
+    let (v, loc) = int(p, name, def);
+    if v < 1 || v > max {
+        let loc = loc.unwrap_or_default();
+        ctx.error(
+            loc,
+            format!("{what} \"{name}\" is {v}: it must be between 1 and {max}"),
+            "out of range",
+            None,
+        );
+        return def as u32;
+    }
+    v as u32
+}
+
+pub fn film(ctx: &mut Ctx, f: Ent) -> FilmDesc {
+    let empty = ParamList::default();
+    let p = match f {
+        Some((name, p)) if name.value != "image" => {
+            p.mark_all_used();
+            ctx.error(
+                name.loc,
+                format!(
+                    "unknown film \"{}\" (pbrt-v3 has only \"image\")",
+                    name.value
+                ),
+                "unknown film",
+                None,
+            );
+            &empty
+        }
+        Some((_, p)) => p,
+        None => &empty,
+    };
+    let xresolution = checked_count(
+        ctx,
+        p,
+        "xresolution",
+        1280,
+        MAX_RESOLUTION,
+        "film resolution",
+    );
+    let yresolution = checked_count(
+        ctx,
+        p,
+        "yresolution",
+        720,
+        MAX_RESOLUTION,
+        "film resolution",
+    );
+    let mut cropwindow = [0.0, 1.0, 0.0, 1.0];
+    if let Some(q) = p
+        .items
+        .iter()
+        .find(|q| q.name == "cropwindow" && q.ty == ParamType::Float)
+    {
+        q.used.set(true);
+        let v = q.nums();
+        if v.len() == 4 {
+            let c = |a: f64| a.clamp(0.0, 1.0) as f32;
+            cropwindow = [
+                c(v[0].min(v[1])),
+                c(v[0].max(v[1])),
+                c(v[2].min(v[3])),
+                c(v[2].max(v[3])),
+            ];
+            if cropwindow[0] >= cropwindow[1] || cropwindow[2] >= cropwindow[3] {
+                ctx.error(
+                    q.values_loc,
+                    "\"cropwindow\" is empty: it covers no pixels",
+                    "empty crop window",
+                    None,
+                );
+                cropwindow = [0.0, 1.0, 0.0, 1.0];
+            }
+        } else {
+            ctx.warn(
+                q.values_loc,
+                format!(
+                    "\"cropwindow\" needs 4 values, found {}: ignored (as pbrt-v3)",
+                    v.len()
+                ),
+                "expected 4 values",
+            );
+        }
+    }
+    let filename = string(p, "filename")
+        .map(|(s, _)| s.to_string())
+        .unwrap_or_else(|| "pbrt.exr".into());
+    let scale = float(p, "scale", 1.0) as f32;
+    float(p, "diagonal", 35.0);
+    let max_sample_luminance = float(p, "maxsampleluminance", f64::INFINITY) as f32;
+    if let Some((name, _)) = f {
+        ctx.report_unused(p, &format!("Film \"{}\"", name.value));
+    }
+    FilmDesc {
+        xresolution,
+        yresolution,
+        cropwindow,
+        filename: PathBuf::from(filename),
+        scale,
+        max_sample_luminance,
+    }
+}
+
+pub fn filter(ctx: &mut Ctx, f: Ent) -> FilterDesc {
+    let Some((name, p)) = f else {
+        return FilterDesc::Box {
+            radius: Vec2::splat(0.5),
+        };
+    };
+    let def = match name.value.as_str() {
+        "box" => 0.5,
+        "gaussian" | "triangle" | "mitchell" => 2.0,
+        "sinc" => 4.0,
+        other => {
+            p.mark_all_used();
+            ctx.error(name.loc, format!("unknown filter \"{other}\" (pbrt-v3 has box, gaussian, mitchell, sinc, triangle; an unknown filter is fatal there)"), "unknown filter", None);
+            return FilterDesc::Box {
+                radius: Vec2::splat(0.5),
+            };
+        }
+    };
+    let mut radius = Vec2::new(
+        float(p, "xwidth", def) as f32,
+        float(p, "ywidth", def) as f32,
+    );
+    if !(radius.x > 0.0 && radius.y > 0.0 && radius.is_finite()) {
+        ctx.error(
+            name.loc,
+            format!("filter width {} {} must be positive", radius.x, radius.y),
+            "bad filter width",
+            None,
+        );
+        radius = Vec2::splat(def as f32);
+    }
+    let d = match name.value.as_str() {
+        "box" => FilterDesc::Box { radius },
+        "gaussian" => FilterDesc::Gaussian {
+            radius,
+            alpha: float(p, "alpha", 2.0) as f32,
+        },
+        "triangle" => FilterDesc::Triangle { radius },
+        "mitchell" => FilterDesc::Mitchell {
+            radius,
+            b: float(p, "B", 1.0 / 3.0) as f32,
+            c: float(p, "C", 1.0 / 3.0) as f32,
+        },
+        _ => FilterDesc::LanczosSinc {
+            radius,
+            tau: float(p, "tau", 3.0) as f32,
+        },
+    };
+    ctx.report_unused(p, &format!("PixelFilter \"{}\"", name.value));
+    d
+}
+
+pub fn sampler(ctx: &mut Ctx, s: Ent) -> SamplerDesc {
+    let Some((name, p)) = s else {
+        return SamplerDesc {
+            kind: SamplerKind::Halton,
+            pixel_samples: 16,
+            sample_pixel_center: false,
+        };
+    };
+    let mut center = false;
+    let (kind, spp) = match name.value.as_str() {
+        "halton" => {
+            center = boolean(p, "samplepixelcenter", false);
+            (
+                SamplerKind::Halton,
+                checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
+            )
+        }
+        "random" => (
+            SamplerKind::Random,
+            checked_count(ctx, p, "pixelsamples", 4, MAX_SAMPLES, "sample count"),
+        ),
+        "sobol" => (
+            SamplerKind::Sobol,
+            checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
+        ),
+        "02sequence" | "lowdiscrepancy" => {
+            int(p, "dimensions", 4);
+            (
+                SamplerKind::ZeroTwoSequence,
+                checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
+            )
+        }
+        "maxmindist" => {
+            int(p, "dimensions", 4);
+            (
+                SamplerKind::MaxMinDist,
+                checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
+            )
+        }
+        "stratified" => {
+            let jitter = boolean(p, "jitter", true);
+            let xs = checked_count(ctx, p, "xsamples", 4, MAX_SAMPLES, "sample count");
+            let ys = checked_count(ctx, p, "ysamples", 4, MAX_SAMPLES, "sample count");
+            int(p, "dimensions", 4);
+            let total = xs as u64 * ys as u64;
+            if total > MAX_SAMPLES as u64 {
+                ctx.error(
+                    name.loc,
+                    format!(
+                        "stratified sampler: xsamples × ysamples = {total} exceeds {MAX_SAMPLES}"
+                    ),
+                    "too many samples",
+                    None,
+                );
+                (
+                    SamplerKind::Stratified {
+                        jitter,
+                        xsamples: 4,
+                        ysamples: 4,
+                    },
+                    16,
+                )
+            } else {
+                (
+                    SamplerKind::Stratified {
+                        jitter,
+                        xsamples: xs,
+                        ysamples: ys,
+                    },
+                    total as u32,
+                )
+            }
+        }
+        other => {
+            p.mark_all_used();
+            ctx.error(name.loc, format!("unknown sampler \"{other}\" (pbrt-v3 has halton, sobol, random, stratified, 02sequence, lowdiscrepancy, maxmindist)"), "unknown sampler", None);
+            (SamplerKind::Halton, 16)
+        }
+    };
+    ctx.report_unused(p, &format!("Sampler \"{}\"", name.value));
+    SamplerDesc {
+        kind,
+        pixel_samples: spp,
+        sample_pixel_center: center,
+    }
+}
+
+pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {
+    let path = |d| IntegratorDesc::Path {
+        max_depth: d,
+        rr_threshold: 1.0,
+        light_sample_strategy: LightSampleStrategy::Spatial,
+    };
+    let Some((name, p)) = s else { return path(5) };
+    let (md, loc) = int(p, "maxdepth", 5);
+    let max_depth = if md < 0 {
+        ctx.error(
+            loc.unwrap_or(name.loc),
+            format!("\"maxdepth\" is {md}: it must be ≥ 0"),
+            "negative depth",
+            None,
+        );
+        5
+    } else {
+        md as u32
+    };
+    if let Some(q) = p.items.iter().find(|q| q.name == "pixelbounds") {
+        q.used.set(true);
+        ctx.warn(q.loc, "\"pixelbounds\" is not supported by pbrs: the whole film is rendered (use --cropwindow)", "ignored");
+    }
+    let d = match name.value.as_str() {
+        "path" => {
+            let rr = float(p, "rrthreshold", 1.0) as f32;
+            let strategy = match string(p, "lightsamplestrategy") {
+                None | Some(("spatial", _)) => LightSampleStrategy::Spatial,
+                Some(("uniform", _)) => LightSampleStrategy::Uniform,
+                Some(("power", _)) => LightSampleStrategy::Power,
+                Some((other, loc)) => {
+                    ctx.warn(loc, format!("unknown light sample strategy \"{other}\": \"spatial\" is used (as pbrt-v3)"), "expected uniform, power or spatial");
+                    LightSampleStrategy::Spatial
+                }
+            };
+            IntegratorDesc::Path {
+                max_depth,
+                rr_threshold: rr,
+                light_sample_strategy: strategy,
+            }
+        }
+        "directlighting" => {
+            let strategy = match string(p, "strategy") {
+                None | Some(("all", _)) => DirectStrategy::All,
+                Some(("one", _)) => DirectStrategy::One,
+                Some((other, loc)) => {
+                    ctx.warn(
+                        loc,
+                        format!("unknown strategy \"{other}\": \"all\" is used (as pbrt-v3)"),
+                        "expected all or one",
+                    );
+                    DirectStrategy::All
+                }
+            };
+            IntegratorDesc::DirectLighting {
+                max_depth,
+                strategy,
+            }
+        }
+        "whitted" => IntegratorDesc::Whitted { max_depth },
+        "volpath" | "bdpt" | "mlt" | "sppm" | "ambientocclusion" => {
+            p.mark_all_used();
+            ctx.warn(name.loc, format!("integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth {max_depth}", name.value), "substituted by path");
+            path(max_depth)
+        }
+        other => {
+            p.mark_all_used();
+            ctx.error(name.loc, format!("unknown integrator \"{other}\" (pbrt-v3 has whitted, directlighting, path, volpath, bdpt, mlt, ambientocclusion, sppm)"), "unknown integrator", None);
+            path(max_depth)
+        }
+    };
+    ctx.report_unused(p, &format!("Integrator \"{}\"", name.value));
+    d
+}

@@ -1,0 +1,829 @@
+//! The walk over statements with pbrt-v3's graphics state (api.cpp): CTM, attribute
+//! and transform stacks, current and named materials, textures, area light,
+//! ReverseOrientation, object definitions, and the option directives.
+
+use super::entities::{self, Lookup, MaterialSpec, Textures};
+use super::Ctx;
+use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
+use crate::lang::Loc;
+use crate::scene::*;
+use glam::{DMat4, DVec3, DVec4};
+use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
+use std::sync::Arc;
+
+#[derive(Clone)]
+struct Graphics {
+    material: Rc<MaterialSpec>,
+    named: Rc<HashMap<String, Rc<MaterialSpec>>>,
+    textures: Rc<Textures>,
+    area_light: Option<(usize, Loc)>,
+    reverse: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum FrameKind {
+    Attribute,
+    Transform,
+    Object,
+}
+
+impl FrameKind {
+    fn begin(self) -> &'static str {
+        match self {
+            FrameKind::Attribute => "AttributeBegin",
+            FrameKind::Transform => "TransformBegin",
+            FrameKind::Object => "ObjectBegin",
+        }
+    }
+}
+
+struct Frame {
+    kind: FrameKind,
+    loc: Loc,
+    ctm: [DMat4; 2],
+    active: [bool; 2],
+    graphics: Option<Graphics>,
+}
+
+/// A shape recorded inside ObjectBegin, built when the object is first instanced.
+struct PendingShape {
+    stmt: usize,
+    ctm: DMat4,
+    graphics: Graphics,
+}
+
+struct ObjectDef {
+    loc: Loc,
+    shapes: Vec<PendingShape>,
+    built: Option<usize>,
+}
+
+#[derive(PartialEq, Eq, Clone, Copy)]
+enum Phase {
+    Options,
+    World,
+    After,
+}
+
+/// Walks the statements and fills a [`SceneDescription`].
+pub struct Builder<'s, 'c> {
+    stmts: &'s [Stmt],
+    pub ctx: &'c mut Ctx,
+    phase: Phase,
+    ctm: [DMat4; 2],
+    active: [bool; 2],
+    named_coords: HashMap<String, [DMat4; 2]>,
+    graphics: Graphics,
+    stack: Vec<Frame>,
+    // Options: the statement and the CTM it saw.
+    camera: Option<(usize, DMat4)>,
+    film: Option<usize>,
+    filter: Option<usize>,
+    sampler: Option<usize>,
+    integrator: Option<usize>,
+    accelerator: Option<usize>,
+    // World.
+    current_object: Option<(String, ObjectDef)>,
+    objects: HashMap<String, ObjectDef>,
+    object_order: Vec<String>,
+    /// Built materials by their statement (`None`: the initial matte).
+    material_ids: HashMap<Option<usize>, MaterialId>,
+    material_keys: HashMap<String, MaterialId>,
+    reported_materials: HashSet<Option<usize>>,
+    area_lights: HashMap<usize, AreaLightDesc>,
+    named_material_defs: Vec<(String, Rc<MaterialSpec>)>,
+    pub meshes: HashMap<std::path::PathBuf, Option<Arc<MeshData>>>,
+    after_warned: bool,
+    world_seen: bool,
+    world_ended: bool,
+    pub scene_materials: Vec<MaterialDesc>,
+    pub material_kinds: Vec<&'static str>,
+    pub shapes: Vec<ShapeDesc>,
+    pub lights: Vec<LightDesc>,
+    pub scene_objects: Vec<ObjectDesc>,
+    pub instances: Vec<InstanceDesc>,
+    pub skipped: Vec<String>,
+    pub unsupported_shapes: usize,
+}
+
+impl<'s, 'c> Builder<'s, 'c> {
+    pub fn new(stmts: &'s [Stmt], ctx: &'c mut Ctx) -> Self {
+        let default_material = Rc::new(MaterialSpec::default_matte());
+        Builder {
+            stmts,
+            ctx,
+            phase: Phase::Options,
+            ctm: [DMat4::IDENTITY; 2],
+            active: [true, true],
+            named_coords: HashMap::new(),
+            graphics: Graphics {
+                material: default_material,
+                named: Rc::new(HashMap::new()),
+                textures: Rc::new(Textures::default()),
+                area_light: None,
+                reverse: false,
+            },
+            stack: Vec::new(),
+            camera: None,
+            film: None,
+            filter: None,
+            sampler: None,
+            integrator: None,
+            accelerator: None,
+            current_object: None,
+            objects: HashMap::new(),
+            object_order: Vec::new(),
+            material_ids: HashMap::new(),
+            material_keys: HashMap::new(),
+            reported_materials: HashSet::new(),
+            area_lights: HashMap::new(),
+            named_material_defs: Vec::new(),
+            meshes: HashMap::new(),
+            after_warned: false,
+            world_seen: false,
+            world_ended: false,
+            scene_materials: Vec::new(),
+            material_kinds: Vec::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+            scene_objects: Vec::new(),
+            instances: Vec::new(),
+            skipped: Vec::new(),
+            unsupported_shapes: 0,
+        }
+    }
+
+    fn apply(&mut self, f: impl Fn(DMat4) -> DMat4) {
+        for i in 0..2 {
+            if self.active[i] {
+                self.ctm[i] = f(self.ctm[i]);
+            }
+        }
+    }
+
+    fn world_only(kind: DirKind) -> bool {
+        use DirKind as K;
+        matches!(
+            kind,
+            K::AttributeBegin
+                | K::AttributeEnd
+                | K::TransformBegin
+                | K::TransformEnd
+                | K::Shape
+                | K::Material
+                | K::MakeNamedMaterial
+                | K::NamedMaterial
+                | K::LightSource
+                | K::AreaLightSource
+                | K::Texture
+                | K::ReverseOrientation
+                | K::ObjectBegin
+                | K::ObjectEnd
+                | K::ObjectInstance
+        )
+    }
+
+    fn options_only(kind: DirKind) -> bool {
+        use DirKind as K;
+        matches!(
+            kind,
+            K::Camera
+                | K::Sampler
+                | K::Film
+                | K::PixelFilter
+                | K::Integrator
+                | K::Accelerator
+                | K::TransformTimes
+        )
+    }
+
+    /// Walks every statement.
+    pub fn run(&mut self) {
+        let stmts = self.stmts;
+        for (i, s) in stmts.iter().enumerate() {
+            if self.phase == Phase::After {
+                if !self.after_warned {
+                    self.after_warned = true;
+                    self.ctx.warn(s.loc, format!("`{}` after WorldEnd: pbrs renders the first world block and ignores everything after it", s.kind.name()), "ignored from here on");
+                    self.skipped.push(
+                        "statements after the first WorldEnd (pbrs renders one world block)".into(),
+                    );
+                }
+                continue;
+            }
+            if self.phase == Phase::Options && Self::world_only(s.kind) {
+                self.ctx.warn(
+                    s.loc,
+                    format!(
+                        "`{}` before WorldBegin is ignored (pbrt-v3 reports it and ignores it)",
+                        s.kind.name()
+                    ),
+                    "only allowed inside WorldBegin … WorldEnd",
+                );
+                if let Some(p) = s.params() {
+                    p.mark_all_used();
+                }
+                continue;
+            }
+            if self.phase == Phase::World && Self::options_only(s.kind) {
+                self.ctx.warn(s.loc, format!("`{}` inside the world block is ignored (pbrt-v3 reports it and ignores it)", s.kind.name()), "only allowed before WorldBegin");
+                if let Some(p) = s.params() {
+                    p.mark_all_used();
+                }
+                continue;
+            }
+            self.statement(i, s);
+        }
+        if self.phase == Phase::World {
+            let loc = stmts.last().map(|s| s.loc).unwrap_or_default();
+            self.ctx.warn(
+                loc,
+                "the file ends without WorldEnd: the scene is loaded anyway",
+                "last statement",
+            );
+            self.end_world(loc);
+        }
+        if !self.world_seen {
+            let loc = stmts.last().map(|s| s.loc).unwrap_or_default();
+            if !self.ctx.sources.files.is_empty() {
+                self.ctx.warn(
+                    loc,
+                    "the scene has no WorldBegin: it has no shapes or lights",
+                    "last statement",
+                );
+            }
+        }
+    }
+
+    fn statement(&mut self, i: usize, s: &'s Stmt) {
+        use DirKind as K;
+        let nums = match &s.dir {
+            Directive::Numbers(v) => v.as_slice(),
+            _ => &[],
+        };
+        match s.kind {
+            K::Identity => self.apply(|_| DMat4::IDENTITY),
+            K::Translate => {
+                let t = DMat4::from_translation(DVec3::new(nums[0], nums[1], nums[2]));
+                self.apply(|m| m * t);
+            }
+            K::Scale => {
+                let t = DMat4::from_scale(DVec3::new(nums[0], nums[1], nums[2]));
+                self.apply(|m| m * t);
+            }
+            K::Rotate => {
+                let axis = DVec3::new(nums[1], nums[2], nums[3]);
+                if axis.length_squared() == 0.0 || !axis.length_squared().is_finite() {
+                    self.ctx.error(s.loc, "Rotate about a zero-length axis", "the axis (x y z) must not be 0 0 0", None);
+                    return;
+                }
+                let t = DMat4::from_axis_angle(axis.normalize(), nums[0].to_radians());
+                self.apply(|m| m * t);
+            }
+            K::LookAt => match look_at(nums) {
+                Some(t) => self.apply(|m| m * t),
+                None => self.ctx.warn(s.loc, "degenerate LookAt (eye equals look, or up is parallel to the view direction): ignored, as pbrt-v3 does", "this LookAt"),
+            },
+            K::Transform | K::ConcatTransform => {
+                let mut a = [0.0; 16];
+                a.copy_from_slice(nums);
+                let t = DMat4::from_cols_array(&a);
+                if s.kind == K::Transform {
+                    self.apply(|_| t);
+                } else {
+                    self.apply(|m| m * t);
+                }
+            }
+            K::CoordinateSystem => {
+                if let Directive::Named(n) = &s.dir {
+                    self.named_coords.insert(n.value.clone(), self.ctm);
+                }
+            }
+            K::CoordSysTransform => {
+                if let Directive::Named(n) = &s.dir {
+                    match self.named_coords.get(&n.value) {
+                        Some(&m) => self.ctm = m,
+                        None => self.ctx.warn(n.loc, format!("unknown coordinate system \"{}\": CoordSysTransform ignored (as pbrt-v3)", n.value), "not defined by CoordinateSystem or Camera"),
+                    }
+                }
+            }
+            K::ActiveTransform => {
+                if let Directive::ActiveTransform(k) = s.dir {
+                    self.active = match k {
+                        ActiveKind::All => [true, true],
+                        ActiveKind::StartTime => [true, false],
+                        ActiveKind::EndTime => [false, true],
+                    };
+                    if k != ActiveKind::All {
+                        self.ctx.warn(s.loc, "ActiveTransform: motion blur is not supported; pbrs uses the start-time transforms", "animated transforms ignored");
+                    }
+                }
+            }
+            K::TransformTimes => {
+                if nums != [0.0, 1.0] {
+                    self.ctx.warn(s.loc, "TransformTimes: motion blur is not supported; ignored", "ignored");
+                }
+            }
+            K::Camera => {
+                self.camera = Some((i, self.ctm[0]));
+                if self.ctm[0] != self.ctm[1] {
+                    self.ctx.warn(s.loc, "animated camera transform: motion blur is not supported; the start transform is used", "this Camera");
+                }
+                let inv = self.ctm[0].inverse();
+                self.named_coords.insert("camera".into(), [inv, self.ctm[1].inverse()]);
+            }
+            K::Film => self.film = Some(i),
+            K::PixelFilter => self.filter = Some(i),
+            K::Sampler => self.sampler = Some(i),
+            K::Integrator => self.integrator = Some(i),
+            K::Accelerator => self.accelerator = Some(i),
+            K::WorldBegin => {
+                if self.phase == Phase::World {
+                    self.ctx.warn(s.loc, "WorldBegin inside the world block is ignored", "already inside WorldBegin");
+                    return;
+                }
+                self.phase = Phase::World;
+                self.world_seen = true;
+                self.ctm = [DMat4::IDENTITY; 2];
+                self.active = [true, true];
+                self.named_coords.insert("world".into(), self.ctm);
+            }
+            K::WorldEnd => {
+                if self.phase != Phase::World {
+                    self.ctx.warn(s.loc, "WorldEnd without WorldBegin is ignored", "no world block is open");
+                    return;
+                }
+                self.end_world(s.loc);
+            }
+            K::AttributeBegin | K::TransformBegin => {
+                let kind = if s.kind == K::AttributeBegin { FrameKind::Attribute } else { FrameKind::Transform };
+                self.push(kind, s.loc);
+            }
+            K::AttributeEnd | K::TransformEnd => {
+                let kind = if s.kind == K::AttributeEnd { FrameKind::Attribute } else { FrameKind::Transform };
+                self.pop(kind, s);
+            }
+            K::ObjectBegin => {
+                let Directive::Named(n) = &s.dir else { return };
+                if let Some((outer, _)) = &self.current_object {
+                    let outer = outer.clone();
+                    self.ctx.error(s.loc, format!("ObjectBegin \"{}\" inside the definition of object \"{outer}\": object definitions cannot be nested", n.value), "nested ObjectBegin", None);
+                    return;
+                }
+                self.push(FrameKind::Object, s.loc);
+                self.current_object = Some((n.value.clone(), ObjectDef { loc: n.loc, shapes: Vec::new(), built: None }));
+            }
+            K::ObjectEnd => {
+                if self.current_object.is_none() {
+                    self.ctx.error(s.loc, "ObjectEnd without ObjectBegin", "no object definition is open", None);
+                    return;
+                }
+                if self.pop(FrameKind::Object, s) {
+                    let (name, def) = self.current_object.take().expect("checked");
+                    if let Some(old) = self.objects.get(&name) {
+                        let at = self.ctx.sources.position(old.loc);
+                        self.ctx.warn(def.loc, format!("object \"{name}\" redefined (first defined at {at}); the new definition is used"), "redefinition");
+                    } else {
+                        self.object_order.push(name.clone());
+                    }
+                    self.objects.insert(name, def);
+                }
+            }
+            K::ObjectInstance => {
+                let Directive::Named(n) = &s.dir else { return };
+                self.instance(n);
+            }
+            K::ReverseOrientation => self.graphics.reverse = !self.graphics.reverse,
+            K::Material => {
+                let Directive::Entity { name, params } = &s.dir else { return };
+                self.graphics.material = Rc::new(MaterialSpec::new(name.value.clone(), Some(i), name.loc, self.graphics.textures.clone(), None));
+                let _ = params;
+            }
+            K::MakeNamedMaterial => {
+                let Directive::Entity { name, params } = &s.dir else { return };
+                let ty = params.find("type", |t| t == crate::lang::params::ParamType::String).and_then(|p| p.strs().first().cloned());
+                let Some(ty) = ty else {
+                    self.ctx.error(name.loc, format!("MakeNamedMaterial \"{}\" has no \"string type\" parameter", name.value), "needs \"string type\" [ \"matte\" ] or similar", None);
+                    return;
+                };
+                if let Some(old) = self.graphics.named.get(&name.value) {
+                    let at = self.ctx.sources.position(old.loc);
+                    self.ctx.warn(name.loc, format!("named material \"{}\" redefined (first defined at {at})", name.value), "redefinition");
+                }
+                let spec = Rc::new(MaterialSpec::new(ty, Some(i), name.loc, self.graphics.textures.clone(), Some(name.value.clone())));
+                self.named_material_defs.push((name.value.clone(), spec.clone()));
+                Rc::make_mut(&mut self.graphics.named).insert(name.value.clone(), spec);
+            }
+            K::NamedMaterial => {
+                let Directive::Named(n) = &s.dir else { return };
+                match self.graphics.named.get(&n.value) {
+                    Some(spec) => self.graphics.material = spec.clone(),
+                    None => {
+                        let names: Vec<&str> = self.graphics.named.keys().map(String::as_str).collect();
+                        let help = closest_name(&n.value, &names).map(|c| format!("did you mean \"{c}\"?")).or_else(|| {
+                            Some(if names.is_empty() { "no named material is defined here (MakeNamedMaterial binds names in order, scoped by AttributeBegin/End)".into() } else { format!("defined here: {}", names.join(", ")) })
+                        });
+                        self.ctx.error(n.loc, format!("unknown named material \"{}\"", n.value), "not defined by MakeNamedMaterial before this line", help);
+                    }
+                }
+            }
+            K::Texture => {
+                let Directive::Texture { name, kind, class, params } = &s.dir else { return };
+                let spec = entities::texture(self.ctx, name, kind, class, params, &self.graphics.textures);
+                if let Some((is_float, spec)) = spec {
+                    let tex = Rc::make_mut(&mut self.graphics.textures);
+                    let map = if is_float { &mut tex.float } else { &mut tex.spectrum };
+                    if map.contains_key(&name.value) {
+                        self.ctx.warn(name.loc, format!("texture \"{}\" redefined", name.value), "redefinition");
+                    }
+                    map.insert(name.value.clone(), Rc::new(spec));
+                }
+            }
+            K::LightSource => {
+                let Directive::Entity { name, params } = &s.dir else { return };
+                if self.ctm[0] != self.ctm[1] {
+                    self.ctx.warn(s.loc, "animated light transform: the start transform is used", "this LightSource");
+                }
+                if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
+                    self.lights.push(l);
+                }
+                self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
+            }
+            K::AreaLightSource => {
+                let Directive::Entity { name, params } = &s.dir else { return };
+                match name.value.as_str() {
+                    "diffuse" | "area" => self.graphics.area_light = Some((i, name.loc)),
+                    other => {
+                        params.mark_all_used();
+                        self.ctx.warn(name.loc, format!("unknown area light \"{other}\" (pbrt-v3 has \"diffuse\", alias \"area\"): ignored, later shapes are not emissive"), "not an area light type");
+                        self.graphics.area_light = None;
+                    }
+                }
+            }
+            K::Shape => self.shape(i, s),
+            K::MakeNamedMedium | K::MediumInterface => {
+                if let Some(p) = s.params() {
+                    p.mark_all_used();
+                }
+                self.ctx.warn(s.loc, format!("`{}`: participating media are not supported by pbrs; ignored", s.kind.name()), "ignored");
+            }
+            K::Include => {}
+        }
+    }
+
+    fn push(&mut self, kind: FrameKind, loc: Loc) {
+        self.stack.push(Frame {
+            kind,
+            loc,
+            ctm: self.ctm,
+            active: self.active,
+            graphics: (kind != FrameKind::Transform).then(|| self.graphics.clone()),
+        });
+    }
+
+    /// Pops a frame of `kind`; a missing or mismatched frame is an error.
+    fn pop(&mut self, kind: FrameKind, s: &Stmt) -> bool {
+        let end = s.kind.name();
+        match self.stack.last() {
+            None => {
+                self.ctx.error(
+                    s.loc,
+                    format!("unbalanced {end}: there is no matching {}", kind.begin()),
+                    format!("no open {}", kind.begin()),
+                    None,
+                );
+                false
+            }
+            Some(f) if f.kind != kind => {
+                let at = self.ctx.sources.position(f.loc);
+                let open = f.kind.begin();
+                self.ctx.error(
+                    s.loc,
+                    format!("unbalanced {end}: the innermost open block is {open} at {at}"),
+                    format!("expected the end of {open}"),
+                    None,
+                );
+                false
+            }
+            Some(_) => {
+                let f = self.stack.pop().expect("checked");
+                self.ctm = f.ctm;
+                self.active = f.active;
+                if let Some(g) = f.graphics {
+                    self.graphics = g;
+                }
+                true
+            }
+        }
+    }
+
+    fn end_world(&mut self, loc: Loc) {
+        if let Some((name, def)) = self.current_object.take() {
+            self.ctx.warn(def.loc, format!("object \"{name}\" is not closed by ObjectEnd before the end of the world block; its definition is dropped"), "ObjectBegin without ObjectEnd");
+        }
+        for f in std::mem::take(&mut self.stack).iter().rev() {
+            self.ctx.warn(
+                f.loc,
+                format!(
+                    "{} is not closed before the end of the world block",
+                    f.kind.begin()
+                ),
+                "unclosed",
+            );
+        }
+        let _ = loc;
+        self.phase = Phase::After;
+        self.world_ended = true;
+    }
+
+    fn instance(&mut self, n: &Name) {
+        if let Some((outer, _)) = &self.current_object {
+            let outer = outer.clone();
+            self.ctx.error(n.loc, format!("ObjectInstance \"{}\" inside the definition of object \"{outer}\" (pbrt-v3 does not allow it)", n.value), "inside ObjectBegin", None);
+            return;
+        }
+        let Some(def) = self.objects.get_mut(&n.value) else {
+            let names: Vec<&str> = self.object_order.iter().map(String::as_str).collect();
+            let help = closest_name(&n.value, &names).map(|c| format!("did you mean \"{c}\"?"));
+            self.ctx.error(
+                n.loc,
+                format!("unknown object \"{}\"", n.value),
+                "not defined by ObjectBegin before this line",
+                help,
+            );
+            return;
+        };
+        let index = match def.built {
+            Some(i) => i,
+            None => {
+                let pending = std::mem::take(&mut def.shapes);
+                let mut shapes = Vec::new();
+                for p in &pending {
+                    shapes.extend(self.build_shape(p.stmt, p.ctm, &p.graphics, None));
+                }
+                self.scene_objects.push(ObjectDesc {
+                    name: n.value.clone(),
+                    shapes,
+                });
+                let i = self.scene_objects.len() - 1;
+                self.objects.get_mut(&n.value).expect("present").built = Some(i);
+                i
+            }
+        };
+        if self.ctm[0] != self.ctm[1] {
+            self.ctx.warn(
+                n.loc,
+                "animated instance transform: the start transform is used",
+                "this ObjectInstance",
+            );
+        }
+        self.instances.push(InstanceDesc {
+            object: index,
+            instance_to_world: self.ctm[0],
+        });
+    }
+
+    fn shape(&mut self, i: usize, s: &'s Stmt) {
+        if let Some((name, def)) = &mut self.current_object {
+            if let Some((_, aloc)) = self.graphics.area_light {
+                let name = name.clone();
+                let _ = aloc;
+                self.ctx.warn(s.loc, format!("area light inside the definition of object \"{name}\" is ignored (as pbrt-v3)"), "this shape is not emissive");
+            }
+            def.shapes.push(PendingShape {
+                stmt: i,
+                ctm: self.ctm[0],
+                graphics: self.graphics.clone(),
+            });
+            return;
+        }
+        if self.ctm[0] != self.ctm[1] {
+            self.ctx.warn(s.loc, "animated shape transform: motion blur is not supported; the start transform is used", "this Shape");
+        }
+        let graphics = self.graphics.clone();
+        let area = graphics.area_light.map(|(i, _)| i);
+        if let Some(shape) = self.build_shape(i, self.ctm[0], &graphics, area) {
+            self.shapes.push(shape);
+        }
+    }
+
+    fn build_shape(
+        &mut self,
+        i: usize,
+        ctm: DMat4,
+        g: &Graphics,
+        area: Option<usize>,
+    ) -> Option<ShapeDesc> {
+        let stmts = self.stmts;
+        let Directive::Entity { name, params } = &stmts[i].dir else {
+            return None;
+        };
+        let geometry = entities::geometry(self.ctx, name, params, &mut self.meshes);
+        let Some(geometry) = geometry else {
+            if matches!(name.value.as_str(), "sphere" | "trianglemesh" | "plymesh") {
+                // An error was reported.
+            } else {
+                self.unsupported_shapes += 1;
+            }
+            params.mark_all_used();
+            return None;
+        };
+        let material = self.material_for_shape(&g.material, params, &g.textures);
+        let area_light = area.map(|a| self.area_light(a));
+        self.ctx
+            .report_unused(params, &format!("Shape \"{}\"", name.value));
+        Some(ShapeDesc {
+            geometry,
+            object_to_world: ctm,
+            reverse_orientation: g.reverse,
+            material,
+            area_light,
+        })
+    }
+
+    fn area_light(&mut self, i: usize) -> AreaLightDesc {
+        if let Some(a) = self.area_lights.get(&i) {
+            return *a;
+        }
+        let stmts = self.stmts;
+        let Directive::Entity { name, params } = &stmts[i].dir else {
+            unreachable!("area light statement")
+        };
+        let a = entities::area_light(self.ctx, params);
+        self.ctx
+            .report_unused(params, &format!("AreaLightSource \"{}\"", name.value));
+        self.area_lights.insert(i, a);
+        a
+    }
+
+    fn material_for_shape(
+        &mut self,
+        spec: &Rc<MaterialSpec>,
+        shape_params: &crate::lang::params::ParamList,
+        textures: &Rc<Textures>,
+    ) -> MaterialId {
+        let stmts = self.stmts;
+        let mat_params = spec.stmt.and_then(|i| stmts[i].params());
+        let overrides = entities::shape_may_set_material_params(shape_params);
+        if !overrides {
+            if let Some(&id) = self.material_ids.get(&spec.stmt) {
+                return id;
+            }
+        }
+        let empty = crate::lang::params::ParamList::default();
+        let lookup = Lookup {
+            first: if overrides { Some(shape_params) } else { None },
+            second: mat_params.unwrap_or(&empty),
+            textures: if overrides { textures } else { &spec.textures },
+        };
+        let (desc, kind) = entities::material(self.ctx, spec, &lookup);
+        if self.reported_materials.insert(spec.stmt) {
+            if let Some(p) = mat_params {
+                self.ctx
+                    .report_unused_except(p, &format!("Material \"{}\"", spec.ty), &["type"]);
+            }
+        }
+        let key = format!("{desc:?}");
+        let id = match self.material_keys.get(&key) {
+            Some(&id) => id,
+            None => {
+                self.scene_materials.push(desc);
+                self.material_kinds.push(kind);
+                let id = MaterialId((self.scene_materials.len() - 1) as u32);
+                self.material_keys.insert(key, id);
+                id
+            }
+        };
+        if !overrides {
+            self.material_ids.insert(spec.stmt, id);
+        }
+        id
+    }
+
+    /// Builds the option entities and notes what was left out.
+    pub fn finish(
+        &mut self,
+    ) -> (
+        CameraDesc,
+        FilmDesc,
+        FilterDesc,
+        SamplerDesc,
+        IntegratorDesc,
+    ) {
+        let stmts = self.stmts;
+        let ent = |i: Option<usize>| {
+            i.and_then(|i| match &stmts[i].dir {
+                Directive::Entity { name, params } => Some((name, params)),
+                _ => None,
+            })
+        };
+        let camera = entities::camera(
+            self.ctx,
+            self.camera.and_then(|(i, m)| ent(Some(i)).map(|e| (e, m))),
+        );
+        let film = entities::film(self.ctx, ent(self.film));
+        let filter = entities::filter(self.ctx, ent(self.filter));
+        let sampler = entities::sampler(self.ctx, ent(self.sampler));
+        let integrator = entities::integrator(self.ctx, ent(self.integrator));
+        if let Some((name, params)) = ent(self.accelerator) {
+            params.mark_all_used();
+            self.skipped.push(format!(
+                "Accelerator \"{}\" at {}: ignored, pbrs always builds its own BVH",
+                name.value,
+                self.ctx.sources.position(name.loc)
+            ));
+        }
+        for name in &self.object_order {
+            let def = &self.objects[name];
+            if def.built.is_none() {
+                self.skipped.push(format!(
+                    "object \"{name}\" ({} shapes, defined at {}): never instanced, not built",
+                    def.shapes.len(),
+                    self.ctx.sources.position(def.loc)
+                ));
+            }
+        }
+        let mut seen = HashSet::new();
+        for (name, spec) in &self.named_material_defs {
+            let used = self.material_ids.contains_key(&spec.stmt)
+                || self.reported_materials.contains(&spec.stmt);
+            if !used && seen.insert(spec.stmt) {
+                self.skipped.push(format!("named material \"{name}\" ({}, defined at {}): not used by any shape, not built", spec.ty, self.ctx.sources.position(spec.loc)));
+            }
+        }
+        if self.unsupported_shapes > 0 {
+            self.skipped.push(format!(
+                "{} shapes of unsupported types (see the warnings)",
+                self.unsupported_shapes
+            ));
+        }
+        (camera, film, filter, sampler, integrator)
+    }
+}
+
+/// pbrt-v3 `LookAt`: the world-to-camera matrix, or `None` if degenerate.
+fn look_at(v: &[f64]) -> Option<DMat4> {
+    let pos = DVec3::new(v[0], v[1], v[2]);
+    let look = DVec3::new(v[3], v[4], v[5]);
+    let up = DVec3::new(v[6], v[7], v[8]);
+    let dir = (look - pos).normalize_or_zero();
+    let up = up.normalize_or_zero();
+    let right = up.cross(dir);
+    if dir == DVec3::ZERO || right.length() == 0.0 || !right.is_finite() {
+        return None;
+    }
+    let right = right.normalize();
+    let new_up = dir.cross(right);
+    let camera_to_world = DMat4::from_cols(
+        right.extend(0.0),
+        new_up.extend(0.0),
+        dir.extend(0.0),
+        DVec4::new(pos.x, pos.y, pos.z, 1.0),
+    );
+    Some(camera_to_world.inverse())
+}
+
+pub(crate) fn closest_name<'a>(word: &str, names: &[&'a str]) -> Option<&'a str> {
+    let d = |a: &str, b: &str| strsim(a, b);
+    names
+        .iter()
+        .map(|n| (*n, d(word, n)))
+        .filter(|&(n, dist)| dist <= (n.chars().count() / 3).max(2))
+        .min_by_key(|&(_, dist)| dist)
+        .map(|(n, _)| n)
+}
+
+fn strsim(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.to_lowercase().chars().take(128).collect();
+    let b: Vec<char> = b.to_lowercase().chars().take(128).collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for i in 1..=a.len() {
+        let mut cur = vec![i; b.len() + 1];
+        for j in 1..=b.len() {
+            cur[j] = (prev[j - 1] + usize::from(a[i - 1] != b[j - 1]))
+                .min(prev[j] + 1)
+                .min(cur[j - 1] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn look_at_matches_pbrt() {
+        // Looking down -z from +z: camera +z maps to world -z.
+        let w2c = look_at(&[0.0, 0.0, 5.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]).unwrap();
+        let c2w = w2c.inverse();
+        let fwd = c2w.transform_vector3(DVec3::Z);
+        assert!((fwd - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
+        // pbrt: right = cross(up, dir) = cross(y, -z) = -x.
+        let right = c2w.transform_vector3(DVec3::X);
+        assert!((right - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-12);
+        assert!(look_at(&[0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0]).is_none());
+    }
+}

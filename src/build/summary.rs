@@ -1,0 +1,198 @@
+//! The summary `pbrs --check` prints: options and counts by type.
+
+use crate::scene::*;
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// Counts of what a scene holds, for `--check` and tests.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Summary {
+    pub camera: String,
+    pub film: String,
+    pub filter: String,
+    pub sampler: String,
+    pub integrator: String,
+    /// Shapes placed directly in the world.
+    pub shapes: usize,
+    /// Shapes by geometry type (`trianglemesh`, `sphere`), world shapes only.
+    pub shapes_by_type: BTreeMap<&'static str, usize>,
+    /// Triangles of world shapes.
+    pub triangles: usize,
+    /// Shapes that emit (area lights), world shapes only.
+    pub area_lights: usize,
+    /// Lights other than area lights, by type.
+    pub lights_by_type: BTreeMap<&'static str, usize>,
+    /// Materials built (distinct), by type.
+    pub materials_by_type: BTreeMap<&'static str, usize>,
+    pub objects: usize,
+    pub object_shapes: usize,
+    pub object_triangles: usize,
+    pub instances: usize,
+    pub warnings: usize,
+}
+
+impl Summary {
+    pub fn of(
+        scene: &SceneDescription,
+        material_kinds: &[&'static str],
+        warnings: usize,
+    ) -> Summary {
+        let mut s = Summary {
+            warnings,
+            ..Default::default()
+        };
+        s.camera = match &scene.camera.kind {
+            CameraKind::Perspective {
+                fov, lens_radius, ..
+            } => {
+                if *lens_radius > 0.0 {
+                    format!("perspective, fov {fov}°, lens radius {lens_radius}")
+                } else {
+                    format!("perspective, fov {fov}°")
+                }
+            }
+        };
+        let f = &scene.film;
+        s.film = format!(
+            "{}×{}, \"{}\"",
+            f.xresolution,
+            f.yresolution,
+            f.filename.display()
+        );
+        if f.cropwindow != [0.0, 1.0, 0.0, 1.0] {
+            s.film += &format!(", crop {:?}", f.cropwindow);
+        }
+        s.filter = match scene.filter {
+            FilterDesc::Box { radius } => format!("box, radius {} {}", radius.x, radius.y),
+            FilterDesc::Gaussian { radius, alpha } => {
+                format!("gaussian, radius {} {}, alpha {alpha}", radius.x, radius.y)
+            }
+            FilterDesc::Triangle { radius } => {
+                format!("triangle, radius {} {}", radius.x, radius.y)
+            }
+            FilterDesc::Mitchell { radius, b, c } => {
+                format!("mitchell, radius {} {}, B {b}, C {c}", radius.x, radius.y)
+            }
+            FilterDesc::LanczosSinc { radius, tau } => {
+                format!("sinc, radius {} {}, tau {tau}", radius.x, radius.y)
+            }
+        };
+        let kind = match scene.sampler.kind {
+            SamplerKind::Halton => "halton".to_string(),
+            SamplerKind::Random => "random".into(),
+            SamplerKind::Sobol => "sobol".into(),
+            SamplerKind::Stratified {
+                jitter,
+                xsamples,
+                ysamples,
+            } => format!(
+                "stratified {xsamples}×{ysamples}{}",
+                if jitter { ", jittered" } else { "" }
+            ),
+            SamplerKind::ZeroTwoSequence => "02sequence".into(),
+            SamplerKind::MaxMinDist => "maxmindist".into(),
+        };
+        s.sampler = format!("{kind}, {} samples per pixel", scene.sampler.pixel_samples);
+        s.integrator = match scene.integrator {
+            IntegratorDesc::Path { max_depth, rr_threshold, light_sample_strategy } => {
+                format!("path, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}").to_lowercase()
+            }
+            IntegratorDesc::DirectLighting { max_depth, strategy } => format!("directlighting, maxdepth {max_depth}, strategy {strategy:?}").to_lowercase(),
+            IntegratorDesc::Whitted { max_depth } => format!("whitted, maxdepth {max_depth}"),
+        };
+        for sh in &scene.shapes {
+            s.shapes += 1;
+            *s.shapes_by_type
+                .entry(geometry_name(&sh.geometry))
+                .or_default() += 1;
+            s.triangles += triangles(&sh.geometry);
+            s.area_lights += usize::from(sh.area_light.is_some());
+        }
+        for l in &scene.lights {
+            let k = match l {
+                LightDesc::Point { .. } => "point",
+                LightDesc::Spot { .. } => "spot",
+                LightDesc::Distant { .. } => "distant",
+                LightDesc::Infinite { .. } => "infinite",
+            };
+            *s.lights_by_type.entry(k).or_default() += 1;
+        }
+        for k in material_kinds {
+            *s.materials_by_type.entry(k).or_default() += 1;
+        }
+        s.objects = scene.objects.len();
+        for o in &scene.objects {
+            s.object_shapes += o.shapes.len();
+            s.object_triangles += o
+                .shapes
+                .iter()
+                .map(|sh| triangles(&sh.geometry))
+                .sum::<usize>();
+        }
+        s.instances = scene.instances.len();
+        s
+    }
+}
+
+fn geometry_name(g: &Geometry) -> &'static str {
+    match g {
+        Geometry::TriangleMesh(_) => "trianglemesh",
+        Geometry::Sphere { .. } => "sphere",
+    }
+}
+
+fn triangles(g: &Geometry) -> usize {
+    match g {
+        Geometry::TriangleMesh(m) => m.triangle_count(),
+        Geometry::Sphere { .. } => 0,
+    }
+}
+
+fn by_type(m: &BTreeMap<&'static str, usize>) -> String {
+    if m.is_empty() {
+        return "none".into();
+    }
+    m.iter()
+        .map(|(k, v)| format!("{v} {k}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+impl fmt::Display for Summary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "camera:     {}", self.camera)?;
+        writeln!(f, "film:       {}", self.film)?;
+        writeln!(f, "filter:     {}", self.filter)?;
+        writeln!(f, "sampler:    {}", self.sampler)?;
+        writeln!(f, "integrator: {}", self.integrator)?;
+        writeln!(
+            f,
+            "shapes:     {} ({})",
+            self.shapes,
+            by_type(&self.shapes_by_type)
+        )?;
+        writeln!(f, "triangles:  {}", self.triangles)?;
+        let lights: usize = self.lights_by_type.values().sum();
+        writeln!(
+            f,
+            "lights:     {} ({} area-light shapes; {})",
+            lights + self.area_lights,
+            self.area_lights,
+            by_type(&self.lights_by_type)
+        )?;
+        writeln!(
+            f,
+            "materials:  {} ({})",
+            self.materials_by_type.values().sum::<usize>(),
+            by_type(&self.materials_by_type)
+        )?;
+        if self.objects > 0 || self.instances > 0 {
+            writeln!(
+                f,
+                "objects:    {} ({} shapes, {} triangles), {} instances",
+                self.objects, self.object_shapes, self.object_triangles, self.instances
+            )?;
+        }
+        write!(f, "warnings:   {}", self.warnings)
+    }
+}
