@@ -1,0 +1,94 @@
+//! Shared helpers for render tests: render a scene small, load references,
+//! compare with noise-aware metrics, and leave images to look at on failure.
+#![allow(dead_code)]
+
+use pbrs::build::load_scene;
+use pbrs::render::driver::{render, RenderOptions, RenderStats};
+use pbrs::render::film::compare::{compare, false_colour_difference, Comparison};
+use pbrs::render::film::io::{read_image, write_image};
+use pbrs::render::film::Image;
+use pbrs::scene::SceneDescription;
+use std::path::{Path, PathBuf};
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Loads a scene of the repository (path relative to the repository root).
+pub fn load(rel: &str) -> SceneDescription {
+    let path = repo().join(rel);
+    match load_scene(&path) {
+        Ok(l) => l.scene,
+        Err(f) => panic!("{rel} failed to load: {:?}", f.errors),
+    }
+}
+
+/// Renders a description at `res`×`res` with `spp` samples per pixel.
+pub fn render_at(mut desc: SceneDescription, res: u32, spp: u32, threads: Option<usize>) -> (Image, RenderStats) {
+    desc.film.xresolution = res;
+    desc.film.yresolution = res;
+    desc.sampler.pixel_samples = spp;
+    render(&desc, &RenderOptions { threads, seed: 0 }, &|_, _| {}).expect("render failed")
+}
+
+/// A converged pbrt-v3 reference from `scenes/references/`.
+pub fn reference(stem: &str) -> Image {
+    read_image(&repo().join("scenes/references").join(format!("{stem}-128-16384.pfm"))).expect("reference")
+}
+
+/// pbrt-v3's own render at 64 spp (the noise to expect).
+pub fn pbrt_64(stem: &str) -> Image {
+    read_image(&repo().join("scenes/references").join(format!("{stem}-128-64.pfm"))).expect("pbrt-v3 64 spp")
+}
+
+/// Acceptance bounds for a render compared with a converged reference.
+#[derive(Clone, Copy, Debug)]
+pub struct Bounds {
+    pub max_relative_mse: f64,
+    pub max_block_error: f64,
+    /// Largest relative difference of the per-channel image means.
+    pub max_mean_difference: f64,
+}
+
+impl Bounds {
+    /// The render-core criteria: relative MSE within 1.5× and block error
+    /// within 2× of pbrt-v3's own at equal spp, mean within 1%.
+    pub fn against_pbrt(stem: &str) -> Bounds {
+        let c = compare(&pbrt_64(stem), &reference(stem));
+        Bounds { max_relative_mse: 1.5 * c.relative_mse, max_block_error: 2.0 * c.block_error, max_mean_difference: 0.01 }
+    }
+}
+
+/// Directory for images of failing comparisons.
+pub fn output_dir(name: &str) -> PathBuf {
+    let d = repo().join("target").join("test-output").join(name);
+    let _ = std::fs::create_dir_all(&d);
+    d
+}
+
+/// Compares and asserts; on failure writes render, reference and a
+/// false-colour difference image next to the test output.
+pub fn assert_matches(name: &str, img: &Image, reference: &Image, b: Bounds) -> Comparison {
+    let c = compare(img, reference);
+    let mean_diff = (0..3)
+        .map(|i| ((c.mean_a[i] - c.mean_r[i]) / c.mean_r[i].abs().max(1e-6)).abs())
+        .fold(0.0f64, f64::max);
+    eprintln!(
+        "{name}: relative MSE {:.5} (max {:.5}), block error {:.5} (max {:.5}), mean difference {:.4} (max {:.4}); means {:?} vs {:?}",
+        c.relative_mse, b.max_relative_mse, c.block_error, b.max_block_error, mean_diff, b.max_mean_difference, c.mean_a, c.mean_r
+    );
+    let ok = c.relative_mse <= b.max_relative_mse && c.block_error <= b.max_block_error && mean_diff <= b.max_mean_difference;
+    if !ok {
+        let d = output_dir(name);
+        let _ = write_image(&d.join("render.exr"), img);
+        let _ = write_image(&d.join("render.png"), img);
+        let _ = write_image(&d.join("reference.png"), reference);
+        let _ = write_image(&d.join("difference.png"), &false_colour_difference(img, reference));
+        panic!("{name} does not match its reference (images in {})", d.display());
+    }
+    c
+}
+
+pub fn exists(p: &Path) -> bool {
+    p.exists()
+}
