@@ -30,6 +30,16 @@ fn sanitise(v: f32) -> f32 {
     }
 }
 
+/// `u` clamped to `[0, 1)`; NaN becomes 0.
+#[inline]
+fn sanitise_u(u: f32) -> f32 {
+    if u >= 0.0 {
+        u.min(ONE_MINUS_EPSILON)
+    } else {
+        0.0
+    }
+}
+
 /// Index of the last `i` in `[0, cdf.len() - 2]` with `cdf[i] <= u`
 /// (pbrt's `FindInterval`).
 #[inline]
@@ -116,6 +126,7 @@ impl Distribution1D {
     /// Samples `x` in `[0,1)`; returns `(x, pdf(x), bin index)`.
     #[inline]
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let u = sanitise_u(u);
         let offset = find_interval(&self.cdf, u);
         let c0 = self.cdf[offset];
         let width = self.cdf[offset + 1] - c0;
@@ -131,6 +142,7 @@ impl Distribution1D {
     /// Samples a bin; returns `(index, probability, u remapped to [0,1))`.
     #[inline]
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let u = sanitise_u(u);
         let offset = find_interval(&self.cdf, u);
         let c0 = self.cdf[offset];
         let width = self.cdf[offset + 1] - c0;
