@@ -11,11 +11,11 @@ use glam::Vec2;
 pub struct Distribution1D {
     /// Sanitised function values (finite, >= 0).
     func: Vec<f32>,
-    /// Density per bin over [0,1] (integrates to 1).
+    /// Density per bin over `[0, 1]` (integrates to 1).
     pdf: Vec<f32>,
     /// `count + 1` entries, `cdf[0] == 0`, `cdf[count] == 1`.
     cdf: Vec<f32>,
-    /// Integral of the (sanitised) function over [0,1]: `Σ f / n`.
+    /// Integral of the (sanitised) function over `[0, 1]`: `Σ f / n`.
     func_int: f32,
 }
 
@@ -110,7 +110,7 @@ impl Distribution1D {
         self.func.len()
     }
 
-    /// Integral of the function over [0,1] (0 for an all-zero function, which
+    /// Integral of the function over `[0, 1]` (0 for an all-zero function, which
     /// is nevertheless sampled uniformly).
     #[inline]
     pub fn func_int(&self) -> f32 {
