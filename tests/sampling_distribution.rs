@@ -165,6 +165,17 @@ fn degenerate_inputs() {
         assert!(!(1.0 / 3.0..2.0 / 3.0).contains(&p.y));
         assert!(pdf > 0.0 && pdf == d.pdf(p));
     }
+    // Out-of-range and NaN u are clamped, never panic or loop.
+    let d = Distribution1D::new(&[1.0, 0.0, 3.0]);
+    for u in [f32::NAN, -1.0, 1.0, 2.0, f32::INFINITY] {
+        let (x, pdf, _) = d.sample_continuous(u);
+        assert!(
+            (0.0..1.0).contains(&x) && pdf > 0.0 && pdf == d.pdf(x),
+            "u={u}"
+        );
+        let (i, p, ur) = d.sample_discrete(u);
+        assert!(i != 1 && p > 0.0 && (0.0..1.0).contains(&ur));
+    }
     // Single bin 2D.
     let d = Distribution2D::new(&[4.0], 1, 1);
     assert_eq!(

@@ -328,3 +328,32 @@ fn halton_skips_array_dimensions() {
     };
     assert_eq!(h.dimension(), 9);
 }
+
+/// Throughput of the per-sample path (run with `--ignored --nocapture`).
+#[test]
+#[ignore]
+fn bench_samplers() {
+    for kind in KINDS {
+        let mut s = Sampler::new(&desc(kind, 64), bounds(512, 512), 0);
+        let t = std::time::Instant::now();
+        let mut acc = 0.0f32;
+        let mut n = 0u64;
+        for p in bounds(512, 512).iter().take(20_000) {
+            for i in 0..64 {
+                s.start_pixel_sample(p, i);
+                let cs = s.get_camera_sample(p);
+                acc += cs.p_film.x + cs.time;
+                for _ in 0..10 {
+                    acc += s.get_1d();
+                    acc += s.get_2d().x;
+                }
+                n += 1;
+            }
+        }
+        let dt = t.elapsed().as_secs_f64();
+        println!(
+            "{kind:?}: {:.1} ns per sample (25 dims), checksum {acc}",
+            dt * 1e9 / n as f64
+        );
+    }
+}

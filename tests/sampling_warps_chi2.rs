@@ -216,6 +216,9 @@ fn rejects_cosine_sampling_with_uniform_pdf() {
         &cfg(10),
     );
     println!("wrong pdf: {r}");
+    let (obs, exp) = r.histogram_images();
+    assert_eq!((obs.width, obs.height, exp.width), (20, 10, 20));
+    assert_eq!(obs.data.iter().sum::<f32>() / 3.0, 1_000_000.0);
     assert!(!r.passed(0.01), "{r}");
     assert!(r.p_value < 1e-12);
 }

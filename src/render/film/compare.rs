@@ -157,6 +157,12 @@ pub fn false_colour_difference(a: &Image, r: &Image) -> Image {
     false_colour_difference_scaled(a, r, 0.5)
 }
 
+/// Writes the false-colour difference of `a` against `r` (e.g. as a PNG next
+/// to a failing test's output).
+pub fn write_false_colour(path: &std::path::Path, a: &Image, r: &Image) -> Result<(), String> {
+    super::io::write_image(path, &false_colour_difference(a, r))
+}
+
 fn ramp(t: f32) -> Vec3 {
     const STOPS: [Vec3; 6] = [
         Vec3::new(0.0, 0.0, 0.0),

@@ -24,6 +24,8 @@ pub struct HaltonSampler {
     seed_hash: u64,
     sample_at_pixel_center: bool,
     base_scales: [u64; 2],
+    /// `base_scales[1]` for fast division.
+    scale1: DigitBase,
     base_exponents: [u32; 2],
     sample_stride: u64,
     mult_inverse: [u64; 2],
@@ -64,6 +66,7 @@ impl HaltonSampler {
             seed_hash: mix64(seed ^ 0x4a61_6c74_6f6e_5f68),
             sample_at_pixel_center,
             base_scales,
+            scale1: DigitBase::new(base_scales[1] as u32),
             base_exponents,
             sample_stride,
             mult_inverse,
@@ -132,7 +135,7 @@ impl HaltonSampler {
         }
         match dim {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
-            1 => radical_inverse(&BASE3, index / self.base_scales[1]),
+            1 => radical_inverse(&BASE3, self.scale1.div(index)),
             d if (d as usize) < PRIME_TABLE_SIZE => {
                 let (b, perm) = self.tables.dimension(d as usize);
                 scrambled_radical_inverse(b, perm, index)

@@ -17,6 +17,7 @@
 //! ```
 
 use super::rng::Pcg32;
+use crate::render::film::Image;
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 use std::fmt;
@@ -68,10 +69,24 @@ pub struct Chi2Result {
     /// Observed and expected counts per cell, row-major (θ outer, φ inner).
     pub observed: Vec<f64>,
     pub expected: Vec<f64>,
+    /// Grid shape: `rows` (θ or x) × `cols` (φ or y).
+    pub rows: usize,
+    pub cols: usize,
     pub sample_count: usize,
 }
 
 impl Chi2Result {
+    /// Observed and expected counts as grey images (`cols` wide, `rows`
+    /// high), to write out with `film::io::write_image` when a test fails.
+    pub fn histogram_images(&self) -> (Image, Image) {
+        let to_image = |v: &[f64]| Image {
+            width: self.cols as u32,
+            height: self.rows as u32,
+            data: v.iter().flat_map(|&c| [c as f32; 3]).collect(),
+        };
+        (to_image(&self.observed), to_image(&self.expected))
+    }
+
     /// True if the test does not reject the pdf at `significance`.
     pub fn passed(&self, significance: f64) -> bool {
         self.invalid_samples == 0
@@ -153,7 +168,7 @@ pub fn chi2_sphere(
             expected[it * np + ip] = integrate_2d(&f, t0, t1, p0, p1);
         }
     }
-    finish(observed, expected, invalid, rejected, cfg)
+    finish(observed, expected, invalid, rejected, (nt, np), cfg)
 }
 
 /// Chi-square test of a sampler of points in `[0,1]^2` against its area
@@ -194,7 +209,7 @@ pub fn chi2_square(
             expected[ix * ny + iy] = integrate_2d(&f, x0, x1, y0, y1);
         }
     }
-    finish(observed, expected, invalid, rejected, cfg)
+    finish(observed, expected, invalid, rejected, (nx, ny), cfg)
 }
 
 fn finish(
@@ -202,6 +217,7 @@ fn finish(
     mut expected: Vec<f64>,
     invalid: usize,
     rejected: usize,
+    (rows, cols): (usize, usize),
     cfg: &Chi2Config,
 ) -> Chi2Result {
     let pdf_integral: f64 = expected.iter().sum();
@@ -247,6 +263,8 @@ fn finish(
         unexpected_samples: unexpected,
         observed,
         expected,
+        rows,
+        cols,
         sample_count: cfg.sample_count,
     }
 }

@@ -11,11 +11,11 @@ use glam::Vec2;
 pub struct Distribution1D {
     /// Sanitised function values (finite, >= 0).
     func: Vec<f32>,
-    /// Density per bin over [0,1] (integrates to 1).
+    /// Density per bin over `[0, 1]` (integrates to 1).
     pdf: Vec<f32>,
     /// `count + 1` entries, `cdf[0] == 0`, `cdf[count] == 1`.
     cdf: Vec<f32>,
-    /// Integral of the (sanitised) function over [0,1]: `Σ f / n`.
+    /// Integral of the (sanitised) function over `[0, 1]`: `Σ f / n`.
     func_int: f32,
 }
 
@@ -25,6 +25,16 @@ fn sanitise(v: f32) -> f32 {
         v
     } else if v == f32::INFINITY {
         f32::MAX
+    } else {
+        0.0
+    }
+}
+
+/// `u` clamped to `[0, 1)`; NaN becomes 0.
+#[inline]
+fn sanitise_u(u: f32) -> f32 {
+    if u >= 0.0 {
+        u.min(ONE_MINUS_EPSILON)
     } else {
         0.0
     }
@@ -100,7 +110,7 @@ impl Distribution1D {
         self.func.len()
     }
 
-    /// Integral of the function over [0,1] (0 for an all-zero function, which
+    /// Integral of the function over `[0, 1]` (0 for an all-zero function, which
     /// is nevertheless sampled uniformly).
     #[inline]
     pub fn func_int(&self) -> f32 {
@@ -116,6 +126,7 @@ impl Distribution1D {
     /// Samples `x` in `[0,1)`; returns `(x, pdf(x), bin index)`.
     #[inline]
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let u = sanitise_u(u);
         let offset = find_interval(&self.cdf, u);
         let c0 = self.cdf[offset];
         let width = self.cdf[offset + 1] - c0;
@@ -131,6 +142,7 @@ impl Distribution1D {
     /// Samples a bin; returns `(index, probability, u remapped to [0,1))`.
     #[inline]
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let u = sanitise_u(u);
         let offset = find_interval(&self.cdf, u);
         let c0 = self.cdf[offset];
         let width = self.cdf[offset + 1] - c0;
