@@ -22,7 +22,10 @@ pub fn run(args: &Args) -> i32 {
         Err(f) => {
             print_diagnostics(&f.warnings);
             print_diagnostics(&f.errors);
-            eprintln!("{}: the scene was not loaded; no image was written", args.scene.display());
+            eprintln!(
+                "{}: the scene was not loaded; no image was written",
+                args.scene.display()
+            );
             return 1;
         }
     };
@@ -37,7 +40,10 @@ pub fn run(args: &Args) -> i32 {
         desc.sampler.pixel_samples = spp;
     }
     if let Some(c) = &args.cropwindow {
-        let ok = c.len() == 4 && c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) && c[0] < c[1] && c[2] < c[3];
+        let ok = c.len() == 4
+            && c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v))
+            && c[0] < c[1]
+            && c[2] < c[3];
         if !ok {
             return fail("--cropwindow takes X0 X1 Y0 Y1 in [0, 1] with X0 < X1 and Y0 < Y1");
         }
@@ -66,7 +72,10 @@ pub fn run(args: &Args) -> i32 {
     } else {
         ProgressBar::hidden()
     };
-    let opts = RenderOptions { threads: args.threads, seed: args.seed };
+    let opts = RenderOptions {
+        threads: args.threads,
+        seed: args.seed,
+    };
     let progress = |done: usize, total: usize| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
@@ -80,7 +89,9 @@ pub fn run(args: &Args) -> i32 {
         return fail(format!("cannot write {}: {e}", out.display()));
     }
     if !args.quiet {
-        let mem = peak_memory_bytes().map_or("unknown".to_string(), |b| format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0)));
+        let mem = peak_memory_bytes().map_or("unknown".to_string(), |b| {
+            format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0))
+        });
         eprintln!(
             "{}: {}x{} px, {} spp, {} threads; build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
             out.display(),
@@ -103,7 +114,12 @@ pub fn run(args: &Args) -> i32 {
     }
     if args.stats {
         eprintln!("statistics:");
-        for n in desc.skipped.iter().map(|s| format!("left out: {s}")).chain(stats.notes.iter().cloned()) {
+        for n in desc
+            .skipped
+            .iter()
+            .map(|s| format!("left out: {s}"))
+            .chain(stats.notes.iter().cloned())
+        {
             eprintln!("  {n}");
         }
         eprintln!("  samples: {}", stats.samples);

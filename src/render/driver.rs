@@ -57,7 +57,11 @@ struct TileCounts {
 /// Renders `desc` (with its film, sampler and integrator settings as given:
 /// apply command-line overrides to the description first). `progress` is
 /// called after each tile with (tiles done, tiles total).
-pub fn render(desc: &SceneDescription, opts: &RenderOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<(Image, RenderStats), String> {
+pub fn render(
+    desc: &SceneDescription,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(Image, RenderStats), String> {
     let t0 = Instant::now();
     let scene = RenderScene::new(desc);
     let mut integrator = Integrator::new(&desc.integrator, &scene);
@@ -104,7 +108,8 @@ pub fn render(desc: &SceneDescription, opts: &RenderOptions, progress: &(dyn Fn(
             ls.kind(),
             ls.active_count(),
             match ls.kind() {
-                crate::render::lights::LightSamplerKind::Spatial => format!(", {} voxel distributions built", ls.voxels_built()),
+                crate::render::lights::LightSamplerKind::Spatial =>
+                    format!(", {} voxel distributions built", ls.voxels_built()),
                 _ => String::new(),
             }
         ));
@@ -123,7 +128,13 @@ pub fn render(desc: &SceneDescription, opts: &RenderOptions, progress: &(dyn Fn(
     Ok((film.image(), stats))
 }
 
-fn render_tile(scene: &RenderScene, integrator: &Integrator, film: &Film, proto: &Sampler, bounds: Bounds2i) -> (FilmTile, TileCounts) {
+fn render_tile(
+    scene: &RenderScene,
+    integrator: &Integrator,
+    film: &Film,
+    proto: &Sampler,
+    bounds: Bounds2i,
+) -> (FilmTile, TileCounts) {
     let mut tile = film.tile(bounds);
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();

@@ -31,7 +31,11 @@ impl RenderScene {
         let mut notes = Vec::new();
 
         let mut add_shape = |s: &ShapeDesc, to_world: DMat4, lights_allowed: bool| {
-            let emit = if lights_allowed { s.area_light.filter(|a| a.l.max_element() > 0.0) } else { None };
+            let emit = if lights_allowed {
+                s.area_light.filter(|a| a.l.max_element() > 0.0)
+            } else {
+                None
+            };
             match &s.geometry {
                 scene::Geometry::TriangleMesh(m) => {
                     let mesh_index = meshes.len() as u32;
@@ -39,13 +43,32 @@ impl RenderScene {
                     if let Some(a) = emit {
                         tm.first_light = Some(area.len() as u32);
                         for tri in 0..tm.triangle_count() {
-                            area.push((AreaShape::Triangle { mesh: mesh_index, tri }, a));
+                            area.push((
+                                AreaShape::Triangle {
+                                    mesh: mesh_index,
+                                    tri,
+                                },
+                                a,
+                            ));
                         }
                     }
                     meshes.push(tm);
                 }
-                &scene::Geometry::Sphere { radius, z_min, z_max, phi_max } => {
-                    let mut sp = Sphere::new(radius, z_min, z_max, phi_max, to_world, s.reverse_orientation, s.material.0);
+                &scene::Geometry::Sphere {
+                    radius,
+                    z_min,
+                    z_max,
+                    phi_max,
+                } => {
+                    let mut sp = Sphere::new(
+                        radius,
+                        z_min,
+                        z_max,
+                        phi_max,
+                        to_world,
+                        s.reverse_orientation,
+                        s.material.0,
+                    );
                     if let Some(a) = emit {
                         sp.light = Some(area.len() as u32);
                         area.push((AreaShape::Sphere(spheres.len() as u32), a));
@@ -65,10 +88,17 @@ impl RenderScene {
                 }
             }
         }
-        let emissive_shapes = desc.shapes.iter().filter(|s| s.area_light.is_some()).count();
+        let emissive_shapes = desc
+            .shapes
+            .iter()
+            .filter(|s| s.area_light.is_some())
+            .count();
         let geometry = Geometry::new(meshes, spheres);
         if geometry.degenerate_triangles > 0 {
-            notes.push(format!("{} zero-area triangles left out of the BVH", geometry.degenerate_triangles));
+            notes.push(format!(
+                "{} zero-area triangles left out of the BVH",
+                geometry.degenerate_triangles
+            ));
         }
         if !geometry.has_bvh() {
             notes.push("no geometry: no BVH built".into());
@@ -82,26 +112,65 @@ impl RenderScene {
                     AreaShape::Triangle { mesh, tri } => geometry.meshes[mesh as usize].area(tri),
                     AreaShape::Sphere(i) => geometry.spheres[i as usize].area(),
                 };
-                Light::Area { shape, l: a.l, two_sided: a.two_sided, n_samples: a.n_samples.max(1), area }
+                Light::Area {
+                    shape,
+                    l: a.l,
+                    two_sided: a.two_sided,
+                    n_samples: a.n_samples.max(1),
+                    area,
+                }
             })
             .collect();
         let mut infinite_lights = Vec::new();
         for l in &desc.lights {
             let light = match *l {
-                LightDesc::Point { position, intensity } => Light::Point { p: position.as_vec3(), intensity },
-                LightDesc::Spot { light_to_world, intensity, cone_angle, cone_delta_angle } => {
+                LightDesc::Point {
+                    position,
+                    intensity,
+                } => Light::Point {
+                    p: position.as_vec3(),
+                    intensity,
+                },
+                LightDesc::Spot {
+                    light_to_world,
+                    intensity,
+                    cone_angle,
+                    cone_delta_angle,
+                } => {
                     let p = light_to_world.transform_point3(DVec3::ZERO).as_vec3();
-                    let dir = light_to_world.transform_vector3(DVec3::Z).normalize().as_vec3();
+                    let dir = light_to_world
+                        .transform_vector3(DVec3::Z)
+                        .normalize()
+                        .as_vec3();
                     let cos_total = cone_angle.to_radians().cos();
                     let cos_falloff_start = (cone_angle - cone_delta_angle).to_radians().cos();
-                    Light::Spot { p, frame: Frame::from_normal(dir), intensity, cos_total, cos_falloff_start }
+                    Light::Spot {
+                        p,
+                        frame: Frame::from_normal(dir),
+                        intensity,
+                        cos_total,
+                        cos_falloff_start,
+                    }
                 }
-                LightDesc::Distant { radiance, direction } => {
-                    Light::Distant { w: direction.normalize().as_vec3(), l: radiance, scene_radius }
-                }
-                LightDesc::Infinite { radiance, n_samples, .. } => {
+                LightDesc::Distant {
+                    radiance,
+                    direction,
+                } => Light::Distant {
+                    w: direction.normalize().as_vec3(),
+                    l: radiance,
+                    scene_radius,
+                },
+                LightDesc::Infinite {
+                    radiance,
+                    n_samples,
+                    ..
+                } => {
                     infinite_lights.push(lights.len() as u32);
-                    Light::Infinite { l: radiance, n_samples, scene_radius }
+                    Light::Infinite {
+                        l: radiance,
+                        n_samples,
+                        scene_radius,
+                    }
                 }
             };
             lights.push(light);
@@ -122,17 +191,32 @@ impl RenderScene {
             emissive_shapes
         ));
         let camera = Camera::new(&desc.camera, desc.film.xresolution, desc.film.yresolution);
-        RenderScene { geometry, materials, lights, infinite_lights, camera, notes }
+        RenderScene {
+            geometry,
+            materials,
+            lights,
+            infinite_lights,
+            camera,
+            notes,
+        }
     }
 }
 
 /// Transform an object-space mesh to world space (positions in f64 before
 /// rounding; normals by the inverse transpose).
 fn world_mesh(m: &scene::MeshData, to_world: DMat4, reverse: bool, material: u32) -> TriangleMesh {
-    let p = m.positions.iter().map(|v| to_world.transform_point3(v.as_dvec3()).as_vec3()).collect();
+    let p = m
+        .positions
+        .iter()
+        .map(|v| to_world.transform_point3(v.as_dvec3()).as_vec3())
+        .collect();
     let lin = DMat3::from_mat4(to_world);
     let nm = lin.inverse().transpose();
-    let n = m.normals.as_ref().map(|ns| ns.iter().map(|v| (nm * v.as_dvec3()).as_vec3()).collect::<Vec<Vec3>>());
+    let n = m.normals.as_ref().map(|ns| {
+        ns.iter()
+            .map(|v| (nm * v.as_dvec3()).as_vec3())
+            .collect::<Vec<Vec3>>()
+    });
     TriangleMesh {
         p,
         n,

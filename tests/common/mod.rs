@@ -24,7 +24,12 @@ pub fn load(rel: &str) -> SceneDescription {
 }
 
 /// Renders a description at `res`×`res` with `spp` samples per pixel.
-pub fn render_at(mut desc: SceneDescription, res: u32, spp: u32, threads: Option<usize>) -> (Image, RenderStats) {
+pub fn render_at(
+    mut desc: SceneDescription,
+    res: u32,
+    spp: u32,
+    threads: Option<usize>,
+) -> (Image, RenderStats) {
     desc.film.xresolution = res;
     desc.film.yresolution = res;
     desc.sampler.pixel_samples = spp;
@@ -33,12 +38,22 @@ pub fn render_at(mut desc: SceneDescription, res: u32, spp: u32, threads: Option
 
 /// A converged pbrt-v3 reference from `scenes/references/`.
 pub fn reference(stem: &str) -> Image {
-    read_image(&repo().join("scenes/references").join(format!("{stem}-128-16384.pfm"))).expect("reference")
+    read_image(
+        &repo()
+            .join("scenes/references")
+            .join(format!("{stem}-128-16384.pfm")),
+    )
+    .expect("reference")
 }
 
 /// pbrt-v3's own render at 64 spp (the noise to expect).
 pub fn pbrt_64(stem: &str) -> Image {
-    read_image(&repo().join("scenes/references").join(format!("{stem}-128-64.pfm"))).expect("pbrt-v3 64 spp")
+    read_image(
+        &repo()
+            .join("scenes/references")
+            .join(format!("{stem}-128-64.pfm")),
+    )
+    .expect("pbrt-v3 64 spp")
 }
 
 /// Acceptance bounds for a render compared with a converged reference.
@@ -55,7 +70,11 @@ impl Bounds {
     /// within 2× of pbrt-v3's own at equal spp, mean within 1%.
     pub fn against_pbrt(stem: &str) -> Bounds {
         let c = compare(&pbrt_64(stem), &reference(stem));
-        Bounds { max_relative_mse: 1.5 * c.relative_mse, max_block_error: 2.0 * c.block_error, max_mean_difference: 0.01 }
+        Bounds {
+            max_relative_mse: 1.5 * c.relative_mse,
+            max_block_error: 2.0 * c.block_error,
+            max_mean_difference: 0.01,
+        }
     }
 }
 
@@ -77,14 +96,22 @@ pub fn assert_matches(name: &str, img: &Image, reference: &Image, b: Bounds) -> 
         "{name}: relative MSE {:.5} (max {:.5}), block error {:.5} (max {:.5}), mean difference {:.4} (max {:.4}); means {:?} vs {:?}",
         c.relative_mse, b.max_relative_mse, c.block_error, b.max_block_error, mean_diff, b.max_mean_difference, c.mean_a, c.mean_r
     );
-    let ok = c.relative_mse <= b.max_relative_mse && c.block_error <= b.max_block_error && mean_diff <= b.max_mean_difference;
+    let ok = c.relative_mse <= b.max_relative_mse
+        && c.block_error <= b.max_block_error
+        && mean_diff <= b.max_mean_difference;
     if !ok {
         let d = output_dir(name);
         let _ = write_image(&d.join("render.exr"), img);
         let _ = write_image(&d.join("render.png"), img);
         let _ = write_image(&d.join("reference.png"), reference);
-        let _ = write_image(&d.join("difference.png"), &false_colour_difference(img, reference));
-        panic!("{name} does not match its reference (images in {})", d.display());
+        let _ = write_image(
+            &d.join("difference.png"),
+            &false_colour_difference(img, reference),
+        );
+        panic!(
+            "{name} does not match its reference (images in {})",
+            d.display()
+        );
     }
     c
 }

@@ -25,7 +25,10 @@ impl PrimRef {
         Self { mesh, index: tri }
     }
     pub fn sphere(i: u32) -> Self {
-        Self { mesh: SPHERE_TAG, index: i }
+        Self {
+            mesh: SPHERE_TAG,
+            index: i,
+        }
     }
 }
 
@@ -60,23 +63,46 @@ pub struct Geometry {
     prims: Vec<PrimRef>,
     bvh: Option<CwBvh>,
     pub bounds: Bounds3,
+    /// Length of ray directions as obvhs sees them (see `to_obvhs_ray`).
+    ray_length: f32,
     /// Triangles left out because they have zero area.
     pub degenerate_triangles: u64,
     pub build_time: Duration,
 }
 
+/// obvhs's node test clamps the entry distance to an absolute 1e-4 (its
+/// `EPSILON`), which would cull real hits closer than that in small scenes.
+/// So obvhs gets the ray with its direction scaled by an exact power of two
+/// `k` chosen so that |d|·k is 1e-12 of the scene's size: obvhs's parameter is
+/// t' = t / k, every hit farther than ~1e-16 of the scene's size has t' > 1e-4,
+/// and nothing overflows for any scene scale.
 #[inline]
-fn to_obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
-    // Finite reciprocals (no inf·0 = NaN in the slab tests), large enough
-    // that near-parallel rays are never culled short.
-    let inv = |x: f32| if x.abs() < 1e-30 { 1e30f32.copysign(x) } else { 1.0 / x };
-    obvhs::ray::Ray {
+fn to_obvhs_ray(ray: &Ray, target_len: f32) -> (obvhs::ray::Ray, f32) {
+    let len = ray.d.length();
+    let want = target_len / len;
+    // Round to a power of two (keep only sign and exponent bits): exact scaling.
+    let k = if want.is_finite() && want > 0.0 {
+        f32::from_bits(want.to_bits() & 0x7f80_0000).max(f32::MIN_POSITIVE)
+    } else {
+        1.0
+    };
+    let d = ray.d * k;
+    // Finite reciprocals (no inf·0 = NaN in the slab tests).
+    let inv = |x: f32| {
+        if x.abs() < 1e-30 {
+            1e30f32.copysign(x)
+        } else {
+            1.0 / x
+        }
+    };
+    let r = obvhs::ray::Ray {
         origin: Vec3A::from(ray.o),
-        direction: Vec3A::from(ray.d),
-        inv_direction: Vec3A::new(inv(ray.d.x), inv(ray.d.y), inv(ray.d.z)),
+        direction: Vec3A::from(d),
+        inv_direction: Vec3A::new(inv(d.x), inv(d.y), inv(d.z)),
         tmin: 0.0,
-        tmax: ray.t_max,
-    }
+        tmax: ray.t_max / k,
+    };
+    (r, k)
 }
 
 impl Geometry {
@@ -113,11 +139,38 @@ impl Geometry {
             None
         } else {
             let mut t = Duration::ZERO;
-            let bvh = obvhs::cwbvh::builder::build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut t);
-            prims = bvh.primitive_indices.iter().map(|&i| prims[i as usize]).collect();
+            let bvh =
+                obvhs::cwbvh::builder::build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut t);
+            prims = bvh
+                .primitive_indices
+                .iter()
+                .map(|&i| prims[i as usize])
+                .collect();
             Some(bvh)
         };
-        Geometry { meshes, spheres, prims, bvh, bounds, degenerate_triangles: degenerate, build_time: start.elapsed() }
+        let size = if bounds.is_empty() {
+            1.0
+        } else {
+            bounds
+                .diagonal()
+                .length()
+                .max(bounds.max.abs().max_element())
+        };
+        let ray_length = if size.is_finite() && size > 0.0 {
+            size * 1e-12
+        } else {
+            1e-12
+        };
+        Geometry {
+            meshes,
+            spheres,
+            prims,
+            bvh,
+            bounds,
+            ray_length,
+            degenerate_triangles: degenerate,
+            build_time: start.elapsed(),
+        }
     }
 
     pub fn primitive_count(&self) -> usize {
@@ -129,10 +182,17 @@ impl Geometry {
     }
 
     #[inline]
-    fn intersect_prim(&self, prim: PrimRef, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, HitLocal)> {
+    fn intersect_prim(
+        &self,
+        prim: PrimRef,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+    ) -> Option<(f32, HitLocal)> {
         if prim.mesh == SPHERE_TAG {
             let s = &self.spheres[prim.index as usize];
-            s.intersect(o, d, t_max).map(|(t, p)| (t, HitLocal::SpherePoint(p)))
+            s.intersect(o, d, t_max)
+                .map(|(t, p)| (t, HitLocal::SpherePoint(p)))
         } else {
             let m = &self.meshes[prim.mesh as usize];
             let [p0, p1, p2] = m.vertices(prim.index);
@@ -147,12 +207,13 @@ impl Geometry {
         let mut rh = RayHit::none();
         let mut best: Option<Hit> = None;
         let (o, d) = (ray.o, ray.d);
-        bvh.ray_traverse(to_obvhs_ray(ray), &mut rh, |r, id| {
+        let (r, k) = to_obvhs_ray(ray, self.ray_length);
+        bvh.ray_traverse(r, &mut rh, |r, id| {
             let prim = self.prims[id];
-            match self.intersect_prim(prim, o, d, r.tmax) {
+            match self.intersect_prim(prim, o, d, (r.tmax * k).min(ray.t_max)) {
                 Some((t, local)) => {
                     best = Some(Hit { t, prim, local });
-                    t
+                    t / k
                 }
                 None => f32::INFINITY,
             }
@@ -167,9 +228,12 @@ impl Geometry {
             return false;
         };
         let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
-        !bvh.ray_traverse_miss(to_obvhs_ray(ray), |_, id| match self.intersect_prim(self.prims[id], o, d, t_max) {
-            Some((t, _)) => t,
-            None => f32::INFINITY,
+        let (r, k) = to_obvhs_ray(ray, self.ray_length);
+        !bvh.ray_traverse_miss(r, |_, id| {
+            match self.intersect_prim(self.prims[id], o, d, t_max) {
+                Some((t, _)) => t / k,
+                None => f32::INFINITY,
+            }
         })
     }
 
@@ -187,7 +251,11 @@ impl Geometry {
             }
             HitLocal::SpherePoint(p) => {
                 let s = &self.spheres[hit.prim.index as usize];
-                SurfaceHit { point: s.surface_point(p), material: s.material, light: s.light }
+                SurfaceHit {
+                    point: s.surface_point(p),
+                    material: s.material,
+                    light: s.light,
+                }
             }
         }
     }

@@ -22,7 +22,13 @@ pub struct Camera {
 
 impl Camera {
     pub fn new(desc: &CameraDesc, xres: u32, yres: u32) -> Camera {
-        let CameraKind::Perspective { fov, lens_radius, focal_distance, frame_aspect_ratio, screen_window } = desc.kind;
+        let CameraKind::Perspective {
+            fov,
+            lens_radius,
+            focal_distance,
+            frame_aspect_ratio,
+            screen_window,
+        } = desc.kind;
         let frame = frame_aspect_ratio.unwrap_or(xres as f32 / yres as f32);
         let screen = screen_window.unwrap_or(if frame > 1.0 {
             [-frame, frame, -1.0, 1.0]

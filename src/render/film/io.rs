@@ -185,8 +185,11 @@ fn encode_exr(img: &Image) -> Result<Vec<u8>, String> {
     });
     let image = ExrImage::from_channels((img.width as usize, img.height as usize), channels);
     let mut cursor = Cursor::new(Vec::new());
+    // Sequential: the exr crate's parallel compression writes blocks in
+    // completion order, which would make the file depend on timing.
     image
         .write()
+        .non_parallel()
         .to_buffered(&mut cursor)
         .map_err(|e| e.to_string())?;
     Ok(cursor.into_inner())

@@ -61,10 +61,16 @@ impl Bounds3 {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
     pub fn union_point(&self, p: Vec3) -> Self {
-        Self { min: self.min.min(p), max: self.max.max(p) }
+        Self {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
     }
     pub fn union(&self, b: &Bounds3) -> Self {
-        Self { min: self.min.min(b.min), max: self.max.max(b.max) }
+        Self {
+            min: self.min.min(b.min),
+            max: self.max.max(b.max),
+        }
     }
     pub fn diagonal(&self) -> Vec3 {
         self.max - self.min

@@ -11,7 +11,9 @@ mod ray;
 
 pub use bounds::{Bounds2i, Bounds3};
 pub use frame::Frame;
-pub use ray::{offset_ray_origin, spawn_ray, spawn_ray_to, spawn_ray_to_point, Ray, SHADOW_EPSILON};
+pub use ray::{
+    offset_ray_origin, spawn_ray, spawn_ray_to, spawn_ray_to_point, Ray, SHADOW_EPSILON,
+};
 
 use glam::Vec3;
 
@@ -73,7 +75,10 @@ mod tests {
         for v in [0.0f32, -0.0, 1.0, -1.0, 1e-30, -1e30, 3.5e5] {
             assert!(next_float_up(v) > v);
             assert!(next_float_down(v) < v);
-            assert_eq!(next_float_down(next_float_up(v)), if v == -0.0 { 0.0 } else { v });
+            assert_eq!(
+                next_float_down(next_float_up(v)),
+                if v == -0.0 { 0.0 } else { v }
+            );
         }
     }
 }

@@ -16,7 +16,11 @@ pub struct Ray {
 impl Ray {
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Ray {
-        Ray { o, d, t_max: f32::INFINITY }
+        Ray {
+            o,
+            d,
+            t_max: f32::INFINITY,
+        }
     }
     #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
@@ -55,12 +59,20 @@ pub fn spawn_ray(p: Vec3, p_error: Vec3, n: Vec3, d: Vec3) -> Ray {
 pub fn spawn_ray_to(p0: Vec3, e0: Vec3, n0: Vec3, p1: Vec3, e1: Vec3, n1: Vec3) -> Ray {
     let pf = offset_ray_origin(p0, e0, n0, p1 - p0);
     let pt = offset_ray_origin(p1, e1, n1, pf - p1);
-    Ray { o: pf, d: pt - pf, t_max: 1.0 - SHADOW_EPSILON }
+    Ray {
+        o: pf,
+        d: pt - pf,
+        t_max: 1.0 - SHADOW_EPSILON,
+    }
 }
 
 /// A shadow ray from a surface point to a point in space (a point light).
 #[inline]
 pub fn spawn_ray_to_point(p0: Vec3, e0: Vec3, n0: Vec3, p1: Vec3) -> Ray {
     let pf = offset_ray_origin(p0, e0, n0, p1 - p0);
-    Ray { o: pf, d: p1 - pf, t_max: 1.0 - SHADOW_EPSILON }
+    Ray {
+        o: pf,
+        d: p1 - pf,
+        t_max: 1.0 - SHADOW_EPSILON,
+    }
 }

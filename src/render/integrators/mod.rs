@@ -48,28 +48,54 @@ impl Scratch {
 const MAX_PASS_THROUGH: u32 = 256;
 
 pub enum Integrator {
-    Path { max_depth: u32, rr_threshold: f32, lights: LightSampler },
-    Direct { max_depth: u32, strategy: DirectStrategy, lights: LightSampler, n_light_samples: Vec<u32> },
-    Whitted { max_depth: u32 },
+    Path {
+        max_depth: u32,
+        rr_threshold: f32,
+        lights: LightSampler,
+    },
+    Direct {
+        max_depth: u32,
+        strategy: DirectStrategy,
+        lights: LightSampler,
+        n_light_samples: Vec<u32>,
+    },
+    Whitted {
+        max_depth: u32,
+    },
 }
 
 impl Integrator {
     /// Builds the integrator and only the light distribution it uses.
     pub fn new(desc: &IntegratorDesc, scene: &RenderScene) -> Integrator {
         match *desc {
-            IntegratorDesc::Path { max_depth, rr_threshold, light_sample_strategy } => {
+            IntegratorDesc::Path {
+                max_depth,
+                rr_threshold,
+                light_sample_strategy,
+            } => {
                 let kind = match light_sample_strategy {
                     LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
                     LightSampleStrategy::Power => LightSamplerKind::Power,
                     LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
                 };
-                Integrator::Path { max_depth, rr_threshold, lights: LightSampler::new(kind, &scene.lights, &scene.geometry) }
+                Integrator::Path {
+                    max_depth,
+                    rr_threshold,
+                    lights: LightSampler::new(kind, &scene.lights, &scene.geometry),
+                }
             }
-            IntegratorDesc::DirectLighting { max_depth, strategy } => Integrator::Direct {
+            IntegratorDesc::DirectLighting {
+                max_depth,
+                strategy,
+            } => Integrator::Direct {
                 max_depth,
                 strategy,
                 // pbrt-v3's directlighting chooses uniformly for strategy "one".
-                lights: LightSampler::new(LightSamplerKind::Uniform, &scene.lights, &scene.geometry),
+                lights: LightSampler::new(
+                    LightSamplerKind::Uniform,
+                    &scene.lights,
+                    &scene.geometry,
+                ),
                 n_light_samples: Vec::new(),
             },
             IntegratorDesc::Whitted { max_depth } => Integrator::Whitted { max_depth },
@@ -78,8 +104,18 @@ impl Integrator {
 
     /// Requests the sampler arrays the integrator uses (pbrt-v3's Preprocess).
     pub fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
-        if let Integrator::Direct { max_depth, strategy: DirectStrategy::All, n_light_samples, .. } = self {
-            *n_light_samples = scene.lights.iter().map(|l| sampler.round_count(l.n_samples())).collect();
+        if let Integrator::Direct {
+            max_depth,
+            strategy: DirectStrategy::All,
+            n_light_samples,
+            ..
+        } = self
+        {
+            *n_light_samples = scene
+                .lights
+                .iter()
+                .map(|l| sampler.round_count(l.n_samples()))
+                .collect();
             for _ in 0..*max_depth {
                 for &n in n_light_samples.iter() {
                     sampler.request_2d_array(n);
@@ -98,17 +134,43 @@ impl Integrator {
 
     /// Radiance arriving at the camera along `ray`.
     #[inline]
-    pub fn li(&self, ray: Ray, scene: &RenderScene, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
+    pub fn li(
+        &self,
+        ray: Ray,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
         match self {
-            Integrator::Path { max_depth, rr_threshold, lights } => {
-                path_li(ray, scene, sampler, scratch, *max_depth, *rr_threshold, lights)
+            Integrator::Path {
+                max_depth,
+                rr_threshold,
+                lights,
+            } => path_li(
+                ray,
+                scene,
+                sampler,
+                scratch,
+                *max_depth,
+                *rr_threshold,
+                lights,
+            ),
+            Integrator::Direct { .. } | Integrator::Whitted { .. } => {
+                self.recursive_li(ray, scene, sampler, scratch, 0, 0)
             }
-            Integrator::Direct { .. } | Integrator::Whitted { .. } => self.recursive_li(ray, scene, sampler, scratch, 0, 0),
         }
     }
 
     /// directlighting and whitted: pbrt-v3's recursive Li.
-    fn recursive_li(&self, ray: Ray, scene: &RenderScene, sampler: &mut Sampler, scratch: &mut Scratch, depth: u32, pass: u32) -> Vec3 {
+    fn recursive_li(
+        &self,
+        ray: Ray,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+        depth: u32,
+        pass: u32,
+    ) -> Vec3 {
         scratch.counts.closest += 1;
         let Some(hit) = scene.geometry.intersect(&ray) else {
             return escaped(scene);
@@ -126,11 +188,26 @@ impl Integrator {
         let bsdf = material.bsdf(s.point.ns, s.point.n, false);
         let mut l = emitted(scene, &s, wo);
         let max_depth = match *self {
-            Integrator::Direct { max_depth, strategy, ref lights, ref n_light_samples } => {
+            Integrator::Direct {
+                max_depth,
+                strategy,
+                ref lights,
+                ref n_light_samples,
+            } => {
                 if !scene.lights.is_empty() {
                     l += match strategy {
-                        DirectStrategy::All => sample_all_lights(scene, &s, &bsdf, wo, sampler, scratch, n_light_samples),
-                        DirectStrategy::One => sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights),
+                        DirectStrategy::All => sample_all_lights(
+                            scene,
+                            &s,
+                            &bsdf,
+                            wo,
+                            sampler,
+                            scratch,
+                            n_light_samples,
+                        ),
+                        DirectStrategy::One => {
+                            sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights)
+                        }
                     };
                 }
                 max_depth
@@ -138,7 +215,9 @@ impl Integrator {
             Integrator::Whitted { max_depth } => {
                 for light in &scene.lights {
                     let u = sampler.get_2d();
-                    let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else { continue };
+                    let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else {
+                        continue;
+                    };
                     if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
                         continue;
                     }
@@ -155,13 +234,19 @@ impl Integrator {
             Integrator::Path { .. } => unreachable!("path is not recursive"),
         };
         if depth + 1 < max_depth {
-            for filter in [LobeFilter::SpecularReflection, LobeFilter::SpecularTransmission] {
+            for filter in [
+                LobeFilter::SpecularReflection,
+                LobeFilter::SpecularTransmission,
+            ] {
                 let u = sampler.get_2d();
                 if let Some(bs) = bsdf.sample(wo, u, filter) {
                     let cos = bs.wi.dot(s.point.ns).abs();
                     if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
                         let next = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-                        l += bs.f * self.recursive_li(next, scene, sampler, scratch, depth + 1, 0) * cos / bs.pdf;
+                        l += bs.f
+                            * self.recursive_li(next, scene, sampler, scratch, depth + 1, 0)
+                            * cos
+                            / bs.pdf;
                     }
                 }
             }
@@ -182,7 +267,11 @@ fn emitted(scene: &RenderScene, s: &SurfaceHit, wo: Vec3) -> Vec3 {
 /// Radiance of rays that leave the scene.
 #[inline]
 fn escaped(scene: &RenderScene) -> Vec3 {
-    scene.infinite_lights.iter().map(|&i| scene.lights[i as usize].le_escaped()).sum()
+    scene
+        .infinite_lights
+        .iter()
+        .map(|&i| scene.lights[i as usize].le_escaped())
+        .sum()
 }
 
 /// pbrt-v3's PathIntegrator::Li.
@@ -233,7 +322,9 @@ fn path_li(
             l += beta * sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights);
         }
         let u = sampler.get_2d();
-        let Some(bs) = bsdf.sample(wo, u, LobeFilter::All) else { break };
+        let Some(bs) = bsdf.sample(wo, u, LobeFilter::All) else {
+            break;
+        };
         if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
             break;
         }
@@ -241,7 +332,11 @@ fn path_li(
         specular_bounce = bs.specular;
         if bs.specular && bs.transmission {
             let eta2 = bsdf.eta * bsdf.eta;
-            eta_scale *= if wo.dot(s.point.n) > 0.0 { eta2 } else { 1.0 / eta2 };
+            eta_scale *= if wo.dot(s.point.n) > 0.0 {
+                eta2
+            } else {
+                1.0 / eta2
+            };
         }
         ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
         // Russian roulette after bounce 3 on max(β·etaScale).
@@ -297,11 +392,15 @@ fn sample_all_lights(
         // The two arrays are consecutive; copy the first into reused scratch.
         let mut u_light = std::mem::take(&mut scratch.u_light);
         u_light.clear();
-        let got_light = sampler.get_2d_array(n).map(|a| u_light.extend_from_slice(a)).is_some();
+        let got_light = sampler
+            .get_2d_array(n)
+            .map(|a| u_light.extend_from_slice(a))
+            .is_some();
         let ld = if let (true, Some(u_scatter)) = (got_light, sampler.get_2d_array(n)) {
             let mut sum = Vec3::ZERO;
             for k in 0..n as usize {
-                sum += estimate_direct(scene, s, bsdf, wo, light, u_light[k], u_scatter[k], scratch);
+                sum +=
+                    estimate_direct(scene, s, bsdf, wo, light, u_light[k], u_scatter[k], scratch);
             }
             sum / n as f32
         } else {

@@ -50,14 +50,24 @@ impl LightSampler {
     /// Builds only what the strategy needs: nothing for one light or uniform,
     /// a power table, or an (initially empty) voxel grid.
     pub fn new(kind: LightSamplerKind, lights: &[Light], geom: &Geometry) -> LightSampler {
-        let active: Vec<u32> = (0..lights.len() as u32).filter(|&i| lights[i as usize].power() > 0.0).collect();
-        let kind = if active.len() <= 1 { LightSamplerKind::Uniform } else { kind };
+        let active: Vec<u32> = (0..lights.len() as u32)
+            .filter(|&i| lights[i as usize].power() > 0.0)
+            .collect();
+        let kind = if active.len() <= 1 {
+            LightSamplerKind::Uniform
+        } else {
+            kind
+        };
         let power = (kind == LightSamplerKind::Power).then(|| {
             let p: Vec<f32> = active.iter().map(|&i| lights[i as usize].power()).collect();
             Distribution1D::new(&p)
         });
         let spatial = (kind == LightSamplerKind::Spatial).then(|| {
-            let bounds = if geom.bounds.is_empty() { Bounds3::from_point(Vec3::ZERO) } else { geom.bounds };
+            let bounds = if geom.bounds.is_empty() {
+                Bounds3::from_point(Vec3::ZERO)
+            } else {
+                geom.bounds
+            };
             let diag = bounds.diagonal();
             let max_extent = diag.max_element();
             let mut n = [1i32; 3];
@@ -67,9 +77,18 @@ impl LightSampler {
                 }
             }
             let count = (n[0] * n[1] * n[2]) as usize;
-            SpatialGrid { bounds, n, voxels: (0..count).map(|_| OnceLock::new()).collect() }
+            SpatialGrid {
+                bounds,
+                n,
+                voxels: (0..count).map(|_| OnceLock::new()).collect(),
+            }
         });
-        LightSampler { kind, active, power, spatial }
+        LightSampler {
+            kind,
+            active,
+            power,
+            spatial,
+        }
     }
 
     pub fn kind(&self) -> LightSamplerKind {
@@ -82,7 +101,9 @@ impl LightSampler {
 
     /// Number of voxel distributions built so far (spatial only).
     pub fn voxels_built(&self) -> usize {
-        self.spatial.as_ref().map_or(0, |s| s.voxels.iter().filter(|v| v.get().is_some()).count())
+        self.spatial
+            .as_ref()
+            .map_or(0, |s| s.voxels.iter().filter(|v| v.get().is_some()).count())
     }
 
     /// Choose a light for shading point `p`: (light index, probability).
@@ -99,7 +120,11 @@ impl LightSampler {
                 (i, pmf)
             }
             LightSamplerKind::Spatial => {
-                let (i, pmf, _) = self.spatial.as_ref()?.lookup(p, &self.active, lights, geom).sample_discrete(u);
+                let (i, pmf, _) = self
+                    .spatial
+                    .as_ref()?
+                    .lookup(p, &self.active, lights, geom)
+                    .sample_discrete(u);
                 (i, pmf)
             }
         };
@@ -108,7 +133,13 @@ impl LightSampler {
 }
 
 impl SpatialGrid {
-    fn lookup(&self, p: Vec3, active: &[u32], lights: &[Light], geom: &Geometry) -> &Distribution1D {
+    fn lookup(
+        &self,
+        p: Vec3,
+        active: &[u32],
+        lights: &[Light],
+        geom: &Geometry,
+    ) -> &Distribution1D {
         let o = self.bounds.offset(p);
         let mut v = [0i32; 3];
         for i in 0..3 {
@@ -122,17 +153,44 @@ impl SpatialGrid {
     /// pbrt-v3's SpatialLightDistribution::ComputeDistribution: estimate each
     /// light's contribution (Li/pdf, visibility ignored) at 128 Halton points
     /// of the voxel, and floor every light at 0.1% of the average.
-    fn compute(&self, v: [i32; 3], active: &[u32], lights: &[Light], geom: &Geometry) -> Distribution1D {
+    fn compute(
+        &self,
+        v: [i32; 3],
+        active: &[u32],
+        lights: &[Light],
+        geom: &Geometry,
+    ) -> Distribution1D {
         let d = self.bounds.diagonal();
-        let vmin = self.bounds.min + d * Vec3::new(v[0] as f32 / self.n[0] as f32, v[1] as f32 / self.n[1] as f32, v[2] as f32 / self.n[2] as f32);
+        let vmin = self.bounds.min
+            + d * Vec3::new(
+                v[0] as f32 / self.n[0] as f32,
+                v[1] as f32 / self.n[1] as f32,
+                v[2] as f32 / self.n[2] as f32,
+            );
         let vmax = self.bounds.min
-            + d * Vec3::new((v[0] + 1) as f32 / self.n[0] as f32, (v[1] + 1) as f32 / self.n[1] as f32, (v[2] + 1) as f32 / self.n[2] as f32);
-        let voxel = Bounds3 { min: vmin, max: vmax };
+            + d * Vec3::new(
+                (v[0] + 1) as f32 / self.n[0] as f32,
+                (v[1] + 1) as f32 / self.n[1] as f32,
+                (v[2] + 1) as f32 / self.n[2] as f32,
+            );
+        let voxel = Bounds3 {
+            min: vmin,
+            max: vmax,
+        };
         const N: u64 = 128;
         let mut contrib = vec![0.0f32; active.len()];
         for i in 0..N {
-            let po = voxel.lerp(Vec3::new(radical_inverse(2, i), radical_inverse(3, i), radical_inverse(5, i)));
-            let r = SurfacePoint { p: po, p_error: Vec3::ZERO, n: Vec3::ZERO, ns: Vec3::ZERO };
+            let po = voxel.lerp(Vec3::new(
+                radical_inverse(2, i),
+                radical_inverse(3, i),
+                radical_inverse(5, i),
+            ));
+            let r = SurfacePoint {
+                p: po,
+                p_error: Vec3::ZERO,
+                n: Vec3::ZERO,
+                ns: Vec3::ZERO,
+            };
             let u = Vec2::new(radical_inverse(7, i), radical_inverse(11, i));
             for (j, &l) in active.iter().enumerate() {
                 if let Some(s) = lights[l as usize].sample_li(&r, u, geom) {

@@ -22,12 +22,35 @@ pub enum AreaShape {
 
 #[derive(Clone, Copy, Debug)]
 pub enum Light {
-    Area { shape: AreaShape, l: Vec3, two_sided: bool, n_samples: u32, area: f32 },
-    Point { p: Vec3, intensity: Vec3 },
-    Spot { p: Vec3, frame: Frame, intensity: Vec3, cos_total: f32, cos_falloff_start: f32 },
+    Area {
+        shape: AreaShape,
+        l: Vec3,
+        two_sided: bool,
+        n_samples: u32,
+        area: f32,
+    },
+    Point {
+        p: Vec3,
+        intensity: Vec3,
+    },
+    Spot {
+        p: Vec3,
+        frame: Frame,
+        intensity: Vec3,
+        cos_total: f32,
+        cos_falloff_start: f32,
+    },
     /// `w` points towards the light.
-    Distant { w: Vec3, l: Vec3, scene_radius: f32 },
-    Infinite { l: Vec3, n_samples: u32, scene_radius: f32 },
+    Distant {
+        w: Vec3,
+        l: Vec3,
+        scene_radius: f32,
+    },
+    Infinite {
+        l: Vec3,
+        n_samples: u32,
+        scene_radius: f32,
+    },
 }
 
 /// A light sample as seen from a reference point.
@@ -45,7 +68,10 @@ impl Light {
     /// Delta lights cannot be hit by rays (no BSDF sample for them in MIS).
     #[inline]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. })
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+        )
     }
 
     pub fn is_infinite(&self) -> bool {
@@ -62,14 +88,22 @@ impl Light {
     /// Luminance of the emitted power (pbrt-v3's `Power().y()`).
     pub fn power(&self) -> f32 {
         let p = match *self {
-            Light::Area { l, two_sided, area, .. } => l * area * PI * if two_sided { 2.0 } else { 1.0 },
+            Light::Area {
+                l, two_sided, area, ..
+            } => l * area * PI * if two_sided { 2.0 } else { 1.0 },
             Light::Point { intensity, .. } => 4.0 * PI * intensity,
-            Light::Spot { intensity, cos_total, cos_falloff_start, .. } => {
-                intensity * 2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total))
+            Light::Spot {
+                intensity,
+                cos_total,
+                cos_falloff_start,
+                ..
+            } => intensity * 2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total)),
+            Light::Distant {
+                l, scene_radius, ..
             }
-            Light::Distant { l, scene_radius, .. } | Light::Infinite { l, scene_radius, .. } => {
-                l * PI * scene_radius * scene_radius
-            }
+            | Light::Infinite {
+                l, scene_radius, ..
+            } => l * PI * scene_radius * scene_radius,
         };
         luminance(p).max(0.0)
     }
@@ -97,22 +131,39 @@ impl Light {
     #[inline]
     pub fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample> {
         match *self {
-            Light::Area { shape, l, two_sided, .. } => {
+            Light::Area {
+                shape,
+                l,
+                two_sided,
+                ..
+            } => {
                 let s = match shape {
                     AreaShape::Triangle { mesh, tri } => {
                         let s = geom.meshes[mesh as usize].sample_area(tri, u);
                         crate::render::shapes::to_solid_angle(r.p, s)?
                     }
-                    AreaShape::Sphere(i) => geom.spheres[i as usize].sample_from(r.p, r.p_error, r.n, u)?,
+                    AreaShape::Sphere(i) => {
+                        geom.spheres[i as usize].sample_from(r.p, r.p_error, r.n, u)?
+                    }
                 };
                 let d = s.point.p - r.p;
                 if d.length_squared() == 0.0 || !(s.pdf > 0.0) {
                     return None;
                 }
                 let wi = d.normalize();
-                let li = if two_sided || s.point.n.dot(-wi) > 0.0 { l } else { Vec3::ZERO };
-                let shadow = spawn_ray_to(r.p, r.p_error, r.n, s.point.p, s.point.p_error, s.point.n);
-                Some(LightSample { li, wi, pdf: s.pdf, shadow })
+                let li = if two_sided || s.point.n.dot(-wi) > 0.0 {
+                    l
+                } else {
+                    Vec3::ZERO
+                };
+                let shadow =
+                    spawn_ray_to(r.p, r.p_error, r.n, s.point.p, s.point.p_error, s.point.n);
+                Some(LightSample {
+                    li,
+                    wi,
+                    pdf: s.pdf,
+                    shadow,
+                })
             }
             Light::Point { p, intensity } => {
                 let d = p - r.p;
@@ -120,9 +171,20 @@ impl Light {
                 if d2 == 0.0 {
                     return None;
                 }
-                Some(LightSample { li: intensity / d2, wi: d / d2.sqrt(), pdf: 1.0, shadow: spawn_ray_to_point(r.p, r.p_error, r.n, p) })
+                Some(LightSample {
+                    li: intensity / d2,
+                    wi: d / d2.sqrt(),
+                    pdf: 1.0,
+                    shadow: spawn_ray_to_point(r.p, r.p_error, r.n, p),
+                })
             }
-            Light::Spot { p, frame, intensity, cos_total, cos_falloff_start } => {
+            Light::Spot {
+                p,
+                frame,
+                intensity,
+                cos_total,
+                cos_falloff_start,
+            } => {
                 let d = p - r.p;
                 let d2 = d.length_squared();
                 if d2 == 0.0 {
@@ -138,17 +200,32 @@ impl Light {
                     let delta = (cos - cos_total) / (cos_falloff_start - cos_total);
                     (delta * delta) * (delta * delta)
                 };
-                Some(LightSample { li: intensity * falloff / d2, wi, pdf: 1.0, shadow: spawn_ray_to_point(r.p, r.p_error, r.n, p) })
+                Some(LightSample {
+                    li: intensity * falloff / d2,
+                    wi,
+                    pdf: 1.0,
+                    shadow: spawn_ray_to_point(r.p, r.p_error, r.n, p),
+                })
             }
             Light::Distant { w, l, scene_radius } => {
                 let far = r.p + w * (2.0 * scene_radius);
-                Some(LightSample { li: l, wi: w, pdf: 1.0, shadow: spawn_ray_to_point(r.p, r.p_error, r.n, far) })
+                Some(LightSample {
+                    li: l,
+                    wi: w,
+                    pdf: 1.0,
+                    shadow: spawn_ray_to_point(r.p, r.p_error, r.n, far),
+                })
             }
             Light::Infinite { l, .. } => {
                 let wi = uniform_sample_sphere(u);
                 // Anything in the way occludes an infinitely distant light.
                 let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
-                Some(LightSample { li: l, wi, pdf: uniform_sphere_pdf(), shadow })
+                Some(LightSample {
+                    li: l,
+                    wi,
+                    pdf: uniform_sphere_pdf(),
+                    shadow,
+                })
             }
         }
     }
@@ -175,7 +252,9 @@ impl Light {
                     }
                     AreaShape::Sphere(i) => {
                         let s = &geom.spheres[i as usize];
-                        s.pdf_from(r.p, r.p_error, r.n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
+                        s.pdf_from(r.p, r.p_error, r.n, wi, |o, d| {
+                            s.intersect(o, d, f32::INFINITY)
+                        })
                     }
                 }
             }

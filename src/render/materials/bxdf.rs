@@ -8,15 +8,31 @@ use std::f32::consts::FRAC_1_PI;
 pub enum Lobes {
     /// No lobes: a black surface (e.g. an emitter with Kd 0).
     Empty,
-    Lambertian { r: Vec3 },
-    OrenNayar { r: Vec3, a: f32, b: f32 },
+    Lambertian {
+        r: Vec3,
+    },
+    OrenNayar {
+        r: Vec3,
+        a: f32,
+        b: f32,
+    },
     /// Specular reflection with no Fresnel term (pbrt's FresnelNoOp).
-    Mirror { r: Vec3 },
+    Mirror {
+        r: Vec3,
+    },
     /// One lobe choosing reflection or transmission by the Fresnel term.
-    FresnelSpecular { r: Vec3, t: Vec3, eta: f32 },
+    FresnelSpecular {
+        r: Vec3,
+        t: Vec3,
+        eta: f32,
+    },
     /// SpecularReflection (dielectric Fresnel) + SpecularTransmission as two
     /// lobes; either is absent when its colour is black.
-    SplitGlass { r: Vec3, t: Vec3, eta: f32 },
+    SplitGlass {
+        r: Vec3,
+        t: Vec3,
+        eta: f32,
+    },
 }
 
 /// Which lobes a query may use (pbrt's BxDFType masks that pbrs needs).
@@ -112,7 +128,9 @@ impl Lobes {
                 if sin_i > 1e-4 && sin_o > 1e-4 {
                     let (ci, si) = (wi.x / sin_i, wi.y / sin_i);
                     let (co, so) = (wo.x / sin_o, wo.y / sin_o);
-                    max_cos = (ci.clamp(-1.0, 1.0) * co.clamp(-1.0, 1.0) + si.clamp(-1.0, 1.0) * so.clamp(-1.0, 1.0)).max(0.0);
+                    max_cos = (ci.clamp(-1.0, 1.0) * co.clamp(-1.0, 1.0)
+                        + si.clamp(-1.0, 1.0) * so.clamp(-1.0, 1.0))
+                    .max(0.0);
                 }
                 let (sin_alpha, tan_beta) = if wi.z.abs() > wo.z.abs() {
                     (sin_o, sin_i / wi.z.abs())
@@ -127,7 +145,9 @@ impl Lobes {
 
     fn pdf_local(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
-            Lobes::Lambertian { .. } | Lobes::OrenNayar { .. } if wo.z * wi.z > 0.0 => wi.z.abs() * FRAC_1_PI,
+            Lobes::Lambertian { .. } | Lobes::OrenNayar { .. } if wo.z * wi.z > 0.0 => {
+                wi.z.abs() * FRAC_1_PI
+            }
             _ => 0.0,
         }
     }
@@ -137,7 +157,10 @@ impl Bsdf {
     /// True if the BSDF has a lobe that light sampling can use.
     #[inline]
     pub fn has_non_specular(&self) -> bool {
-        matches!(self.lobes, Lobes::Lambertian { .. } | Lobes::OrenNayar { .. })
+        matches!(
+            self.lobes,
+            Lobes::Lambertian { .. } | Lobes::OrenNayar { .. }
+        )
     }
 
     /// True if the BSDF has no lobes at all.
@@ -196,7 +219,13 @@ impl Bsdf {
                 }
                 let wi_w = self.frame.from_local(wi);
                 let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
-                return Some(BsdfSample { f: self.lobes.f_local(wo, wi, reflect), wi: wi_w, pdf, specular: false, transmission: false });
+                return Some(BsdfSample {
+                    f: self.lobes.f_local(wo, wi, reflect),
+                    wi: wi_w,
+                    pdf,
+                    specular: false,
+                    transmission: false,
+                });
             }
             Lobes::Mirror { r } => {
                 if !want_refl {
@@ -236,7 +265,8 @@ impl Bsdf {
                     (fr * r / wi.z.abs(), wi, pdf, false)
                 } else {
                     let (wi, ei, et) = transmit(wo, eta)?;
-                    let ft = t * (1.0 - fr_dielectric(cos_theta(wi), 1.0, eta)) * (ei * ei) / (et * et);
+                    let ft =
+                        t * (1.0 - fr_dielectric(cos_theta(wi), 1.0, eta)) * (ei * ei) / (et * et);
                     (ft / wi.z.abs(), wi, pdf, true)
                 }
             }
@@ -245,7 +275,13 @@ impl Bsdf {
         if pdf == 0.0 || !f.is_finite() {
             return None;
         }
-        Some(BsdfSample { f, wi: self.frame.from_local(wi), pdf, specular: true, transmission })
+        Some(BsdfSample {
+            f,
+            wi: self.frame.from_local(wi),
+            pdf,
+            specular: true,
+            transmission,
+        })
     }
 }
 

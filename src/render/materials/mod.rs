@@ -14,9 +14,20 @@ use glam::Vec3;
 /// A material ready to build BSDFs at hit points.
 #[derive(Clone, Copy, Debug)]
 pub enum Material {
-    Matte { kd: Vec3, a: f32, b: f32, oren_nayar: bool },
-    Mirror { kr: Vec3 },
-    Glass { kr: Vec3, kt: Vec3, eta: f32 },
+    Matte {
+        kd: Vec3,
+        a: f32,
+        b: f32,
+        oren_nayar: bool,
+    },
+    Mirror {
+        kr: Vec3,
+    },
+    Glass {
+        kr: Vec3,
+        kt: Vec3,
+        eta: f32,
+    },
     None,
 }
 
@@ -35,7 +46,11 @@ impl Material {
                 }
             }
             MaterialDesc::Mirror { kr } => Material::Mirror { kr: clamp(kr) },
-            MaterialDesc::Glass { kr, kt, eta } => Material::Glass { kr: clamp(kr), kt: clamp(kt), eta },
+            MaterialDesc::Glass { kr, kt, eta } => Material::Glass {
+                kr: clamp(kr),
+                kt: clamp(kt),
+                eta,
+            },
             MaterialDesc::None => Material::None,
         }
     }
@@ -51,7 +66,12 @@ impl Material {
     #[inline]
     pub fn bsdf(&self, ns: Vec3, ng: Vec3, multiple_lobes: bool) -> Bsdf {
         let lobes = match *self {
-            Material::Matte { kd, a, b, oren_nayar } => {
+            Material::Matte {
+                kd,
+                a,
+                b,
+                oren_nayar,
+            } => {
                 if kd == Vec3::ZERO {
                     Lobes::Empty
                 } else if oren_nayar {
@@ -82,6 +102,11 @@ impl Material {
             Material::Glass { eta, .. } => eta,
             _ => 1.0,
         };
-        Bsdf { frame: Frame::from_normal(ns), ng, lobes, eta }
+        Bsdf {
+            frame: Frame::from_normal(ns),
+            ng,
+            lobes,
+            eta,
+        }
     }
 }

@@ -29,7 +29,15 @@ pub struct Sphere {
 }
 
 impl Sphere {
-    pub fn new(radius: f32, z_min: f32, z_max: f32, phi_max_deg: f32, object_to_world: DMat4, reverse: bool, material: u32) -> Sphere {
+    pub fn new(
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        phi_max_deg: f32,
+        object_to_world: DMat4,
+        reverse: bool,
+        material: u32,
+    ) -> Sphere {
         let r = radius.abs() as f64;
         let zmin = (z_min.min(z_max) as f64).clamp(-r, r);
         let zmax = (z_min.max(z_max) as f64).clamp(-r, r);
@@ -47,12 +55,20 @@ impl Sphere {
             && c0.dot(c1).abs() < tol * l0
             && c0.dot(c2).abs() < tol * l0
             && c1.dot(c2).abs() < tol * l0;
-        let cone = (whole && similarity)
-            .then(|| (object_to_world.transform_point3(DVec3::ZERO).as_vec3(), (r * l0) as f32));
+        let cone = (whole && similarity).then(|| {
+            (
+                object_to_world.transform_point3(DVec3::ZERO).as_vec3(),
+                (r * l0) as f32,
+            )
+        });
         // Object-space area of the zone, scaled exactly for similarities;
         // for other transforms `area` is only used for light power.
         let obj_area = phi_max * r * (zmax - zmin);
-        let scale2 = if similarity { l0 * l0 } else { det.abs().powf(2.0 / 3.0) };
+        let scale2 = if similarity {
+            l0 * l0
+        } else {
+            det.abs().powf(2.0 / 3.0)
+        };
         Sphere {
             radius: r,
             z_min: zmin,
@@ -87,7 +103,10 @@ impl Sphere {
         }
         // Widen by a few ulps so f32 rounding of the corners stays conservative.
         let pad = (b.max.abs().max(b.min.abs())) * 4.0 * f32::EPSILON;
-        Bounds3 { min: b.min - pad, max: b.max + pad }
+        Bounds3 {
+            min: b.min - pad,
+            max: b.max + pad,
+        }
     }
 
     /// Closest hit with 0 < t < t_max; returns t and the object-space point.
@@ -108,8 +127,19 @@ impl Sphere {
             return None;
         }
         let root = disc.sqrt();
-        let q = if b < 0.0 { -0.5 * (b - root) } else { -0.5 * (b + root) };
-        let (mut t0, mut t1) = (q / a, if q != 0.0 { (oo.length_squared() - self.radius * self.radius) / q } else { q / a });
+        let q = if b < 0.0 {
+            -0.5 * (b - root)
+        } else {
+            -0.5 * (b + root)
+        };
+        let (mut t0, mut t1) = (
+            q / a,
+            if q != 0.0 {
+                (oo.length_squared() - self.radius * self.radius) / q
+            } else {
+                q / a
+            },
+        );
         if t0 > t1 {
             std::mem::swap(&mut t0, &mut t1);
         }
@@ -139,7 +169,9 @@ impl Sphere {
 
     #[inline]
     fn is_partial(&self) -> bool {
-        self.z_min > -self.radius || self.z_max < self.radius || self.phi_max < std::f64::consts::TAU
+        self.z_min > -self.radius
+            || self.z_max < self.radius
+            || self.phi_max < std::f64::consts::TAU
     }
 
     /// World-space surface point for an object-space point on the sphere.
@@ -151,13 +183,20 @@ impl Sphere {
         let obj_err = p_obj.abs() * gamma(5) as f64;
         let lin = DMat3::from_mat4(self.object_to_world);
         let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
-        let err = abs_lin * obj_err + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs()) * gamma(3) as f64;
+        let err = abs_lin * obj_err
+            + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
+                * gamma(3) as f64;
         let p_error = err.as_vec3() + p.abs() * f32::EPSILON;
         let mut n = (self.normal_matrix * p_obj).normalize().as_vec3();
         if self.flip_normal {
             n = -n;
         }
-        SurfacePoint { p, p_error, n, ns: n }
+        SurfacePoint {
+            p,
+            p_error,
+            n,
+            ns: n,
+        }
     }
 
     /// Uniform sample by area on the sphere's zone (object space), with the
@@ -173,7 +212,10 @@ impl Sphere {
         // dA_world / dA_obj = |det M| · |M^-T n_obj|.
         let n_obj = p_obj / r;
         let jac = self.normal_matrix_det_abs() * (self.normal_matrix * n_obj).length();
-        ShapeSample { point, pdf: (1.0 / (obj_area * jac)) as f32 }
+        ShapeSample {
+            point,
+            pdf: (1.0 / (obj_area * jac)) as f32,
+        }
     }
 
     fn normal_matrix_det_abs(&self) -> f64 {
@@ -219,12 +261,20 @@ impl Sphere {
             let local = Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha);
             let n_world = -frame.from_local(local);
             let pw = c + r * n_world;
-            let mut point = SurfacePoint { p: pw, p_error: gamma(5) * pw.abs(), n: n_world, ns: n_world };
+            let mut point = SurfacePoint {
+                p: pw,
+                p_error: gamma(5) * pw.abs(),
+                n: n_world,
+                ns: n_world,
+            };
             if self.flip_normal {
                 point.n = -point.n;
                 point.ns = point.n;
             }
-            return Some(ShapeSample { point, pdf: uniform_cone_pdf(cos_max) });
+            return Some(ShapeSample {
+                point,
+                pdf: uniform_cone_pdf(cos_max),
+            });
         }
         let s = self.sample_area(u);
         to_solid_angle(p, s)
@@ -233,7 +283,14 @@ impl Sphere {
     /// Density by solid angle of `sample_from` producing direction `wi`
     /// from `p` (pbrt-v3's Sphere::Pdf): the cone density when the sphere is
     /// seen from outside, else the area density at the first hit of `wi`.
-    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3, hit: impl Fn(Vec3, Vec3) -> Option<(f32, DVec3)>) -> f32 {
+    pub fn pdf_from(
+        &self,
+        p: Vec3,
+        p_error: Vec3,
+        n: Vec3,
+        wi: Vec3,
+        hit: impl Fn(Vec3, Vec3) -> Option<(f32, DVec3)>,
+    ) -> f32 {
         if let Some((_, _, cos_max)) = self.cone_from(p, p_error, n) {
             return uniform_cone_pdf(cos_max);
         }
@@ -277,13 +334,23 @@ mod tests {
 
     #[test]
     fn unit_sphere_hits_and_normals() {
-        let s = Sphere::new(1.0, -1.0, 1.0, 360.0, DMat4::from_translation(DVec3::new(0.0, 0.0, 5.0)), false, 0);
+        let s = Sphere::new(
+            1.0,
+            -1.0,
+            1.0,
+            360.0,
+            DMat4::from_translation(DVec3::new(0.0, 0.0, 5.0)),
+            false,
+            0,
+        );
         let (t, p) = s.intersect(Vec3::ZERO, Vec3::Z, f32::INFINITY).unwrap();
         assert!((t - 4.0).abs() < 1e-6);
         let sp = s.surface_point(p);
         assert!((sp.n - (-Vec3::Z)).length() < 1e-6);
         // From inside, the far hit.
-        let (t, _) = s.intersect(Vec3::new(0.0, 0.0, 5.0), Vec3::Z, f32::INFINITY).unwrap();
+        let (t, _) = s
+            .intersect(Vec3::new(0.0, 0.0, 5.0), Vec3::Z, f32::INFINITY)
+            .unwrap();
         assert!((t - 1.0).abs() < 1e-6);
         assert!(s.intersect(Vec3::ZERO, -Vec3::Z, f32::INFINITY).is_none());
         assert!((s.area() - 4.0 * PI).abs() < 1e-4);
@@ -292,7 +359,15 @@ mod tests {
     #[test]
     fn leaving_ray_does_not_rehit() {
         for scale in [1e-4f64, 1.0, 1e5] {
-            let s = Sphere::new(1.0, -1.0, 1.0, 360.0, DMat4::from_scale(DVec3::splat(scale)), false, 0);
+            let s = Sphere::new(
+                1.0,
+                -1.0,
+                1.0,
+                360.0,
+                DMat4::from_scale(DVec3::splat(scale)),
+                false,
+                0,
+            );
             for i in 0..1000 {
                 let u = Vec2::new((i as f32 * 0.618034) % 1.0, (i as f32 * 0.7548776) % 1.0);
                 let smp = s.sample_area(u);
@@ -300,7 +375,10 @@ mod tests {
                 // Outward along a tangent-ish direction must miss the sphere.
                 let w = (sp.n + Frame::from_normal(sp.n).s * 30.0).normalize();
                 let o = offset_ray_origin(sp.p, sp.p_error, sp.n, w);
-                assert!(s.intersect(o, w, f32::INFINITY).is_none(), "scale {scale} i {i}");
+                assert!(
+                    s.intersect(o, w, f32::INFINITY).is_none(),
+                    "scale {scale} i {i}"
+                );
             }
         }
     }

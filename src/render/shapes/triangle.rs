@@ -50,7 +50,9 @@ impl TriangleMesh {
     pub fn is_degenerate(&self, tri: u32) -> bool {
         let [p0, p1, p2] = self.vertices(tri);
         let c = (p0 - p2).cross(p1 - p2);
-        !(p0.is_finite() && p1.is_finite() && p2.is_finite()) || !(c.length_squared() > 0.0) || !c.length_squared().is_finite()
+        !(p0.is_finite() && p1.is_finite() && p2.is_finite())
+            || !(c.length_squared() > 0.0)
+            || !c.length_squared().is_finite()
     }
 
     /// Oriented normals at barycentrics (b0, b1, b2), as pbrt-v3's triangle.cpp.
@@ -93,21 +95,35 @@ impl TriangleMesh {
         let mut point = self.surface_point(tri, b);
         let [p0, p1, p2] = self.vertices(tri);
         point.p_error = gamma(6) * ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs());
-        ShapeSample { point, pdf: 1.0 / self.area(tri) }
+        ShapeSample {
+            point,
+            pdf: 1.0 / self.area(tri),
+        }
     }
 }
 
 /// pbrt-v3's watertight ray–triangle test with its conservative check that
 /// t is positive. Returns (t, [b0, b1, b2]).
 #[inline]
-pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, [f32; 3])> {
+pub fn intersect_triangle(
+    o: Vec3,
+    d: Vec3,
+    t_max: f32,
+    p0: Vec3,
+    p1: Vec3,
+    p2: Vec3,
+) -> Option<(f32, [f32; 3])> {
     // Translate to the ray origin, permute so z is the largest direction axis.
     let mut p0t = p0 - o;
     let mut p1t = p1 - o;
     let mut p2t = p2 - o;
     let ad = d.abs();
     let kz = if ad.x > ad.y {
-        if ad.x > ad.z { 0 } else { 2 }
+        if ad.x > ad.z {
+            0
+        } else {
+            2
+        }
     } else if ad.y > ad.z {
         1
     } else {
@@ -167,7 +183,8 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     let delta_y = gamma(5) * (max_yt + max_zt);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
     if t <= delta_t {
         return None;
     }
@@ -180,13 +197,36 @@ mod tests {
 
     #[test]
     fn hits_inside_misses_outside() {
-        let (p0, p1, p2) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
-        let h = intersect_triangle(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, f32::INFINITY, p0, p1, p2).unwrap();
+        let (p0, p1, p2) = (
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        let h = intersect_triangle(
+            Vec3::new(0.2, 0.2, 1.0),
+            -Vec3::Z,
+            f32::INFINITY,
+            p0,
+            p1,
+            p2,
+        )
+        .unwrap();
         assert!((h.0 - 1.0).abs() < 1e-6);
         let p = h.1[0] * p0 + h.1[1] * p1 + h.1[2] * p2;
         assert!((p - Vec3::new(0.2, 0.2, 0.0)).length() < 1e-6);
-        assert!(intersect_triangle(Vec3::new(0.8, 0.8, 1.0), -Vec3::Z, f32::INFINITY, p0, p1, p2).is_none());
-        assert!(intersect_triangle(Vec3::new(0.2, 0.2, 1.0), Vec3::Z, f32::INFINITY, p0, p1, p2).is_none());
+        assert!(intersect_triangle(
+            Vec3::new(0.8, 0.8, 1.0),
+            -Vec3::Z,
+            f32::INFINITY,
+            p0,
+            p1,
+            p2
+        )
+        .is_none());
+        assert!(
+            intersect_triangle(Vec3::new(0.2, 0.2, 1.0), Vec3::Z, f32::INFINITY, p0, p1, p2)
+                .is_none()
+        );
         assert!(intersect_triangle(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 0.5, p0, p1, p2).is_none());
     }
 
@@ -194,7 +234,10 @@ mod tests {
     fn degenerate_triangle_never_hits() {
         let (p0, p1, p2) = (Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
         for d in [-Vec3::Z, Vec3::new(0.1, 0.0, -1.0), Vec3::Y] {
-            assert!(intersect_triangle(Vec3::new(0.5, 0.0, 1.0), d, f32::INFINITY, p0, p1, p2).is_none());
+            assert!(
+                intersect_triangle(Vec3::new(0.5, 0.0, 1.0), d, f32::INFINITY, p0, p1, p2)
+                    .is_none()
+            );
         }
     }
 }
