@@ -16,7 +16,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-const DEFAULT_SCENES: [&str; 4] = ["scenes/cornell-path.pbrt", "scenes/cornell-direct.pbrt", "scenes/cornell-glass.pbrt", "scenes/cornell-dragon.pbrt"];
+const DEFAULT_SCENES: [&str; 4] = [
+    "scenes/cornell-path.pbrt",
+    "scenes/cornell-direct.pbrt",
+    "scenes/cornell-glass.pbrt",
+    "scenes/cornell-dragon.pbrt",
+];
 
 /// Reference stem for a scene file (see scenes/README.md).
 fn reference_stem(scene: &Path) -> Option<&'static str> {
@@ -39,11 +44,19 @@ struct Opts {
 }
 
 fn parse() -> Result<Opts, String> {
-    let mut o = Opts { spp: 64, res: 512, threads: Some(2), scenes: Vec::new(), child: false };
+    let mut o = Opts {
+        spp: 64,
+        res: 512,
+        threads: Some(2),
+        scenes: Vec::new(),
+        child: false,
+    };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut num = |name: &str| -> Result<u64, String> {
-            args.next().and_then(|v| v.parse().ok()).ok_or(format!("{name} needs a positive number"))
+            args.next()
+                .and_then(|v| v.parse().ok())
+                .ok_or(format!("{name} needs a positive number"))
         };
         match a.as_str() {
             "--spp" => o.spp = num("--spp")? as u32,
@@ -80,11 +93,20 @@ fn downsample(img: &Image, f: u32) -> Image {
 fn child(o: &Opts) -> Result<(), String> {
     let start = Instant::now();
     let scene = &o.scenes[0];
-    let mut desc = load_scene(scene).map_err(|f| format!("{}: {} errors", scene.display(), f.errors.len()))?.scene;
+    let mut desc = load_scene(scene)
+        .map_err(|f| format!("{}: {} errors", scene.display(), f.errors.len()))?
+        .scene;
     desc.film.xresolution = o.res;
     desc.film.yresolution = o.res;
     desc.sampler.pixel_samples = o.spp;
-    let (img, stats) = render(&desc, &RenderOptions { threads: o.threads, seed: 0 }, &|_, _| {})?;
+    let (img, stats) = render(
+        &desc,
+        &RenderOptions {
+            threads: o.threads,
+            seed: 0,
+        },
+        &|_, _| {},
+    )?;
     let wall = start.elapsed().as_secs_f64();
     let mut err = (f64::NAN, f64::NAN);
     if let Some(stem) = reference_stem(scene) {
@@ -124,9 +146,16 @@ fn main() {
     }
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_default();
-    println!("machine: {} cores, {cpu}", std::thread::available_parallelism().map_or(0, |n| n.get()));
+    println!(
+        "machine: {} cores, {cpu}",
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
     println!("{}×{}, {} spp, threads {:?}; error: downsampled to 128×128 against the converged pbrt-v3 reference", o.res, o.res, o.spp, o.threads);
     println!();
     println!("| scene | wall s | render s | rays M (closest + shadow) | Mrays/s | ns/ray | peak MiB | rel. MSE | block err |");
@@ -134,7 +163,12 @@ fn main() {
     let exe = std::env::current_exe().expect("current exe");
     for scene in &o.scenes {
         let mut cmd = Command::new(&exe);
-        cmd.arg("--child").arg(scene).args(["--spp", &o.spp.to_string(), "--res", &o.res.to_string()]);
+        cmd.arg("--child").arg(scene).args([
+            "--spp",
+            &o.spp.to_string(),
+            "--res",
+            &o.res.to_string(),
+        ]);
         if let Some(t) = o.threads {
             cmd.args(["--threads", &t.to_string()]);
         }
@@ -147,11 +181,20 @@ fn main() {
         };
         let text = String::from_utf8_lossy(&out.stdout);
         let Some(line) = text.lines().find(|l| l.starts_with("RESULT ")) else {
-            eprintln!("bench: {} failed: {}", scene.display(), String::from_utf8_lossy(&out.stderr));
+            eprintln!(
+                "bench: {} failed: {}",
+                scene.display(),
+                String::from_utf8_lossy(&out.stderr)
+            );
             continue;
         };
-        let v: Vec<f64> = line.split_whitespace().skip(1).map(|x| x.parse().unwrap_or(f64::NAN)).collect();
-        let (wall, closest, shadow, render_s, mem, rel, block) = (v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|x| x.parse().unwrap_or(f64::NAN))
+            .collect();
+        let (wall, closest, shadow, render_s, mem, rel, block) =
+            (v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
         let rays = closest + shadow;
         println!(
             "| {} | {:.2} | {:.2} | {:.1} ({:.1} + {:.1}) | {:.2} | {:.0} | {:.1} | {:.5} | {:.5} |",

@@ -5,7 +5,7 @@
 use crate::render::accel::Geometry;
 use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
-use crate::render::lights::{AreaShape, Light};
+use crate::render::lights::{AreaShape, Light, TriangleCache};
 use crate::render::materials::Material;
 use crate::render::shapes::{Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
@@ -112,12 +112,17 @@ impl RenderScene {
                     AreaShape::Triangle { mesh, tri } => geometry.meshes[mesh as usize].area(tri),
                     AreaShape::Sphere(i) => geometry.spheres[i as usize].area(),
                 };
+                let tri = match shape {
+                    AreaShape::Triangle { mesh, tri } => TriangleCache::new(&geometry, mesh, tri),
+                    AreaShape::Sphere(_) => TriangleCache::default(),
+                };
                 Light::Area {
                     shape,
                     l: a.l,
                     two_sided: a.two_sided,
                     n_samples: a.n_samples.max(1),
                     area,
+                    tri,
                 }
             })
             .collect();

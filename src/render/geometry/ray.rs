@@ -37,15 +37,24 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     if w.dot(n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
+    let po = p + offset;
+    Vec3::new(
+        step_away(po.x, offset.x),
+        step_away(po.y, offset.y),
+        step_away(po.z, offset.z),
+    )
+}
+
+/// Move `v` one ulp in the direction of the sign of `dir` (not at all for 0).
+#[inline(always)]
+fn step_away(v: f32, dir: f32) -> f32 {
+    if dir > 0.0 {
+        next_float_up(v)
+    } else if dir < 0.0 {
+        next_float_down(v)
+    } else {
+        v
     }
-    po
 }
 
 /// A ray leaving a surface point in direction `d`.

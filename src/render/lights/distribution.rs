@@ -6,9 +6,8 @@
 
 use super::Light;
 use crate::render::accel::Geometry;
-use crate::render::geometry::{luminance, Bounds3};
+use crate::render::geometry::Bounds3;
 use crate::render::sampling::Distribution1D;
-use crate::render::shapes::SurfacePoint;
 use glam::{Vec2, Vec3};
 use std::sync::OnceLock;
 
@@ -44,6 +43,24 @@ fn radical_inverse(base: u32, mut a: u64) -> f32 {
         a /= base as u64;
     }
     ((rev as f64 * f) as f32).min(crate::render::sampling::ONE_MINUS_EPSILON)
+}
+
+/// Points per voxel when estimating light contributions (pbrt-v3: 128).
+const VOXEL_SAMPLES: usize = 128;
+
+/// The first 128 points of the 5D Halton sequence (bases 2, 3, 5, 7, 11):
+/// three for the position in the voxel, two for the light sample.
+fn halton_points() -> &'static [[f32; 5]; VOXEL_SAMPLES] {
+    static POINTS: OnceLock<[[f32; 5]; VOXEL_SAMPLES]> = OnceLock::new();
+    POINTS.get_or_init(|| {
+        let mut pts = [[0.0; 5]; VOXEL_SAMPLES];
+        for (i, p) in pts.iter_mut().enumerate() {
+            for (d, base) in [2, 3, 5, 7, 11].into_iter().enumerate() {
+                p[d] = radical_inverse(base, i as u64);
+            }
+        }
+        pts
+    })
 }
 
 impl LightSampler {
@@ -177,34 +194,16 @@ impl SpatialGrid {
             min: vmin,
             max: vmax,
         };
-        const N: u64 = 128;
         let mut contrib = vec![0.0f32; active.len()];
-        for i in 0..N {
-            let po = voxel.lerp(Vec3::new(
-                radical_inverse(2, i),
-                radical_inverse(3, i),
-                radical_inverse(5, i),
-            ));
-            let r = SurfacePoint {
-                p: po,
-                p_error: Vec3::ZERO,
-                n: Vec3::ZERO,
-                ns: Vec3::ZERO,
-            };
-            let u = Vec2::new(radical_inverse(7, i), radical_inverse(11, i));
+        for h in halton_points() {
+            let po = voxel.lerp(Vec3::new(h[0], h[1], h[2]));
+            let u = Vec2::new(h[3], h[4]);
             for (j, &l) in active.iter().enumerate() {
-                if let Some(s) = lights[l as usize].sample_li(&r, u, geom) {
-                    if s.pdf > 0.0 {
-                        let c = luminance(s.li) / s.pdf;
-                        if c.is_finite() {
-                            contrib[j] += c;
-                        }
-                    }
-                }
+                contrib[j] += lights[l as usize].contribution_estimate(po, u, geom);
             }
         }
         let sum: f32 = contrib.iter().sum();
-        let avg = sum / (N as f32 * contrib.len() as f32);
+        let avg = sum / (VOXEL_SAMPLES as f32 * contrib.len() as f32);
         let min = if avg > 0.0 { 0.001 * avg } else { 1.0 };
         for c in &mut contrib {
             *c = c.max(min);

@@ -7,9 +7,11 @@ mod distribution;
 pub use distribution::{LightSampler, LightSamplerKind};
 
 use crate::render::accel::Geometry;
-use crate::render::geometry::{luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray};
+use crate::render::geometry::{
+    gamma, luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray,
+};
 use crate::render::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
-use crate::render::shapes::{area_to_solid_angle, intersect_triangle, SurfacePoint};
+use crate::render::shapes::{intersect_triangle, ShapeSample, SurfacePoint};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -20,6 +22,31 @@ pub enum AreaShape {
     Sphere(u32),
 }
 
+/// World-space vertices of a triangle light, cached so that sampling it does
+/// not go through the mesh; `n` is its oriented unit normal when that is the
+/// same over the whole triangle (always, unless per-vertex normals disagree
+/// in orientation), else zero.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TriangleCache {
+    pub p: [Vec3; 3],
+    pub n: Vec3,
+}
+
+impl TriangleCache {
+    pub fn new(geom: &Geometry, mesh: u32, tri: u32) -> TriangleCache {
+        let m = &geom.meshes[mesh as usize];
+        let p = m.vertices(tri);
+        let corners =
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|b| m.oriented_normal(tri, b));
+        let constant =
+            corners[0] == corners[1] && corners[1] == corners[2] && corners[0].is_finite();
+        TriangleCache {
+            p,
+            n: if constant { corners[0] } else { Vec3::ZERO },
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub enum Light {
     Area {
@@ -28,6 +55,7 @@ pub enum Light {
         two_sided: bool,
         n_samples: u32,
         area: f32,
+        tri: TriangleCache,
     },
     Point {
         p: Vec3,
@@ -126,6 +154,55 @@ impl Light {
         }
     }
 
+    /// A cheap estimate of luminance(Li)/pdf at a point in space, for the
+    /// spatial light distribution: the same sampling as `sample_li`, with no
+    /// shadow ray and no error bounds (pbrt-v3 also ignores visibility here).
+    pub fn contribution_estimate(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
+        let c = match *self {
+            Light::Area {
+                shape: AreaShape::Triangle { mesh, tri: t },
+                l,
+                two_sided,
+                area,
+                tri,
+                ..
+            } => {
+                let b = crate::render::sampling::uniform_sample_triangle(u);
+                let [p0, p1, p2] = tri.p;
+                let q = b.x * p0 + b.y * p1 + (1.0 - b.x - b.y) * p2;
+                let d = q - p;
+                let dist2 = d.length_squared();
+                let n = if tri.n != Vec3::ZERO {
+                    tri.n
+                } else {
+                    geom.meshes[mesh as usize].oriented_normal(t, [b.x, b.y, 1.0 - b.x - b.y])
+                };
+                let cos = -n.dot(d) / dist2.sqrt();
+                if dist2 == 0.0 || (!two_sided && cos <= 0.0) {
+                    return 0.0;
+                }
+                luminance(l) * cos.abs() * area / dist2
+            }
+            _ => {
+                let r = SurfacePoint {
+                    p,
+                    p_error: Vec3::ZERO,
+                    n: Vec3::ZERO,
+                    ns: Vec3::ZERO,
+                };
+                match self.sample_li(&r, u, geom) {
+                    Some(s) if s.pdf > 0.0 => luminance(s.li) / s.pdf,
+                    _ => 0.0,
+                }
+            }
+        };
+        if c.is_finite() {
+            c.max(0.0)
+        } else {
+            0.0
+        }
+    }
+
     /// Sample incident light at `r` (pbrt-v3's Sample_Li). Visibility is not
     /// tested here: the caller traces `shadow`.
     #[inline]
@@ -135,11 +212,32 @@ impl Light {
                 shape,
                 l,
                 two_sided,
+                area,
+                tri: cache,
                 ..
             } => {
                 let s = match shape {
                     AreaShape::Triangle { mesh, tri } => {
-                        let s = geom.meshes[mesh as usize].sample_area(tri, u);
+                        let s = if cache.n != Vec3::ZERO {
+                            // pbrt-v3 Triangle::Sample from the cached vertices.
+                            let b = crate::render::sampling::uniform_sample_triangle(u);
+                            let b = [b.x, b.y, 1.0 - b.x - b.y];
+                            let [p0, p1, p2] = cache.p;
+                            let p = b[0] * p0 + b[1] * p1 + b[2] * p2;
+                            let p_error = gamma(6)
+                                * ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs());
+                            ShapeSample {
+                                point: SurfacePoint {
+                                    p,
+                                    p_error,
+                                    n: cache.n,
+                                    ns: cache.n,
+                                },
+                                pdf: 1.0 / area,
+                            }
+                        } else {
+                            geom.meshes[mesh as usize].sample_area(tri, u)
+                        };
                         crate::render::shapes::to_solid_angle(r.p, s)?
                     }
                     AreaShape::Sphere(i) => {
@@ -236,16 +334,20 @@ impl Light {
     #[inline]
     pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
         match *self {
-            Light::Area { shape, area, .. } => {
+            Light::Area { shape, tri, .. } => {
                 let ray = spawn_ray(r.p, r.p_error, r.n, wi);
                 match shape {
-                    AreaShape::Triangle { mesh, tri } => {
-                        let m = &geom.meshes[mesh as usize];
-                        let [p0, p1, p2] = m.vertices(tri);
+                    AreaShape::Triangle { .. } => {
+                        let [p0, p1, p2] = tri.p;
                         match intersect_triangle(ray.o, ray.d, ray.t_max, p0, p1, p2) {
-                            Some((_, b)) => {
-                                let h = m.surface_point(tri, b);
-                                area_to_solid_angle(r.p, h.p, h.n, 1.0 / area)
+                            // dist²/(|cos θ'|·area) = 2t²/|(e1×e2)·d| for unit d.
+                            Some((t, _)) => {
+                                let pdf = 2.0 * t * t / (p1 - p0).cross(p2 - p0).dot(ray.d).abs();
+                                if pdf.is_finite() {
+                                    pdf
+                                } else {
+                                    0.0
+                                }
                             }
                             None => 0.0,
                         }

@@ -77,6 +77,15 @@ impl TriangleMesh {
         (n, n)
     }
 
+    /// The oriented geometric normal at barycentrics `b` (no position, no
+    /// error bound: for estimates).
+    #[inline]
+    pub fn oriented_normal(&self, tri: u32, b: [f32; 3]) -> Vec3 {
+        let [p0, p1, p2] = self.vertices(tri);
+        let geometric = (p0 - p2).cross(p1 - p2).normalize();
+        self.normals_at(tri, b, geometric).0
+    }
+
     /// The surface point at barycentrics `b` (b0 + b1 + b2 = 1).
     #[inline]
     pub fn surface_point(&self, tri: u32, b: [f32; 3]) -> SurfacePoint {
