@@ -245,7 +245,7 @@ impl Light {
                     }
                 };
                 let d = s.point.p - r.p;
-                if d.length_squared() == 0.0 || !(s.pdf > 0.0) {
+                if d.length_squared() == 0.0 || s.pdf.is_nan() || s.pdf <= 0.0 {
                     return None;
                 }
                 let wi = d.normalize();

@@ -49,10 +49,9 @@ impl TriangleMesh {
     /// triangles are left out of the scene (they can never be seen).
     pub fn is_degenerate(&self, tri: u32) -> bool {
         let [p0, p1, p2] = self.vertices(tri);
-        let c = (p0 - p2).cross(p1 - p2);
-        !(p0.is_finite() && p1.is_finite() && p2.is_finite())
-            || !(c.length_squared() > 0.0)
-            || !c.length_squared().is_finite()
+        let l2 = (p0 - p2).cross(p1 - p2).length_squared();
+        let finite = p0.is_finite() && p1.is_finite() && p2.is_finite() && l2.is_finite();
+        !finite || l2 <= 0.0
     }
 
     /// Oriented normals at barycentrics (b0, b1, b2), as pbrt-v3's triangle.cpp.
