@@ -111,7 +111,7 @@ fn child(o: &Opts) -> Result<(), String> {
     let mut err = (f64::NAN, f64::NAN);
     if let Some(stem) = reference_stem(scene) {
         let ref_path = Path::new("scenes/references").join(format!("{stem}-128-16384.pfm"));
-        if let (Ok(r), true) = (read_image(&ref_path), o.res % 128 == 0) {
+        if let (Ok(r), true) = (read_image(&ref_path), o.res.is_multiple_of(128)) {
             let c = compare(&downsample(&img, o.res / 128), &r);
             err = (c.relative_mse, c.block_error);
         }
