@@ -680,6 +680,14 @@ impl<'s, 'c> Builder<'s, 'c> {
         let (desc, kind) = entities::material(self.ctx, spec, &lookup);
         if self.reported_materials.insert(spec.stmt) {
             if let Some(p) = mat_params {
+                if overrides {
+                    // pbrt-v3 does not report material parameters a shape overrode.
+                    for q in &p.items {
+                        if shape_params.get(&q.name).is_some() {
+                            q.used.set(true);
+                        }
+                    }
+                }
                 self.ctx
                     .report_unused_except(p, &format!("Material \"{}\"", spec.ty), &["type"]);
             }
