@@ -785,11 +785,19 @@ fn triangle_mesh(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> 
     {
         Some(q) => {
             q.used.set(true);
+            let n = to_vec3(q.nums());
             if q.count() != nv {
                 ctx.warn(q.values_loc, format!("\"N\" has {} normals but \"P\" has {nv} vertices: normals dropped (as pbrt-v3)", q.count()), "count mismatch");
                 None
+            } else if n.iter().any(|v| !v.is_finite() || *v == Vec3::ZERO) {
+                ctx.warn(
+                    q.values_loc,
+                    "\"N\" has a zero or non-finite normal: normals dropped",
+                    "bad normal",
+                );
+                None
             } else {
-                Some(to_vec3(q.nums()))
+                Some(n)
             }
         }
         None => None,

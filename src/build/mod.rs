@@ -101,7 +101,7 @@ impl Ctx {
 
 /// Reads, parses and builds a scene file.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadFailure> {
-    let text = match std::fs::read(path) {
+    let text = match DiskLoader.load(path) {
         Ok(b) => b,
         Err(e) => {
             return Err(plain_failure(

@@ -445,7 +445,9 @@ impl<'s, 'c> Builder<'s, 'c> {
                 if self.ctm[0] != self.ctm[1] {
                     self.ctx.warn(s.loc, "animated light transform: the start transform is used", "this LightSource");
                 }
-                if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
+                if !self.ctm[0].is_finite() {
+                    self.ctx.error(s.loc, "the light's transform has non-finite entries (overflow in the transform statements)", "this LightSource", None);
+                } else if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
                     self.lights.push(l);
                 }
                 self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
@@ -578,6 +580,10 @@ impl<'s, 'c> Builder<'s, 'c> {
                 "this ObjectInstance",
             );
         }
+        if !self.ctm[0].is_finite() {
+            self.ctx.error(n.loc, "the instance transform has non-finite entries (overflow in the transform statements)", "this ObjectInstance", None);
+            return;
+        }
         self.instances.push(InstanceDesc {
             object: index,
             instance_to_world: self.ctm[0],
@@ -619,6 +625,11 @@ impl<'s, 'c> Builder<'s, 'c> {
         let Directive::Entity { name, params } = &stmts[i].dir else {
             return None;
         };
+        if !ctm.is_finite() {
+            self.ctx.error(stmts[i].loc, "the shape's transform has non-finite entries (overflow in the transform statements)", "this Shape", None);
+            params.mark_all_used();
+            return None;
+        }
         let geometry = entities::geometry(self.ctx, name, params, &mut self.meshes);
         let Some(geometry) = geometry else {
             if matches!(name.value.as_str(), "sphere" | "trianglemesh" | "plymesh") {

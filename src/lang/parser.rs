@@ -177,6 +177,12 @@ pub struct DiskLoader;
 
 impl FileLoader for DiskLoader {
     fn load(&self, path: &Path) -> Result<Vec<u8>, String> {
+        // Only regular files: a device or a FIFO could be endless.
+        match std::fs::metadata(path) {
+            Ok(m) if !m.is_file() => return Err("not a regular file".into()),
+            Err(e) => return Err(e.to_string()),
+            Ok(_) => {}
+        }
         std::fs::read(path).map_err(|e| e.to_string())
     }
 }
