@@ -382,6 +382,14 @@ fn materials_and_substitutes() {
         "{w}"
     );
     assert!(!w.contains("not used"), "{w}");
+    // A shape parameter that nothing uses is reported even when the material is substituted.
+    let s = load("WorldBegin\nMaterial \"metal\"\nShape \"sphere\" \"float radiuss\" 2\nWorldEnd");
+    assert!(
+        warnings(&s)
+            .contains("mem.pbrt:3:16: parameter \"float radiuss\" not used by Shape \"sphere\""),
+        "{}",
+        warnings(&s)
+    );
     let (u, w) = m("\"BUSH1\"");
     assert_eq!(
         u,

@@ -316,10 +316,9 @@ impl Lookup<'_> {
         }
     }
 
+    /// Marks the material's own parameters (not the shape's) used.
     fn mark_all(&self) {
-        for l in self.lists() {
-            l.mark_all_used();
-        }
+        self.second.mark_all_used();
     }
 }
 
@@ -469,6 +468,14 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
                 glam::DVec4::W,
             );
             let light_to_world = ctm * DMat4::from_translation(from) * frame;
+            if !light_to_world.is_finite() {
+                ctx.warn(
+                    name.loc,
+                    "spot light transform is not finite (from/to too large): skipped",
+                    "degenerate spot light",
+                );
+                return None;
+            }
             Some(LightDesc::Spot {
                 light_to_world,
                 intensity: i,
