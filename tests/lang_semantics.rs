@@ -290,6 +290,12 @@ fn lights() {
     ));
     assert!(matches!(l[3], LightDesc::Infinite { n_samples: 1, .. }));
     assert!(warnings(&s).contains("\"goniometric\" is not supported"));
+    // pbrt-v3 point.cpp: Translate(from) · CTM, so `from` is not scaled by the CTM.
+    let s = load("WorldBegin\nTranslate 1 0 0\nScale 2 2 2\nLightSource \"point\" \"point from\" [0 1 0]\nWorldEnd");
+    let LightDesc::Point { position, .. } = s.scene.lights[0] else {
+        panic!()
+    };
+    assert!(close(position, DVec3::new(1.0, 1.0, 0.0)), "{position}");
 }
 
 #[test]

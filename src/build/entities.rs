@@ -433,8 +433,10 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
         "point" => {
             let i = spectrum(ctx, p, "I", Vec3::ONE) * light_scale(ctx, p);
             let from = point3(p, "from", DVec3::ZERO);
+            // pbrt-v3 point.cpp: light-to-world = Translate(from) · CTM, so the light
+            // sits at CTM·origin + from (not CTM·from when the CTM scales or rotates).
             Some(LightDesc::Point {
-                position: ctm.transform_point3(from),
+                position: ctm.transform_point3(DVec3::ZERO) + from,
                 intensity: i,
             })
         }
