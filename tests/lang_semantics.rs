@@ -705,3 +705,24 @@ fn diagnostics_print_file_line_col() {
     assert!(out.contains("x.pbrt:3:1"), "{out}");
     assert!(out.contains("[x.pbrt:3:1]"), "{out}");
 }
+
+#[test]
+fn snippets_of_very_long_lines_are_cut() {
+    let text = format!(
+        "WorldBegin Shape \"trianglemesh\" \"point P\" [{} 1.2.3 ] WorldEnd",
+        "0.5 ".repeat(100_000)
+    );
+    let f = load_scene_str(&text, Path::new("long.pbrt")).err().unwrap();
+    let handler =
+        miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor());
+    let mut out = String::new();
+    handler
+        .render_report(&mut out, f.errors[0].as_ref())
+        .unwrap();
+    assert!(
+        out.contains("long.pbrt:1:400045: bad number `1.2.3`"),
+        "{}",
+        &out[..out.len().min(500)]
+    );
+    assert!(out.len() < 2000, "snippet of {} bytes", out.len());
+}
