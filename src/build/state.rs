@@ -242,7 +242,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 "the file ends without WorldEnd: the scene is loaded anyway",
                 "last statement",
             );
-            self.end_world(loc);
+            self.end_world();
         }
         if !self.world_seen {
             let loc = stmts.last().map(|s| s.loc).unwrap_or_default();
@@ -354,7 +354,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                     self.ctx.warn(s.loc, "WorldEnd without WorldBegin is ignored", "no world block is open");
                     return;
                 }
-                self.end_world(s.loc);
+                self.end_world();
             }
             K::AttributeBegin | K::TransformBegin => {
                 let kind = if s.kind == K::AttributeBegin { FrameKind::Attribute } else { FrameKind::Transform };
@@ -396,9 +396,8 @@ impl<'s, 'c> Builder<'s, 'c> {
             }
             K::ReverseOrientation => self.graphics.reverse = !self.graphics.reverse,
             K::Material => {
-                let Directive::Entity { name, params } = &s.dir else { return };
+                let Directive::Entity { name, .. } = &s.dir else { return };
                 self.graphics.material = Rc::new(MaterialSpec::new(name.value.clone(), Some(i), name.loc, self.graphics.textures.clone(), None));
-                let _ = params;
             }
             K::MakeNamedMaterial => {
                 let Directive::Entity { name, params } = &s.dir else { return };
@@ -520,7 +519,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         }
     }
 
-    fn end_world(&mut self, loc: Loc) {
+    fn end_world(&mut self) {
         if let Some((name, def)) = self.current_object.take() {
             self.ctx.warn(def.loc, format!("object \"{name}\" is not closed by ObjectEnd before the end of the world block; its definition is dropped"), "ObjectBegin without ObjectEnd");
         }
@@ -534,7 +533,6 @@ impl<'s, 'c> Builder<'s, 'c> {
                 "unclosed",
             );
         }
-        let _ = loc;
         self.phase = Phase::After;
         self.world_ended = true;
     }
@@ -592,9 +590,8 @@ impl<'s, 'c> Builder<'s, 'c> {
 
     fn shape(&mut self, i: usize, s: &'s Stmt) {
         if let Some((name, def)) = &mut self.current_object {
-            if let Some((_, aloc)) = self.graphics.area_light {
+            if self.graphics.area_light.is_some() {
                 let name = name.clone();
-                let _ = aloc;
                 self.ctx.warn(s.loc, format!("area light inside the definition of object \"{name}\" is ignored (as pbrt-v3)"), "this shape is not emissive");
             }
             def.shapes.push(PendingShape {

@@ -859,14 +859,12 @@ impl<'l> Parser<'l> {
     /// Reads `[ v… ]` or one value. Returns numbers, strings and their span.
     fn values(&mut self, decl: Token, quoted: bool) -> PResult<(Vec<f64>, Vec<String>, Loc)> {
         let Some(t) = self.next() else {
-            let loc = self.eof_loc();
             self.error(
                 decl.loc,
                 "parameter has no value: the file ends",
                 "this parameter",
                 None,
             );
-            let _ = loc;
             return Err(());
         };
         match t.kind {
