@@ -367,7 +367,16 @@ impl<'l> Parser<'l> {
                 if parse_number(word.as_bytes()).is_ok() {
                     self.error(tok.loc, format!("unexpected number `{word}`: expected a directive"), "a directive name was expected here", Some("values of a parameter list must follow its \"type name\" string, inside [ ] if there are several".into()));
                 } else {
-                    let help = did_you_mean(&word).map(|s| format!("did you mean `{s}`?"));
+                    let help = if matches!(
+                        word.as_str(),
+                        "Import" | "ColorSpace" | "Option" | "Attribute"
+                    ) {
+                        Some(format!(
+                            "`{word}` is a pbrt-v4 directive; pbrs reads the pbrt-v3 format"
+                        ))
+                    } else {
+                        did_you_mean(&word).map(|s| format!("did you mean `{s}`?"))
+                    };
                     self.error(
                         tok.loc,
                         format!("unknown directive `{word}`"),
