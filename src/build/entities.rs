@@ -316,10 +316,9 @@ impl Lookup<'_> {
         }
     }
 
+    /// Marks the material's own parameters (not the shape's) used.
     fn mark_all(&self) {
-        for l in self.lists() {
-            l.mark_all_used();
-        }
+        self.second.mark_all_used();
     }
 }
 
@@ -434,8 +433,10 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
         "point" => {
             let i = spectrum(ctx, p, "I", Vec3::ONE) * light_scale(ctx, p);
             let from = point3(p, "from", DVec3::ZERO);
+            // pbrt-v3 point.cpp: light-to-world = Translate(from) · CTM, so the light
+            // sits at CTM·origin + from (not CTM·from when the CTM scales or rotates).
             Some(LightDesc::Point {
-                position: ctm.transform_point3(from),
+                position: ctm.transform_point3(DVec3::ZERO) + from,
                 intensity: i,
             })
         }
@@ -469,6 +470,14 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
                 glam::DVec4::W,
             );
             let light_to_world = ctm * DMat4::from_translation(from) * frame;
+            if !light_to_world.is_finite() {
+                ctx.warn(
+                    name.loc,
+                    "spot light transform is not finite (from/to too large): skipped",
+                    "degenerate spot light",
+                );
+                return None;
+            }
             Some(LightDesc::Spot {
                 light_to_world,
                 intensity: i,
@@ -785,11 +794,19 @@ fn triangle_mesh(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> 
     {
         Some(q) => {
             q.used.set(true);
+            let n = to_vec3(q.nums());
             if q.count() != nv {
                 ctx.warn(q.values_loc, format!("\"N\" has {} normals but \"P\" has {nv} vertices: normals dropped (as pbrt-v3)", q.count()), "count mismatch");
                 None
+            } else if n.iter().any(|v| !v.is_finite() || *v == Vec3::ZERO) {
+                ctx.warn(
+                    q.values_loc,
+                    "\"N\" has a zero or non-finite normal: normals dropped",
+                    "bad normal",
+                );
+                None
             } else {
-                Some(to_vec3(q.nums()))
+                Some(n)
             }
         }
         None => None,

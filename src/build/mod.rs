@@ -101,7 +101,8 @@ impl Ctx {
 
 /// Reads, parses and builds a scene file.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadFailure> {
-    let text = match std::fs::read(path) {
+    // The user named this file, so a pipe is fine here (unlike Include targets).
+    let text = match std::fs::read(path).map_err(|e| e.to_string()) {
         Ok(b) => b,
         Err(e) => {
             return Err(plain_failure(

@@ -354,7 +354,7 @@ pub fn read_ply(data: &[u8]) -> Result<PlyMesh, String> {
                     _ => skipped_polys += 1,
                 }
             }
-        } else {
+        } else if !el.props.is_empty() {
             for _ in 0..el.count {
                 for p in &el.props {
                     read_prop(&mut r, p)?;
@@ -440,5 +440,14 @@ mod tests {
         assert!(read_ply(&huge).is_err());
         assert!(read_ply(b"ply\nformat ascii 1.0\nend_header\n").is_err());
         assert!(read_ply(b"hello").is_err());
+        // An element without properties and an absurd count is skipped at once.
+        let at = good
+            .windows(14)
+            .position(|w| w == b"element face 1")
+            .unwrap();
+        let mut empty = good[..at].to_vec();
+        empty.extend_from_slice(b"element junk 18446744073709551615\n");
+        empty.extend_from_slice(&good[at..]);
+        assert_eq!(read_ply(&empty).unwrap().mesh.triangle_count(), 1);
     }
 }

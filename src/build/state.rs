@@ -242,7 +242,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 "the file ends without WorldEnd: the scene is loaded anyway",
                 "last statement",
             );
-            self.end_world(loc);
+            self.end_world();
         }
         if !self.world_seen {
             let loc = stmts.last().map(|s| s.loc).unwrap_or_default();
@@ -354,7 +354,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                     self.ctx.warn(s.loc, "WorldEnd without WorldBegin is ignored", "no world block is open");
                     return;
                 }
-                self.end_world(s.loc);
+                self.end_world();
             }
             K::AttributeBegin | K::TransformBegin => {
                 let kind = if s.kind == K::AttributeBegin { FrameKind::Attribute } else { FrameKind::Transform };
@@ -396,9 +396,8 @@ impl<'s, 'c> Builder<'s, 'c> {
             }
             K::ReverseOrientation => self.graphics.reverse = !self.graphics.reverse,
             K::Material => {
-                let Directive::Entity { name, params } = &s.dir else { return };
+                let Directive::Entity { name, .. } = &s.dir else { return };
                 self.graphics.material = Rc::new(MaterialSpec::new(name.value.clone(), Some(i), name.loc, self.graphics.textures.clone(), None));
-                let _ = params;
             }
             K::MakeNamedMaterial => {
                 let Directive::Entity { name, params } = &s.dir else { return };
@@ -445,7 +444,9 @@ impl<'s, 'c> Builder<'s, 'c> {
                 if self.ctm[0] != self.ctm[1] {
                     self.ctx.warn(s.loc, "animated light transform: the start transform is used", "this LightSource");
                 }
-                if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
+                if !self.ctm[0].is_finite() {
+                    self.ctx.error(s.loc, "the light's transform has non-finite entries (overflow in the transform statements)", "this LightSource", None);
+                } else if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
                     self.lights.push(l);
                 }
                 self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
@@ -518,7 +519,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         }
     }
 
-    fn end_world(&mut self, loc: Loc) {
+    fn end_world(&mut self) {
         if let Some((name, def)) = self.current_object.take() {
             self.ctx.warn(def.loc, format!("object \"{name}\" is not closed by ObjectEnd before the end of the world block; its definition is dropped"), "ObjectBegin without ObjectEnd");
         }
@@ -532,7 +533,6 @@ impl<'s, 'c> Builder<'s, 'c> {
                 "unclosed",
             );
         }
-        let _ = loc;
         self.phase = Phase::After;
         self.world_ended = true;
     }
@@ -578,6 +578,10 @@ impl<'s, 'c> Builder<'s, 'c> {
                 "this ObjectInstance",
             );
         }
+        if !self.ctm[0].is_finite() {
+            self.ctx.error(n.loc, "the instance transform has non-finite entries (overflow in the transform statements)", "this ObjectInstance", None);
+            return;
+        }
         self.instances.push(InstanceDesc {
             object: index,
             instance_to_world: self.ctm[0],
@@ -586,9 +590,8 @@ impl<'s, 'c> Builder<'s, 'c> {
 
     fn shape(&mut self, i: usize, s: &'s Stmt) {
         if let Some((name, def)) = &mut self.current_object {
-            if let Some((_, aloc)) = self.graphics.area_light {
+            if self.graphics.area_light.is_some() {
                 let name = name.clone();
-                let _ = aloc;
                 self.ctx.warn(s.loc, format!("area light inside the definition of object \"{name}\" is ignored (as pbrt-v3)"), "this shape is not emissive");
             }
             def.shapes.push(PendingShape {
@@ -619,6 +622,11 @@ impl<'s, 'c> Builder<'s, 'c> {
         let Directive::Entity { name, params } = &stmts[i].dir else {
             return None;
         };
+        if !ctm.is_finite() {
+            self.ctx.error(stmts[i].loc, "the shape's transform has non-finite entries (overflow in the transform statements)", "this Shape", None);
+            params.mark_all_used();
+            return None;
+        }
         let geometry = entities::geometry(self.ctx, name, params, &mut self.meshes);
         let Some(geometry) = geometry else {
             if matches!(name.value.as_str(), "sphere" | "trianglemesh" | "plymesh") {
@@ -680,6 +688,14 @@ impl<'s, 'c> Builder<'s, 'c> {
         let (desc, kind) = entities::material(self.ctx, spec, &lookup);
         if self.reported_materials.insert(spec.stmt) {
             if let Some(p) = mat_params {
+                if overrides {
+                    // pbrt-v3 does not report material parameters a shape overrode.
+                    for q in &p.items {
+                        if shape_params.get(&q.name).is_some() {
+                            q.used.set(true);
+                        }
+                    }
+                }
                 self.ctx
                     .report_unused_except(p, &format!("Material \"{}\"", spec.ty), &["type"]);
             }

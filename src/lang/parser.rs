@@ -177,6 +177,12 @@ pub struct DiskLoader;
 
 impl FileLoader for DiskLoader {
     fn load(&self, path: &Path) -> Result<Vec<u8>, String> {
+        // Only regular files: a device or a FIFO could be endless.
+        match std::fs::metadata(path) {
+            Ok(m) if !m.is_file() => return Err("not a regular file".into()),
+            Err(e) => return Err(e.to_string()),
+            Ok(_) => {}
+        }
         std::fs::read(path).map_err(|e| e.to_string())
     }
 }
@@ -361,7 +367,16 @@ impl<'l> Parser<'l> {
                 if parse_number(word.as_bytes()).is_ok() {
                     self.error(tok.loc, format!("unexpected number `{word}`: expected a directive"), "a directive name was expected here", Some("values of a parameter list must follow its \"type name\" string, inside [ ] if there are several".into()));
                 } else {
-                    let help = did_you_mean(&word).map(|s| format!("did you mean `{s}`?"));
+                    let help = if matches!(
+                        word.as_str(),
+                        "Import" | "ColorSpace" | "Option" | "Attribute"
+                    ) {
+                        Some(format!(
+                            "`{word}` is a pbrt-v4 directive; pbrs reads the pbrt-v3 format"
+                        ))
+                    } else {
+                        did_you_mean(&word).map(|s| format!("did you mean `{s}`?"))
+                    };
                     self.error(
                         tok.loc,
                         format!("unknown directive `{word}`"),
@@ -853,14 +868,12 @@ impl<'l> Parser<'l> {
     /// Reads `[ v… ]` or one value. Returns numbers, strings and their span.
     fn values(&mut self, decl: Token, quoted: bool) -> PResult<(Vec<f64>, Vec<String>, Loc)> {
         let Some(t) = self.next() else {
-            let loc = self.eof_loc();
             self.error(
                 decl.loc,
                 "parameter has no value: the file ends",
                 "this parameter",
                 None,
             );
-            let _ = loc;
             return Err(());
         };
         match t.kind {

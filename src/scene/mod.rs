@@ -246,7 +246,11 @@ pub enum LightDesc {
 #[derive(Clone, Debug)]
 pub struct ObjectDesc {
     pub name: String,
-    /// Shapes with transforms relative to the object's space.
+    /// Shapes with transforms relative to the object's space. As pbrt-v3 records
+    /// them, a shape's `object_to_world` is the CTM at its `Shape` statement inside
+    /// `ObjectBegin` (the CTM is not reset by `ObjectBegin`); its world transform is
+    /// `instance.instance_to_world * shape.object_to_world`. Area lights are never
+    /// set here (pbrt-v3 ignores them inside object definitions).
     pub shapes: Vec<ShapeDesc>,
 }
 

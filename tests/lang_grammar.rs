@@ -1,0 +1,182 @@
+//! `grammar/pbrt.ebnf` and `grammar/REFERENCE.md` are kept in step with the parser:
+//! the directive names, their operands and the parameter types must match
+//! the tables in `src/lang`.
+
+use pbrs::lang::params::TYPE_NAMES;
+use pbrs::lang::parse_text;
+use pbrs::lang::parser::{DirKind, DiskLoader, DIRECTIVES};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+fn grammar() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/pbrt.ebnf"))
+        .unwrap()
+}
+
+/// The rules of the grammar: name -> body (comments removed).
+fn rules() -> BTreeMap<String, String> {
+    let mut g = grammar();
+    while let Some(s) = g.find("(*") {
+        let e = g[s..].find("*)").map(|e| s + e + 2).unwrap_or(g.len());
+        g.replace_range(s..e, " ");
+    }
+    let mut out = BTreeMap::new();
+    for rule in g.split(';') {
+        if let Some((name, body)) = rule.split_once('=') {
+            out.insert(name.trim().to_string(), body.to_string());
+        }
+    }
+    out
+}
+
+/// Double-quoted literals of a rule body.
+fn literals(body: &str) -> Vec<String> {
+    body.split('"')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+const STATEMENT_RULES: &[&str] = &[
+    "plain",
+    "numeric",
+    "bracketed",
+    "named",
+    "include",
+    "active",
+    "medium",
+    "texture",
+    "entity",
+];
+const ACTIVE_WORDS: &[&str] = &["All", "StartTime", "EndTime"];
+
+fn grammar_directives() -> BTreeSet<String> {
+    let r = rules();
+    STATEMENT_RULES
+        .iter()
+        .flat_map(|n| literals(r.get(*n).unwrap_or_else(|| panic!("rule {n} missing"))))
+        .filter(|l| {
+            l.starts_with(|c: char| c.is_ascii_uppercase()) && !ACTIVE_WORDS.contains(&l.as_str())
+        })
+        .collect()
+}
+
+#[test]
+fn directives_match_the_parser_table() {
+    let parser: BTreeSet<String> = DIRECTIVES.iter().map(|(n, _)| n.to_string()).collect();
+    let grammar = grammar_directives();
+    assert_eq!(grammar, parser, "grammar/pbrt.ebnf and DIRECTIVES differ");
+    assert_eq!(parser.len(), 37, "pbrt-v3 has 37 directives");
+}
+
+#[test]
+fn parameter_types_match() {
+    let r = rules();
+    let grammar: BTreeSet<String> = literals(&r["type"]).into_iter().collect();
+    let parser: BTreeSet<String> = TYPE_NAMES.iter().map(|(n, _)| n.to_string()).collect();
+    assert_eq!(grammar, parser);
+}
+
+fn parses(text: &str) -> bool {
+    let (_, _, d) = parse_text(text, Path::new("g.pbrt"), &DiskLoader);
+    d.errors.is_empty()
+}
+
+/// Every directive's operands as the grammar states them are what the parser takes.
+#[test]
+fn operands_match() {
+    let r = rules();
+    let mut checked = 0;
+    // numeric: `"Name" , N * number`
+    for part in r["numeric"].split('|') {
+        let name = literals(part)[0].clone();
+        let n: usize = part
+            .split(',')
+            .nth(1)
+            .unwrap()
+            .split('*')
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap();
+        let nums = |k: usize| vec!["1"; k].join(" ");
+        assert!(
+            parses(&format!("{name} {}", nums(n))),
+            "{name} with {n} numbers"
+        );
+        assert!(
+            !parses(&format!("{name} {}", nums(n - 1))),
+            "{name} with {} numbers",
+            n - 1
+        );
+        assert!(
+            !parses(&format!("{name} [ {} ]", nums(n))),
+            "{name} with brackets"
+        );
+        checked += 1;
+    }
+    for name in literals(&r["bracketed"]) {
+        if name == "[" || name == "]" {
+            continue;
+        }
+        let nums = |k: usize| vec!["1"; k].join(" ");
+        assert!(parses(&format!("{name} [ {} ]", nums(16))), "{name}");
+        assert!(!parses(&format!("{name} [ {} ]", nums(15))), "{name} 15");
+        assert!(
+            !parses(&format!("{name} {}", nums(16))),
+            "{name} without brackets"
+        );
+        checked += 1;
+    }
+    for name in literals(&r["plain"]) {
+        assert!(parses(&name), "{name}");
+        checked += 1;
+    }
+    for name in literals(&r["named"]) {
+        assert!(parses(&format!("{name} \"x\"")), "{name}");
+        assert!(!parses(&name), "{name} without operand");
+        checked += 1;
+    }
+    for w in ACTIVE_WORDS {
+        assert!(parses(&format!("ActiveTransform {w}")));
+    }
+    assert!(!parses("ActiveTransform \"All\""));
+    assert!(parses("MediumInterface \"a\"") && parses("MediumInterface \"a\" \"b\""));
+    assert!(parses(
+        "Texture \"t\" \"float\" \"constant\" \"float value\" 1"
+    ));
+    for name in literals(&r["entity"]) {
+        assert!(
+            parses(&format!("{name} \"x\" \"float a\" 1 \"string b\" [\"c\"]")),
+            "{name}"
+        );
+        checked += 1;
+    }
+    assert_eq!(
+        checked + 4,
+        DIRECTIVES.len(),
+        "Include, ActiveTransform, MediumInterface, Texture are checked apart"
+    );
+    let _ = DirKind::Include;
+}
+
+#[test]
+fn reference_documents_every_directive_and_type() {
+    let reference =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md"))
+            .unwrap();
+    for (n, _) in DIRECTIVES {
+        assert!(
+            reference.contains(&format!("`{n}`")),
+            "REFERENCE.md lacks `{n}`"
+        );
+    }
+    for (n, _) in TYPE_NAMES {
+        assert!(
+            reference.contains(&format!("`{n}`")),
+            "REFERENCE.md lacks type `{n}`"
+        );
+    }
+}

@@ -1,0 +1,728 @@
+//! Scene building semantics, as pbrt-v3 defines them (see grammar/REFERENCE.md).
+
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use pbrs::build::{load_scene, load_scene_str, LoadedScene};
+use pbrs::scene::*;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pbrs-lang-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn load(text: &str) -> LoadedScene {
+    load_scene_str(text, Path::new("mem.pbrt")).unwrap_or_else(|f| panic!("{f:?}"))
+}
+
+fn warnings(s: &LoadedScene) -> String {
+    s.warnings
+        .iter()
+        .map(|w| w.to_string())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn errors(text: &str) -> String {
+    match load_scene_str(text, Path::new("mem.pbrt")) {
+        Ok(_) => panic!("loaded:\n{text}"),
+        Err(f) => f
+            .errors
+            .iter()
+            .map(|w| w.to_string())
+            .collect::<Vec<_>>()
+            .join("\n"),
+    }
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-9
+}
+
+#[test]
+fn defaults_without_options() {
+    let s = load("WorldBegin\nWorldEnd\n").scene;
+    assert_eq!((s.film.xresolution, s.film.yresolution), (1280, 720));
+    assert_eq!(s.film.filename, PathBuf::from("pbrt.exr"));
+    assert_eq!(s.film.cropwindow, [0.0, 1.0, 0.0, 1.0]);
+    assert_eq!(
+        s.filter,
+        FilterDesc::Box {
+            radius: Vec2::splat(0.5)
+        }
+    );
+    assert_eq!(
+        s.sampler,
+        SamplerDesc {
+            kind: SamplerKind::Halton,
+            pixel_samples: 16,
+            sample_pixel_center: false
+        }
+    );
+    assert_eq!(
+        s.integrator,
+        IntegratorDesc::Path {
+            max_depth: 5,
+            rr_threshold: 1.0,
+            light_sample_strategy: LightSampleStrategy::Spatial
+        }
+    );
+    let CameraKind::Perspective {
+        fov,
+        focal_distance,
+        ..
+    } = s.camera.kind;
+    assert_eq!((fov, focal_distance), (90.0, 1e6));
+}
+
+#[test]
+fn filters_and_samplers_defaults() {
+    let f = |t: &str| {
+        load(&format!("PixelFilter \"{t}\"\nWorldBegin\nWorldEnd"))
+            .scene
+            .filter
+    };
+    assert_eq!(
+        f("gaussian"),
+        FilterDesc::Gaussian {
+            radius: Vec2::splat(2.0),
+            alpha: 2.0
+        }
+    );
+    assert_eq!(
+        f("triangle"),
+        FilterDesc::Triangle {
+            radius: Vec2::splat(2.0)
+        }
+    );
+    assert_eq!(
+        f("mitchell"),
+        FilterDesc::Mitchell {
+            radius: Vec2::splat(2.0),
+            b: 1.0 / 3.0,
+            c: 1.0 / 3.0
+        }
+    );
+    assert_eq!(
+        f("sinc"),
+        FilterDesc::LanczosSinc {
+            radius: Vec2::splat(4.0),
+            tau: 3.0
+        }
+    );
+    let s = |t: &str| {
+        load(&format!("Sampler {t}\nWorldBegin\nWorldEnd"))
+            .scene
+            .sampler
+    };
+    assert_eq!(
+        s("\"stratified\" \"bool jitter\" \"false\" \"integer xsamples\" 2"),
+        SamplerDesc {
+            kind: SamplerKind::Stratified {
+                jitter: false,
+                xsamples: 2,
+                ysamples: 4
+            },
+            pixel_samples: 8,
+            sample_pixel_center: false
+        }
+    );
+    assert_eq!(s("\"random\"").pixel_samples, 4);
+    assert_eq!(s("\"lowdiscrepancy\"").kind, SamplerKind::ZeroTwoSequence);
+    assert_eq!(s("\"02sequence\"").kind, SamplerKind::ZeroTwoSequence);
+    assert_eq!(s("\"maxmindist\"").kind, SamplerKind::MaxMinDist);
+    assert_eq!(s("\"sobol\" \"integer pixelsamples\" 32").pixel_samples, 32);
+}
+
+#[test]
+fn integrators() {
+    let i = |t: &str| load(&format!("Integrator {t}\nWorldBegin\nWorldEnd"));
+    assert_eq!(
+        i("\"whitted\" \"integer maxdepth\" 3").scene.integrator,
+        IntegratorDesc::Whitted { max_depth: 3 }
+    );
+    assert_eq!(
+        i("\"directlighting\" \"string strategy\" \"one\"")
+            .scene
+            .integrator,
+        IntegratorDesc::DirectLighting {
+            max_depth: 5,
+            strategy: DirectStrategy::One
+        }
+    );
+    let b = i("\"bdpt\" \"integer maxdepth\" 7");
+    assert!(matches!(
+        b.scene.integrator,
+        IntegratorDesc::Path { max_depth: 7, .. }
+    ));
+    assert!(warnings(&b).contains("substituted by \"path\""));
+}
+
+#[test]
+fn transforms_post_multiply_and_transform_is_column_major() {
+    let s = load("WorldBegin\nTranslate 1 0 0\nScale 2 2 2\nShape \"sphere\"\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape \"sphere\"\nConcatTransform [2 0 0 0 0 2 0 0 0 0 2 0 0 0 0 1]\nShape \"sphere\"\nWorldEnd").scene;
+    let m = s.shapes[0].object_to_world;
+    assert!(close(
+        m.transform_point3(DVec3::X),
+        DVec3::new(3.0, 0.0, 0.0)
+    ));
+    assert!(close(
+        s.shapes[1].object_to_world.transform_point3(DVec3::ZERO),
+        DVec3::new(5.0, 6.0, 7.0)
+    ));
+    assert!(close(
+        s.shapes[2].object_to_world.transform_point3(DVec3::X),
+        DVec3::new(7.0, 6.0, 7.0)
+    ));
+}
+
+#[test]
+fn rotate_is_in_degrees() {
+    let s = load("WorldBegin\nRotate 90 0 0 1\nShape \"sphere\"\nWorldEnd").scene;
+    assert!(close(
+        s.shapes[0].object_to_world.transform_point3(DVec3::X),
+        DVec3::Y
+    ));
+}
+
+#[test]
+fn attribute_and_transform_stacks() {
+    let s = load("WorldBegin\nAttributeBegin\nTranslate 1 0 0\nMaterial \"mirror\"\nReverseOrientation\nAttributeEnd\nShape \"sphere\"\nTransformBegin\nTranslate 0 1 0\nMaterial \"glass\"\nTransformEnd\nShape \"sphere\"\nWorldEnd").scene;
+    assert_eq!(s.shapes[0].object_to_world, DMat4::IDENTITY);
+    assert!(!s.shapes[0].reverse_orientation);
+    assert_eq!(
+        s.materials[s.shapes[0].material.0 as usize],
+        MaterialDesc::Matte {
+            kd: Vec3::splat(0.5),
+            sigma: 0.0
+        }
+    );
+    // TransformEnd restores the CTM only: the material set inside stays.
+    assert_eq!(s.shapes[1].object_to_world, DMat4::IDENTITY);
+    assert!(matches!(
+        s.materials[s.shapes[1].material.0 as usize],
+        MaterialDesc::Glass { eta: 1.5, .. }
+    ));
+}
+
+#[test]
+fn camera_coordinate_system_and_world_reset() {
+    let s = load("Translate 0 0 5\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\nCoordSysTransform \"camera\"\nLightSource \"point\"\nWorldEnd").scene;
+    // Camera-to-world = inverse(CTM) = Translate(0,0,-5); the light sits at the camera.
+    assert!(close(
+        s.camera.camera_to_world.transform_point3(DVec3::ZERO),
+        DVec3::new(0.0, 0.0, -5.0)
+    ));
+    let LightDesc::Point { position, .. } = s.lights[0] else {
+        panic!()
+    };
+    assert!(close(position, DVec3::new(0.0, 0.0, -5.0)));
+    let CameraKind::Perspective { fov, .. } = s.camera.kind;
+    assert_eq!(fov, 45.0);
+}
+
+#[test]
+fn halffov_and_named_coordinate_systems() {
+    let s = load("Camera \"perspective\" \"float halffov\" 30\nWorldBegin\nTranslate 1 2 3\nCoordinateSystem \"here\"\nIdentity\nCoordSysTransform \"here\"\nShape \"sphere\"\nCoordSysTransform \"nowhere\"\nWorldEnd");
+    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind;
+    assert_eq!(fov, 60.0);
+    assert!(close(
+        s.scene.shapes[0]
+            .object_to_world
+            .transform_point3(DVec3::ZERO),
+        DVec3::new(1.0, 2.0, 3.0)
+    ));
+    assert!(
+        warnings(&s).contains("mem.pbrt:8:19: unknown coordinate system \"nowhere\""),
+        "{}",
+        warnings(&s)
+    );
+}
+
+#[test]
+fn area_light_applies_to_later_shapes_in_scope() {
+    let s = load("WorldBegin\nShape \"sphere\"\nAttributeBegin\nAreaLightSource \"area\" \"rgb L\" [1 2 3] \"float scale\" 2 \"bool twosided\" \"true\" \"integer samples\" 4\nShape \"sphere\"\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\"\nWorldEnd").scene;
+    let lit: Vec<bool> = s.shapes.iter().map(|sh| sh.area_light.is_some()).collect();
+    assert_eq!(lit, [false, true, true, false]);
+    assert_eq!(
+        s.shapes[1].area_light,
+        Some(AreaLightDesc {
+            l: Vec3::new(2.0, 4.0, 6.0),
+            two_sided: true,
+            n_samples: 4
+        })
+    );
+}
+
+#[test]
+fn lights() {
+    let s = load("WorldBegin\nTranslate 1 0 0\nLightSource \"point\" \"rgb I\" [1 1 1] \"rgb scale\" [2 2 2] \"point from\" [0 1 0]\nLightSource \"distant\" \"point from\" [0 0 0] \"point to\" [0 0 1]\nLightSource \"spot\" \"point from\" [0 0 0] \"point to\" [0 1 0] \"float coneangle\" 20\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\nLightSource \"goniometric\"\nWorldEnd");
+    let l = &s.scene.lights;
+    assert_eq!(l.len(), 4);
+    let LightDesc::Point {
+        position,
+        intensity,
+    } = l[0]
+    else {
+        panic!()
+    };
+    assert!(close(position, DVec3::new(1.0, 1.0, 0.0)));
+    assert_eq!(intensity, Vec3::splat(2.0));
+    let LightDesc::Distant { direction, .. } = l[1] else {
+        panic!()
+    };
+    assert!(close(direction, DVec3::new(0.0, 0.0, -1.0)));
+    let LightDesc::Spot {
+        light_to_world,
+        cone_angle,
+        ..
+    } = l[2]
+    else {
+        panic!()
+    };
+    assert_eq!(cone_angle, 20.0);
+    // The spot's +z axis points from `from` to `to`, its origin at CTM·from.
+    assert!(close(light_to_world.transform_vector3(DVec3::Z), DVec3::Y));
+    assert!(close(
+        light_to_world.transform_point3(DVec3::ZERO),
+        DVec3::X
+    ));
+    assert!(matches!(l[3], LightDesc::Infinite { n_samples: 1, .. }));
+    assert!(warnings(&s).contains("\"goniometric\" is not supported"));
+    // pbrt-v3 point.cpp: Translate(from) · CTM, so `from` is not scaled by the CTM.
+    let s = load("WorldBegin\nTranslate 1 0 0\nScale 2 2 2\nLightSource \"point\" \"point from\" [0 1 0]\nWorldEnd");
+    let LightDesc::Point { position, .. } = s.scene.lights[0] else {
+        panic!()
+    };
+    assert!(close(position, DVec3::new(1.0, 1.0, 0.0)), "{position}");
+}
+
+#[test]
+fn colours() {
+    let kd = |p: &str| match load(&format!(
+        "WorldBegin\nMaterial \"matte\" {p}\nShape \"sphere\"\nWorldEnd"
+    ))
+    .scene
+    .materials[0]
+    {
+        MaterialDesc::Matte { kd, .. } => kd,
+        m => panic!("{m:?}"),
+    };
+    assert_eq!(kd("\"color Kd\" [0.1 0.2 0.3]"), Vec3::new(0.1, 0.2, 0.3));
+    let x = kd("\"xyz Kd\" [0.9505 1 1.089]");
+    assert!((x - Vec3::ONE).abs().max_element() < 0.01, "{x}");
+    let b = kd("\"blackbody Kd\" [3000 1]");
+    assert!(b.x > b.y && b.y > b.z, "{b}");
+    let flat = kd("\"spectrum Kd\" [400 0.5 700 0.5]");
+    let y = 0.2126 * flat.x + 0.7152 * flat.y + 0.0722 * flat.z;
+    assert!((y - 0.5).abs() < 0.02, "{flat}");
+    let s = load(
+        "WorldBegin\nMaterial \"matte\" \"spectrum Kd\" \"metal.spd\"\nShape \"sphere\"\nWorldEnd",
+    );
+    assert!(warnings(&s).contains("spectrum files are not supported"));
+    assert_eq!(
+        s.scene.materials[0],
+        MaterialDesc::Matte {
+            kd: Vec3::splat(0.5),
+            sigma: 0.0
+        }
+    );
+}
+
+#[test]
+fn materials_and_substitutes() {
+    let m = |t: &str| {
+        let s = load(&format!(
+            "WorldBegin\nMaterial {t}\nShape \"sphere\"\nWorldEnd"
+        ));
+        (s.scene.materials[0], warnings(&s))
+    };
+    assert_eq!(
+        m("\"glass\"").0,
+        MaterialDesc::Glass {
+            kr: Vec3::ONE,
+            kt: Vec3::ONE,
+            eta: 1.5
+        }
+    );
+    assert_eq!(
+        m("\"glass\" \"float index\" 1.33").0,
+        MaterialDesc::Glass {
+            kr: Vec3::ONE,
+            kt: Vec3::ONE,
+            eta: 1.33
+        }
+    );
+    assert_eq!(
+        m("\"glass\" \"float eta\" 2 \"float index\" 1.2").0,
+        MaterialDesc::Glass {
+            kr: Vec3::ONE,
+            kt: Vec3::ONE,
+            eta: 2.0
+        }
+    );
+    let (g, w) = m("\"glass\" \"float uroughness\" 0.1");
+    assert!(
+        matches!(g, MaterialDesc::Glass { .. }) && w.contains("treated as smooth"),
+        "{w}"
+    );
+    assert_eq!(
+        m("\"mirror\"").0,
+        MaterialDesc::Mirror {
+            kr: Vec3::splat(0.9)
+        }
+    );
+    assert_eq!(m("\"none\"").0, MaterialDesc::None);
+    assert_eq!(m("\"\"").0, MaterialDesc::None);
+    let (p, w) = m("\"plastic\" \"rgb Kd\" [0.1 0.2 0.3] \"float roughness\" 0.01");
+    assert_eq!(
+        p,
+        MaterialDesc::Matte {
+            kd: Vec3::new(0.1, 0.2, 0.3),
+            sigma: 0.0
+        }
+    );
+    assert!(
+        w.contains("\"plastic\" is not supported by pbrs: substituted by a matte"),
+        "{w}"
+    );
+    assert!(!w.contains("not used"), "{w}");
+    // A shape parameter that nothing uses is reported even when the material is substituted.
+    let s = load("WorldBegin\nMaterial \"metal\"\nShape \"sphere\" \"float radiuss\" 2\nWorldEnd");
+    assert!(
+        warnings(&s)
+            .contains("mem.pbrt:3:16: parameter \"float radiuss\" not used by Shape \"sphere\""),
+        "{}",
+        warnings(&s)
+    );
+    let (u, w) = m("\"BUSH1\"");
+    assert_eq!(
+        u,
+        MaterialDesc::Matte {
+            kd: Vec3::splat(0.5),
+            sigma: 0.0
+        }
+    );
+    assert!(w.contains("unknown material type \"BUSH1\""), "{w}");
+    assert_eq!(
+        m("\"matte\" \"float sigma\" 20").0,
+        MaterialDesc::Matte {
+            kd: Vec3::splat(0.5),
+            sigma: 20.0
+        }
+    );
+}
+
+#[test]
+fn textures_constant_and_unsupported() {
+    let s = load("WorldBegin\nTexture \"c\" \"color\" \"constant\" \"rgb value\" [0.1 0.2 0.3]\nTexture \"s\" \"float\" \"constant\" \"float value\" 10\nTexture \"img\" \"color\" \"imagemap\" \"string filename\" \"a.png\"\nMaterial \"matte\" \"texture Kd\" \"c\" \"texture sigma\" \"s\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"img\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"missing\"\nShape \"sphere\"\nWorldEnd");
+    let m = &s.scene.materials;
+    assert_eq!(
+        m[0],
+        MaterialDesc::Matte {
+            kd: Vec3::new(0.1, 0.2, 0.3),
+            sigma: 10.0
+        }
+    );
+    assert_eq!(
+        m[1],
+        MaterialDesc::Matte {
+            kd: Vec3::splat(0.5),
+            sigma: 0.0
+        }
+    );
+    assert_eq!(m.len(), 2, "the default-valued materials are one");
+    let w = warnings(&s);
+    assert!(
+        w.contains("texture class \"imagemap\" is not supported"),
+        "{w}"
+    );
+    assert!(w.contains("unknown spectrum texture \"missing\""), "{w}");
+}
+
+#[test]
+fn named_materials_are_scoped_and_unused_ones_left_out() {
+    let s = load("WorldBegin\nMakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [1 0 0]\nMakeNamedMaterial \"unused\" \"string type\" \"mirror\"\nAttributeBegin\nMakeNamedMaterial \"inner\" \"string type\" \"glass\"\nAttributeEnd\nNamedMaterial \"red\"\nShape \"sphere\"\nWorldEnd");
+    assert_eq!(
+        s.scene.materials,
+        vec![MaterialDesc::Matte {
+            kd: Vec3::X,
+            sigma: 0.0
+        }]
+    );
+    let skipped = s.scene.skipped.join("\n");
+    assert!(skipped.contains("named material \"unused\""), "{skipped}");
+    assert!(skipped.contains("named material \"inner\""), "{skipped}");
+    let e = errors("WorldBegin\nAttributeBegin\nMakeNamedMaterial \"inner\" \"string type\" \"glass\"\nAttributeEnd\nNamedMaterial \"inner\"\nWorldEnd");
+    assert!(
+        e.contains("mem.pbrt:5:15: unknown named material \"inner\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn shape_parameters_override_the_material() {
+    let s = load("WorldBegin\nMaterial \"matte\" \"rgb Kd\" [1 0 0]\nShape \"sphere\" \"rgb Kd\" [0 1 0]\nShape \"sphere\"\nWorldEnd");
+    let m = |i: usize| s.scene.materials[s.scene.shapes[i].material.0 as usize];
+    assert_eq!(
+        m(0),
+        MaterialDesc::Matte {
+            kd: Vec3::Y,
+            sigma: 0.0
+        }
+    );
+    assert_eq!(
+        m(1),
+        MaterialDesc::Matte {
+            kd: Vec3::X,
+            sigma: 0.0
+        }
+    );
+    assert!(s.warnings.is_empty(), "{}", warnings(&s));
+}
+
+#[test]
+fn unused_parameters_are_reported_by_name() {
+    let s = load("Camera \"perspective\" \"float fov\" 30 \"float fovv\" 3\nWorldBegin\nShape \"sphere\" \"float radius\" 2 \"integer radius2\" 1\nLightSource \"point\" \"rgb L\" [1 1 1]\nWorldEnd");
+    let w = warnings(&s);
+    assert!(
+        w.contains("mem.pbrt:1:37: parameter \"float fovv\" not used by Camera \"perspective\""),
+        "{w}"
+    );
+    assert!(
+        w.contains("mem.pbrt:3:33: parameter \"integer radius2\" not used by Shape \"sphere\""),
+        "{w}"
+    );
+    assert!(
+        w.contains("mem.pbrt:4:21: parameter \"rgb L\" not used by LightSource \"point\""),
+        "{w}"
+    );
+}
+
+#[test]
+fn later_parameter_replaces_earlier() {
+    let s = load("Film \"image\" \"integer xresolution\" 100 \"integer xresolution\" 200\nWorldBegin\nWorldEnd");
+    assert_eq!(s.scene.film.xresolution, 200);
+    assert!(s.warnings.is_empty());
+}
+
+#[test]
+fn film_crop_and_options() {
+    let s = load("Film \"image\" \"float cropwindow\" [0.8 0.2 -1 0.5] \"string filename\" \"out.png\" \"float scale\" 2\nWorldBegin\nWorldEnd").scene;
+    assert_eq!(s.film.cropwindow, [0.2, 0.8, 0.0, 0.5]);
+    assert_eq!(s.film.filename, PathBuf::from("out.png"));
+    assert_eq!(s.film.scale, 2.0);
+}
+
+#[test]
+fn triangle_mesh_details() {
+    let s = load("WorldBegin\nShape \"trianglemesh\" \"point P\" [0 0 0 1 0 0 0 1 0] \"float uv\" [0 0 1 0 0 1]\nShape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1] \"point2 st\" [0 0 1 0 0 1] \"float alpha\" 0.5\nWorldEnd");
+    let mesh = |i: usize| match &s.scene.shapes[i].geometry {
+        Geometry::TriangleMesh(m) => m.clone(),
+        g => panic!("{g:?}"),
+    };
+    assert_eq!(mesh(0).indices, vec![0, 1, 2]);
+    assert_eq!(mesh(0).uvs.as_ref().unwrap()[1], Vec2::new(1.0, 0.0));
+    assert!(mesh(1).normals.is_none());
+    assert!(mesh(1).uvs.is_some());
+    let w = warnings(&s);
+    assert!(
+        w.contains("\"N\" has 1 normals but \"P\" has 3 vertices"),
+        "{w}"
+    );
+    assert!(
+        w.contains("\"alpha\": alpha masks are not supported"),
+        "{w}"
+    );
+}
+
+#[test]
+fn sphere_parameters() {
+    let s = load("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float zmin\" 5 \"float zmax\" -1 \"float phimax\" 400\nWorldEnd");
+    let Geometry::Sphere {
+        radius,
+        z_min,
+        z_max,
+        phi_max,
+    } = s.scene.shapes[0].geometry
+    else {
+        panic!()
+    };
+    assert_eq!((radius, z_min, z_max, phi_max), (2.0, -1.0, 2.0, 360.0));
+}
+
+#[test]
+fn unsupported_shapes_and_directives_warn_and_load() {
+    let s = load("WorldBegin\nShape \"disk\" \"float radius\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"fbm\"\nShape \"sphere\"\nWorldEnd");
+    assert_eq!(s.scene.shapes.len(), 1);
+    let w = warnings(&s);
+    assert!(
+        w.contains("mem.pbrt:2:7: shape \"disk\" is not supported by pbrs: skipped"),
+        "{w}"
+    );
+    assert!(w.contains("did you mean \"cylinder\""), "{w}");
+    assert!(w.contains("participating media are not supported"), "{w}");
+    assert!(w.contains("texture class \"fbm\" is not supported"), "{w}");
+}
+
+#[test]
+fn phase_rules() {
+    let s = load("Shape \"sphere\"\nWorldBegin\nCamera \"perspective\" \"float fov\" 10\nShape \"sphere\"\nWorldEnd\nWorldBegin\nShape \"sphere\"\nWorldEnd");
+    assert_eq!(s.scene.shapes.len(), 1);
+    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind;
+    assert_eq!(fov, 90.0);
+    let w = warnings(&s);
+    assert!(
+        w.contains("mem.pbrt:1:1: `Shape` before WorldBegin is ignored"),
+        "{w}"
+    );
+    assert!(
+        w.contains("mem.pbrt:3:1: `Camera` inside the world block is ignored"),
+        "{w}"
+    );
+    assert!(
+        w.contains("mem.pbrt:6:1: `WorldBegin` after WorldEnd"),
+        "{w}"
+    );
+    let s = load("WorldBegin\nShape \"sphere\"\n");
+    assert_eq!(s.scene.shapes.len(), 1);
+    assert!(warnings(&s).contains("without WorldEnd"));
+    let s = load("WorldBegin\nAttributeBegin\nShape \"sphere\"\nWorldEnd");
+    assert!(warnings(&s).contains("mem.pbrt:2:1: AttributeBegin is not closed"));
+}
+
+#[test]
+fn motion_is_ignored_with_a_warning() {
+    let s = load("TransformTimes 0 2\nWorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\nShape \"sphere\"\nWorldEnd");
+    assert_eq!(s.scene.shapes[0].object_to_world, DMat4::IDENTITY);
+    let w = warnings(&s);
+    assert!(
+        w.contains("TransformTimes: motion blur is not supported"),
+        "{w}"
+    );
+    assert!(w.contains("animated shape transform"), "{w}");
+}
+
+#[test]
+fn object_instancing() {
+    let s = load("WorldBegin\nObjectBegin \"unused\"\nShape \"sphere\"\nObjectEnd\nTranslate 0 0 1\nObjectBegin \"thing\"\nAreaLightSource \"diffuse\"\nShape \"sphere\"\nObjectEnd\nIdentity\nTranslate 5 0 0\nObjectInstance \"thing\"\nTranslate 5 0 0\nObjectInstance \"thing\"\nWorldEnd");
+    let sc = &s.scene;
+    assert!(sc.shapes.is_empty());
+    assert_eq!(sc.objects.len(), 1, "only instanced objects are built");
+    assert_eq!(sc.objects[0].name, "thing");
+    // Object shapes keep the CTM of their definition; instances add theirs on top.
+    let sh = &sc.objects[0].shapes[0];
+    assert!(close(
+        sh.object_to_world.transform_point3(DVec3::ZERO),
+        DVec3::Z
+    ));
+    assert!(sh.area_light.is_none());
+    assert_eq!(sc.instances.len(), 2);
+    assert!(close(
+        sc.instances[1]
+            .instance_to_world
+            .transform_point3(DVec3::ZERO),
+        DVec3::new(10.0, 0.0, 0.0)
+    ));
+    assert!(sc.skipped.join("\n").contains("object \"unused\""));
+    assert!(
+        warnings(&s).contains("area light inside the definition of object \"thing\" is ignored")
+    );
+    assert_eq!(s.summary.instances, 2);
+}
+
+#[test]
+fn include_splices_and_resolves_against_the_top_level_directory() {
+    let d = tmpdir("include");
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    // sub/a.inc includes "sub/b.inc": relative to the top-level directory, not to sub/.
+    std::fs::write(d.join("sub/a.inc"), "Include \"sub/b.inc\"\n").unwrap();
+    std::fs::write(d.join("sub/b.inc"), "Shape \"sphere\"\n").unwrap();
+    std::fs::write(
+        d.join("main.pbrt"),
+        "WorldBegin\nInclude \"sub/a.inc\" \"float radius\" 3\nShape \"bogus\"\nWorldEnd\n",
+    )
+    .unwrap();
+    let s = load_scene(&d.join("main.pbrt")).unwrap_or_else(|f| panic!("{f:?}"));
+    let Geometry::Sphere { radius, .. } = s.scene.shapes[0].geometry else {
+        panic!()
+    };
+    assert_eq!(radius, 3.0);
+    std::fs::write(
+        d.join("sub/b.inc"),
+        "Shape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n",
+    )
+    .unwrap();
+    let s = load_scene(&d.join("main.pbrt")).unwrap();
+    let w = s
+        .warnings
+        .iter()
+        .find(|w| w.to_string().contains("\"float bogus\" not used"))
+        .unwrap();
+    let help = w.help().unwrap().to_string();
+    let main = d.join("main.pbrt").display().to_string();
+    let a = d.join("sub/a.inc").display().to_string();
+    assert!(help.contains(&format!("included from {a}:1:1")), "{help}");
+    assert!(
+        help.contains(&format!("included from {main}:2:1")),
+        "{help}"
+    );
+}
+
+#[test]
+fn ply_meshes_are_shared() {
+    let d = tmpdir("ply");
+    std::fs::write(d.join("tri.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uint8 int vertex_index\nend_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n").unwrap();
+    let text = "WorldBegin\nShape \"plymesh\" \"string filename\" \"tri.ply\"\nTranslate 1 0 0\nShape \"plymesh\" \"string filename\" \"tri.ply\"\nWorldEnd";
+    let s = load_scene_str(text, &d.join("scene.pbrt"))
+        .unwrap_or_else(|f| panic!("{f:?}"))
+        .scene;
+    let (Geometry::TriangleMesh(a), Geometry::TriangleMesh(b)) =
+        (&s.shapes[0].geometry, &s.shapes[1].geometry)
+    else {
+        panic!()
+    };
+    assert!(Arc::ptr_eq(a, b));
+    assert_eq!(a.normals.as_ref().unwrap()[0], Vec3::Z);
+}
+
+#[test]
+fn diagnostics_print_file_line_col() {
+    // print_diagnostics writes to stderr; here we check the rendered report text.
+    let f = load_scene_str(
+        "WorldBegin\n  Shape \"sphere\" \"float radius\" [ 1 2 ]\nShap \"x\"\nWorldEnd",
+        Path::new("x.pbrt"),
+    )
+    .err()
+    .unwrap();
+    let handler =
+        miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor());
+    let mut out = String::new();
+    handler
+        .render_report(&mut out, f.errors[0].as_ref())
+        .unwrap();
+    assert!(out.contains("x.pbrt:3:1"), "{out}");
+    assert!(out.contains("[x.pbrt:3:1]"), "{out}");
+}
+
+#[test]
+fn snippets_of_very_long_lines_are_cut() {
+    let text = format!(
+        "WorldBegin Shape \"trianglemesh\" \"point P\" [{} 1.2.3 ] WorldEnd",
+        "0.5 ".repeat(100_000)
+    );
+    let f = load_scene_str(&text, Path::new("long.pbrt")).err().unwrap();
+    let handler =
+        miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor());
+    let mut out = String::new();
+    handler
+        .render_report(&mut out, f.errors[0].as_ref())
+        .unwrap();
+    assert!(
+        out.contains("long.pbrt:1:400045: bad number `1.2.3`"),
+        "{}",
+        &out[..out.len().min(500)]
+    );
+    assert!(out.len() < 2000, "snippet of {} bytes", out.len());
+}
