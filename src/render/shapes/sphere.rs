@@ -346,7 +346,8 @@ mod tests {
         let (t, p) = s.intersect(Vec3::ZERO, Vec3::Z, f32::INFINITY).unwrap();
         assert!((t - 4.0).abs() < 1e-6);
         let sp = s.surface_point(p);
-        assert!((sp.n - (-Vec3::Z)).length() < 1e-6);
+        // pbrt nudges hits at the poles by 1e-5·r off the axis.
+        assert!((sp.n - (-Vec3::Z)).length() < 2e-5);
         // From inside, the far hit.
         let (t, _) = s
             .intersect(Vec3::new(0.0, 0.0, 5.0), Vec3::Z, f32::INFINITY)
