@@ -25,3 +25,8 @@ fn cornell_glass_matches_pbrt() {
 fn bitterli_cornell_box_matches_pbrt() {
     check("scenes/cornell-box.pbrt", "bitterli-cornell-box");
 }
+
+#[test]
+fn cornell_dragon_matches_pbrt() {
+    check("scenes/cornell-dragon.pbrt", "dezeming-cornell-dragon");
+}
