@@ -6,10 +6,10 @@ use crate::build::{load_scene, print_diagnostics};
 /// Parses and builds `args.scene` without rendering. Prints the warnings, then the
 /// summary and what was left out (exit 0), or the errors (exit 1).
 pub fn run(args: &Args) -> i32 {
-    match load_scene(&args.scene) {
+    match load_scene(args.scene_path()) {
         Ok(loaded) => {
             print_diagnostics(&loaded.warnings);
-            println!("{}", args.scene.display());
+            println!("{}", args.scene_path().display());
             println!("{}", loaded.summary);
             if !loaded.scene.skipped.is_empty() {
                 println!("left out:");
@@ -25,7 +25,7 @@ pub fn run(args: &Args) -> i32 {
             let n = failure.errors.len();
             eprintln!(
                 "{}: {n} error{}; the scene was not loaded",
-                args.scene.display(),
+                args.scene_path().display(),
                 if n == 1 { "" } else { "s" }
             );
             1

@@ -4,6 +4,7 @@ use clap::Parser;
 use std::path::PathBuf;
 
 mod check;
+pub mod converge;
 mod render;
 
 /// pbrs: render a pbrt-v3 scene.
@@ -11,11 +12,16 @@ mod render;
 #[command(
     name = "pbrs",
     version,
-    about = "A physically based renderer for pbrt-v3 scenes"
+    about = "A physically based renderer for pbrt-v3 scenes",
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
 )]
 pub struct Args {
+    #[command(subcommand)]
+    pub command: Option<Command>,
     /// The scene file (pbrt-v3 format).
-    pub scene: PathBuf,
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
     /// Parse and build the scene, print warnings and a summary, do not render.
     #[arg(long)]
     pub check: bool,
@@ -42,9 +48,25 @@ pub struct Args {
     pub stats: bool,
 }
 
+impl Args {
+    /// The scene file (clap guarantees it unless a subcommand is given).
+    pub fn scene_path(&self) -> &std::path::Path {
+        self.scene.as_deref().unwrap_or(std::path::Path::new(""))
+    }
+}
+
+#[derive(clap::Subcommand, Debug, Clone)]
+pub enum Command {
+    /// Error against run time: progressive renders compared with a reference.
+    Converge(converge::ConvergeArgs),
+}
+
 /// Runs the command line; returns the process exit status.
 pub fn main() -> i32 {
     let args = Args::parse();
+    if let Some(Command::Converge(c)) = &args.command {
+        return converge::run(c);
+    }
     if args.check {
         check::run(&args)
     } else {

@@ -17,14 +17,14 @@ fn fail(msg: impl std::fmt::Display) -> i32 {
 }
 
 pub fn run(args: &Args) -> i32 {
-    let loaded = match load_scene(&args.scene) {
+    let loaded = match load_scene(args.scene_path()) {
         Ok(l) => l,
         Err(f) => {
             print_diagnostics(&f.warnings);
             print_diagnostics(&f.errors);
             eprintln!(
                 "{}: the scene was not loaded; no image was written",
-                args.scene.display()
+                args.scene_path().display()
             );
             return 1;
         }

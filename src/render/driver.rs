@@ -54,78 +54,118 @@ struct TileCounts {
     negative: u64,
 }
 
+/// A scene compiled for rendering, with its film. Samples can be added in
+/// ranges of sample indices: the samplers are stateless per (pixel, index),
+/// so rendering indices 0..n and then n..2n gives exactly the image of a
+/// 2n-spp render (progressive rendering for convergence studies).
+pub struct Renderer {
+    scene: RenderScene,
+    integrator: Integrator,
+    film: Film,
+    sampler: Sampler,
+    pool: rayon::ThreadPool,
+    stats: RenderStats,
+}
+
+impl Renderer {
+    pub fn new(desc: &SceneDescription, opts: &RenderOptions) -> Result<Renderer, String> {
+        let t0 = Instant::now();
+        let scene = RenderScene::new(desc);
+        let mut integrator = Integrator::new(&desc.integrator, &scene);
+        let film = Film::new(&desc.film, &desc.filter);
+        let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
+        integrator.prepare_sampler(&scene, &mut sampler);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(opts.threads.unwrap_or(0))
+            .build()
+            .map_err(|e| format!("cannot start worker threads: {e}"))?;
+        let stats = RenderStats {
+            build_time: t0.elapsed(),
+            threads: pool.current_num_threads(),
+            ..Default::default()
+        };
+        Ok(Renderer {
+            scene,
+            integrator,
+            film,
+            sampler,
+            pool,
+            stats,
+        })
+    }
+
+    /// Renders sample indices `samples` of every pixel into the film.
+    /// `progress` is called with (tiles done, tiles total).
+    pub fn render_samples(
+        &mut self,
+        samples: std::ops::Range<u32>,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) {
+        let t1 = Instant::now();
+        let tiles = self.film.tiles(16);
+        let total = tiles.len();
+        // Chunks bound the memory held by finished tiles awaiting their merge.
+        let chunk = (self.stats.threads * 8).max(1);
+        let mut done = 0usize;
+        let (scene, integrator, sampler) = (&self.scene, &self.integrator, &self.sampler);
+        for group in tiles.chunks(chunk) {
+            let film = &self.film;
+            let rendered: Vec<(FilmTile, TileCounts)> = self.pool.install(|| {
+                group
+                    .par_iter()
+                    .map(|&tb| render_tile(scene, integrator, film, sampler, tb, samples.clone()))
+                    .collect()
+            });
+            for (tile, c) in rendered {
+                self.film.merge_tile(tile);
+                self.stats.rays.add(&c.rays);
+                self.stats.samples += c.samples;
+                self.stats.nan_samples += c.nan;
+                self.stats.inf_samples += c.inf;
+                self.stats.negative_samples += c.negative;
+            }
+            done += group.len();
+            progress(done, total);
+        }
+        self.stats.render_time += t1.elapsed();
+    }
+
+    pub fn image(&self) -> Image {
+        self.film.image()
+    }
+
+    /// Statistics so far, with notes on what was built.
+    pub fn stats(&self) -> RenderStats {
+        let mut stats = self.stats.clone();
+        stats.notes = self.scene.notes.clone();
+        if let Some(ls) = self.integrator.light_sampler() {
+            stats.notes.push(format!(
+                "light selection: {:?} over {} lights that emit{}",
+                ls.kind(),
+                ls.active_count(),
+                match ls.kind() {
+                    crate::render::lights::LightSamplerKind::Spatial =>
+                        format!(", {} voxel distributions built", ls.voxels_built()),
+                    _ => String::new(),
+                }
+            ));
+        }
+        stats
+    }
+}
+
 /// Renders `desc` (with its film, sampler and integrator settings as given:
 /// apply command-line overrides to the description first). `progress` is
-/// called after each tile with (tiles done, tiles total).
+/// called after each group of tiles with (tiles done, tiles total).
 pub fn render(
     desc: &SceneDescription,
     opts: &RenderOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), String> {
-    let t0 = Instant::now();
-    let scene = RenderScene::new(desc);
-    let mut integrator = Integrator::new(&desc.integrator, &scene);
-    let mut film = Film::new(&desc.film, &desc.filter);
-    let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
-    integrator.prepare_sampler(&scene, &mut sampler);
-    let build_time = t0.elapsed();
-
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    let threads = pool.current_num_threads();
-    let tiles = film.tiles(16);
-    let total = tiles.len();
-    let t1 = Instant::now();
-    let mut counts = TileCounts::default();
-    // Chunks bound the memory held by finished tiles awaiting their merge.
-    let chunk = (threads * 8).max(1);
-    let mut done = 0usize;
-    for group in tiles.chunks(chunk) {
-        let rendered: Vec<(FilmTile, TileCounts)> = pool.install(|| {
-            group
-                .par_iter()
-                .map(|&tb| render_tile(&scene, &integrator, &film, &sampler, tb))
-                .collect()
-        });
-        for (tile, c) in rendered {
-            film.merge_tile(tile);
-            counts.rays.add(&c.rays);
-            counts.samples += c.samples;
-            counts.nan += c.nan;
-            counts.inf += c.inf;
-            counts.negative += c.negative;
-        }
-        done += group.len();
-        progress(done, total);
-    }
-    let render_time = t1.elapsed();
-    let mut notes = scene.notes.clone();
-    if let Some(ls) = integrator.light_sampler() {
-        notes.push(format!(
-            "light selection: {:?} over {} lights that emit{}",
-            ls.kind(),
-            ls.active_count(),
-            match ls.kind() {
-                crate::render::lights::LightSamplerKind::Spatial =>
-                    format!(", {} voxel distributions built", ls.voxels_built()),
-                _ => String::new(),
-            }
-        ));
-    }
-    let stats = RenderStats {
-        build_time,
-        render_time,
-        rays: counts.rays,
-        samples: counts.samples,
-        nan_samples: counts.nan,
-        inf_samples: counts.inf,
-        negative_samples: counts.negative,
-        threads,
-        notes,
-    };
-    Ok((film.image(), stats))
+    let mut r = Renderer::new(desc, opts)?;
+    let spp = r.sampler.samples_per_pixel();
+    r.render_samples(0..spp, progress);
+    Ok((r.image(), r.stats()))
 }
 
 fn render_tile(
@@ -134,14 +174,14 @@ fn render_tile(
     film: &Film,
     proto: &Sampler,
     bounds: Bounds2i,
+    samples: std::ops::Range<u32>,
 ) -> (FilmTile, TileCounts) {
     let mut tile = film.tile(bounds);
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
-    let spp = sampler.samples_per_pixel();
     for pixel in bounds.iter() {
-        for i in 0..spp {
+        for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
             let cs = sampler.get_camera_sample(pixel);
             let ray = scene.camera.generate_ray(&cs);
