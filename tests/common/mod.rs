@@ -85,6 +85,17 @@ pub fn output_dir(name: &str) -> PathBuf {
     d
 }
 
+/// Whether `img` is within `b` of `reference`.
+pub fn within(img: &Image, reference: &Image, b: Bounds) -> bool {
+    let c = compare(img, reference);
+    let mean_diff = (0..3)
+        .map(|i| ((c.mean_a[i] - c.mean_r[i]) / c.mean_r[i].abs().max(1e-6)).abs())
+        .fold(0.0f64, f64::max);
+    c.relative_mse <= b.max_relative_mse
+        && c.block_error <= b.max_block_error
+        && mean_diff <= b.max_mean_difference
+}
+
 /// Compares and asserts; on failure writes render, reference and a
 /// false-colour difference image next to the test output.
 pub fn assert_matches(name: &str, img: &Image, reference: &Image, b: Bounds) -> Comparison {
