@@ -51,7 +51,7 @@ fn every_scene_has_a_golden_entry() {
             e.scene
         );
         match &e.check {
-            Check::Pbrt(stem) => assert!(repo()
+            Check::Pbrt(stem) | Check::PbrtOwnNoise(stem) => assert!(repo()
                 .join(format!("scenes/references/{stem}-128-16384.pfm"))
                 .exists()),
             Check::Pbrs(name) => assert!(
@@ -88,6 +88,7 @@ fn render_seeded(
 }
 
 fn check(kind: &str) {
+    let mut checked = 0;
     for e in manifest(&repo()) {
         let name = e
             .scene
@@ -96,14 +97,21 @@ fn check(kind: &str) {
             .replace('/', "-");
         match &e.check {
             Check::Pbrt(stem) if kind == "pbrt" => {
+                checked += 1;
                 let (img, stats) = render_seeded(&e.scene, 0);
                 assert_eq!(stats.dropped_samples(), 0, "{}", e.scene);
                 assert_matches(&name, &img, &reference(stem), Bounds::against_pbrt(stem));
             }
-            Check::Pbrs(r) if kind == "pbrs" => {
-                let reference =
-                    read_image(&repo().join(format!("scenes/references/{r}-128-pbrs.pfm")))
-                        .unwrap();
+            Check::Pbrs(_) | Check::PbrtOwnNoise(_) if kind == "own-noise" => {
+                checked += 1;
+                let reference = match &e.check {
+                    Check::Pbrs(r) => {
+                        read_image(&repo().join(format!("scenes/references/{r}-128-pbrs.pfm")))
+                            .unwrap()
+                    }
+                    Check::PbrtOwnNoise(stem) => reference(stem),
+                    _ => unreachable!(),
+                };
                 let (a, stats) = render_seeded(&e.scene, 0);
                 assert_eq!(stats.dropped_samples(), 0, "{}", e.scene);
                 // The noise of one 64-spp render, measured against a second,
@@ -123,6 +131,7 @@ fn check(kind: &str) {
             _ => {}
         }
     }
+    assert!(checked > 0, "no scene of kind {kind} was checked");
 }
 
 #[test]
@@ -131,8 +140,8 @@ fn scenes_with_pbrt_references_match() {
 }
 
 #[test]
-fn scenes_with_pbrs_references_match() {
-    check("pbrs");
+fn scenes_checked_against_their_own_noise_match() {
+    check("own-noise");
 }
 
 #[test]

@@ -9,6 +9,9 @@ pub enum Check {
     Pbrt(String),
     /// Converged pbrs reference `NAME-128-pbrs.pfm`.
     Pbrs(String),
+    /// Converged pbrt-v3 reference, with bounds from the render's own noise
+    /// (for settings whose noise differs from pbrt-v3's, e.g. another sampler).
+    PbrtOwnNoise(String),
     /// Analytic answer asserted by a test file.
     Test(String),
 }
@@ -35,6 +38,7 @@ pub fn manifest(repo: &Path) -> Vec<Entry> {
             let check = match f[1] {
                 "pbrt" => Check::Pbrt(f[2].into()),
                 "pbrs" => Check::Pbrs(f[2].into()),
+                "pbrt-own-noise" => Check::PbrtOwnNoise(f[2].into()),
                 "test" => Check::Test(f[2].into()),
                 k => panic!("golden.txt: unknown kind {k}"),
             };
