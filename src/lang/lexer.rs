@@ -32,7 +32,7 @@ pub struct LexError {
 }
 
 /// Tokenizer over one file.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Lexer {
     pub file: u32,
     pub chain: u32,

@@ -314,6 +314,44 @@ impl<'l> Parser<'l> {
         }
     }
 
+    /// The hot path of big meshes: reads consecutive numbers of the current file
+    /// straight from its bytes into `out`. Stops, without consuming it, at the
+    /// first token that is not a well-formed number (`]`, a string, an error, the
+    /// end of the file), which the general path then handles.
+    fn number_run(&mut self, out: &mut Vec<f64>) {
+        if self.peeked.is_some() {
+            return;
+        }
+        let Some(lx) = self.stack.last_mut() else {
+            return;
+        };
+        let text = self.sources.files[lx.file as usize].text.as_bytes();
+        loop {
+            let save = lx.clone();
+            match lx.next(text) {
+                Some(Ok(t)) if t.kind == TokKind::Bare => {
+                    match parse_number(&text[t.loc.start as usize..t.loc.end as usize]) {
+                        Ok(v) => {
+                            out.push(v);
+                            self.last = Loc {
+                                start: t.loc.end,
+                                ..t.loc
+                            };
+                        }
+                        Err(_) => {
+                            *lx = save;
+                            return;
+                        }
+                    }
+                }
+                _ => {
+                    *lx = save;
+                    return;
+                }
+            }
+        }
+    }
+
     fn peek(&mut self) -> Option<Token> {
         if self.peeked.is_none() {
             self.peeked = self.next();
@@ -917,6 +955,9 @@ impl<'l> Parser<'l> {
                 let mut strs = Vec::new();
                 let mut ok = true;
                 loop {
+                    if ok && strs.is_empty() {
+                        self.number_run(&mut nums);
+                    }
                     let Some(v) = self.next() else {
                         self.error(
                             t.loc,
