@@ -1193,6 +1193,19 @@ pub fn sampler(ctx: &mut Ctx, s: Ent) -> SamplerDesc {
             (SamplerKind::Halton, 16)
         }
     };
+    if matches!(
+        kind,
+        SamplerKind::Sobol | SamplerKind::ZeroTwoSequence | SamplerKind::MaxMinDist
+    ) {
+        ctx.warn(
+            name.loc,
+            format!(
+                "sampler \"{}\" is not implemented: rendered with the halton sampler (same expected image, different noise)",
+                name.value
+            ),
+            "rendered with halton",
+        );
+    }
     ctx.report_unused(p, &format!("Sampler \"{}\"", name.value));
     SamplerDesc {
         kind,
