@@ -148,3 +148,18 @@ fn renders_png_pfm_and_exr() {
         assert_eq!((img.width, img.height), (51, 51), "{ext}");
     }
 }
+
+#[test]
+fn a_film_too_large_for_memory_is_an_error_not_an_abort() {
+    let out = output_dir("huge").join("huge.exr");
+    let o = pbrs()
+        .args(["tests/inputs/huge-film.pbrt", "--quiet", "--outfile"])
+        .arg(&out)
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("the film needs"), "{err}");
+    assert!(!out.exists());
+}

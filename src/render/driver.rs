@@ -70,6 +70,7 @@ pub struct Renderer {
 impl Renderer {
     pub fn new(desc: &SceneDescription, opts: &RenderOptions) -> Result<Renderer, String> {
         let t0 = Instant::now();
+        check_film_memory(desc)?;
         let scene = RenderScene::new(desc);
         let mut integrator = Integrator::new(&desc.integrator, &scene);
         let film = Film::new(&desc.film, &desc.filter);
@@ -204,6 +205,38 @@ fn render_tile(
     }
     c.rays = scratch.counts();
     (tile, c)
+}
+
+/// Bytes per film pixel over a render: f64 sums (32), the final linear image
+/// (12) and the encoded file's buffer (up to 12).
+const BYTES_PER_PIXEL: u64 = 56;
+
+/// A film too large for this machine is an error before anything is
+/// allocated, not an abort in the middle of the render.
+fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
+    let f = &desc.film;
+    let [x0, x1, y0, y1] = f.cropwindow;
+    let w = ((f.xresolution as f64 * x1 as f64).ceil() - (f.xresolution as f64 * x0 as f64).ceil())
+        .max(0.0) as u64;
+    let h = ((f.yresolution as f64 * y1 as f64).ceil() - (f.yresolution as f64 * y0 as f64).ceil())
+        .max(0.0) as u64;
+    let need = w * h * BYTES_PER_PIXEL;
+    match available_memory_bytes() {
+        Some(avail) if need > avail / 10 * 9 => Err(format!(
+            "the film needs {:.1} GiB ({w}×{h} pixels), more than the {:.1} GiB of memory available",
+            need as f64 / (1u64 << 30) as f64,
+            avail as f64 / (1u64 << 30) as f64
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Memory available to new allocations (Linux `MemAvailable`), if known.
+pub fn available_memory_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 /// Peak resident memory of this process in bytes (Linux), if known.
