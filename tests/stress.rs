@@ -177,3 +177,26 @@ fn disabling_russian_roulette_keeps_the_expected_image() {
         Bounds::against_pbrt("cornell-path"),
     );
 }
+
+#[test]
+fn a_hall_of_mirrors_100000_deep_does_not_exhaust_the_stack() {
+    for integrator in ["directlighting", "whitted"] {
+        let mut desc = load("scenes/stress/mirrors-deep.pbrt");
+        if integrator == "whitted" {
+            desc.integrator = pbrs::scene::IntegratorDesc::Whitted { max_depth: 100_000 };
+        }
+        let (img, stats) =
+            pbrs::render::driver::render(&desc, &Default::default(), &|_, _| {}).unwrap();
+        assert_eq!(stats.dropped_samples(), 0);
+        assert!(
+            img.data.iter().all(|&v| v == 0.0),
+            "{integrator}: a point light is invisible to specular paths"
+        );
+        // 16 camera rays, nearly all bouncing between the mirrors to maxdepth.
+        assert!(
+            stats.rays.closest > 1_000_000,
+            "{integrator}: only {} rays",
+            stats.rays.closest
+        );
+    }
+}

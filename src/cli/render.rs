@@ -123,6 +123,10 @@ pub fn run(args: &Args) -> i32 {
             eprintln!("  {n}");
         }
         eprintln!("  samples: {}", stats.samples);
+        eprintln!(
+            "  rays: {} closest-hit, {} shadow",
+            stats.rays.closest, stats.rays.shadow
+        );
     }
     0
 }

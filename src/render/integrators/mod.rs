@@ -31,10 +31,20 @@ impl RayCounts {
     }
 }
 
+/// A pending vertex of directlighting's and whitted's specular tree.
+#[derive(Clone, Copy, Debug)]
+struct Work {
+    ray: Ray,
+    beta: Vec3,
+    depth: u32,
+    pass: u32,
+}
+
 /// Per-tile scratch space, so the per-sample path never allocates.
 #[derive(Default)]
 pub struct Scratch {
     u_light: Vec<Vec2>,
+    work: Vec<Work>,
     counts: RayCounts,
 }
 
@@ -156,101 +166,132 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.recursive_li(ray, scene, sampler, scratch, 0, 0)
+                self.specular_tree_li(ray, scene, sampler, scratch)
             }
         }
     }
 
-    /// directlighting and whitted: pbrt-v3's recursive Li.
-    fn recursive_li(
+    /// directlighting and whitted: pbrt-v3's recursive Li, run with an
+    /// explicit stack (kept in the per-tile scratch) instead of recursion, so
+    /// that a hall of mirrors with a huge `maxdepth` cannot overflow a
+    /// thread's stack. Vertices are expanded depth first, reflection before
+    /// transmission, as pbrt-v3 recurses; both specular samples of a vertex
+    /// are drawn when it is expanded (the same distribution as pbrt-v3, which
+    /// draws the transmission sample after the reflection subtree).
+    fn specular_tree_li(
         &self,
         ray: Ray,
         scene: &RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
-        depth: u32,
-        pass: u32,
     ) -> Vec3 {
-        scratch.counts.closest += 1;
-        let Some(hit) = scene.geometry.intersect(&ray) else {
-            return escaped(scene);
-        };
-        let s = scene.geometry.surface(&hit);
-        let material = &scene.materials[s.material as usize];
-        if material.is_none() {
-            if pass >= MAX_PASS_THROUGH {
-                return Vec3::ZERO;
-            }
-            let next = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
-            return self.recursive_li(next, scene, sampler, scratch, depth, pass + 1);
-        }
-        let wo = -ray.d;
-        let bsdf = material.bsdf(s.point.ns, s.point.n, false);
-        let mut l = emitted(scene, &s, wo);
-        let max_depth = match *self {
-            Integrator::Direct {
-                max_depth,
-                strategy,
-                ref lights,
-                ref n_light_samples,
-            } => {
-                if !scene.lights.is_empty() {
-                    l += match strategy {
-                        DirectStrategy::All => sample_all_lights(
-                            scene,
-                            &s,
-                            &bsdf,
-                            wo,
-                            sampler,
-                            scratch,
-                            n_light_samples,
-                        ),
-                        DirectStrategy::One => {
-                            sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights)
-                        }
-                    };
+        let mut stack = std::mem::take(&mut scratch.work);
+        stack.clear();
+        stack.push(Work {
+            ray,
+            beta: Vec3::ONE,
+            depth: 0,
+            pass: 0,
+        });
+        let mut l = Vec3::ZERO;
+        while let Some(w) = stack.pop() {
+            scratch.counts.closest += 1;
+            let Some(hit) = scene.geometry.intersect(&w.ray) else {
+                l += w.beta * escaped(scene);
+                continue;
+            };
+            let s = scene.geometry.surface(&hit);
+            let material = &scene.materials[s.material as usize];
+            if material.is_none() {
+                if w.pass < MAX_PASS_THROUGH {
+                    let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                    stack.push(Work {
+                        ray,
+                        pass: w.pass + 1,
+                        ..w
+                    });
                 }
-                max_depth
+                continue;
             }
-            Integrator::Whitted { max_depth } => {
-                for light in &scene.lights {
+            let wo = -w.ray.d;
+            let bsdf = material.bsdf(s.point.ns, s.point.n, false);
+            let mut local = emitted(scene, &s, wo);
+            let max_depth = match *self {
+                Integrator::Direct {
+                    max_depth,
+                    strategy,
+                    ref lights,
+                    ref n_light_samples,
+                } => {
+                    if !scene.lights.is_empty() {
+                        local += match strategy {
+                            DirectStrategy::All => sample_all_lights(
+                                scene,
+                                &s,
+                                &bsdf,
+                                wo,
+                                sampler,
+                                scratch,
+                                n_light_samples,
+                            ),
+                            DirectStrategy::One => {
+                                sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights)
+                            }
+                        };
+                    }
+                    max_depth
+                }
+                Integrator::Whitted { max_depth } => {
+                    for light in &scene.lights {
+                        let u = sampler.get_2d();
+                        let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else {
+                            continue;
+                        };
+                        if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
+                            continue;
+                        }
+                        let f = bsdf.f(wo, ls.wi);
+                        if f != Vec3::ZERO {
+                            scratch.counts.shadow += 1;
+                            if !scene.geometry.occluded(&ls.shadow) {
+                                local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
+                            }
+                        }
+                    }
+                    max_depth
+                }
+                Integrator::Path { .. } => unreachable!("path is not recursive"),
+            };
+            l += w.beta * local;
+            if w.depth + 1 < max_depth {
+                let mut children = [None, None];
+                for (i, filter) in [
+                    LobeFilter::SpecularReflection,
+                    LobeFilter::SpecularTransmission,
+                ]
+                .into_iter()
+                .enumerate()
+                {
                     let u = sampler.get_2d();
-                    let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else {
-                        continue;
-                    };
-                    if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
-                        continue;
-                    }
-                    let f = bsdf.f(wo, ls.wi);
-                    if f != Vec3::ZERO {
-                        scratch.counts.shadow += 1;
-                        if !scene.geometry.occluded(&ls.shadow) {
-                            l += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
+                    if let Some(bs) = bsdf.sample(wo, u, filter) {
+                        let cos = bs.wi.dot(s.point.ns).abs();
+                        if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
+                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                            let beta = w.beta * bs.f * cos / bs.pdf;
+                            children[i] = Some(Work {
+                                ray,
+                                beta,
+                                depth: w.depth + 1,
+                                pass: 0,
+                            });
                         }
                     }
                 }
-                max_depth
-            }
-            Integrator::Path { .. } => unreachable!("path is not recursive"),
-        };
-        if depth + 1 < max_depth {
-            for filter in [
-                LobeFilter::SpecularReflection,
-                LobeFilter::SpecularTransmission,
-            ] {
-                let u = sampler.get_2d();
-                if let Some(bs) = bsdf.sample(wo, u, filter) {
-                    let cos = bs.wi.dot(s.point.ns).abs();
-                    if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
-                        let next = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-                        l += bs.f
-                            * self.recursive_li(next, scene, sampler, scratch, depth + 1, 0)
-                            * cos
-                            / bs.pdf;
-                    }
-                }
+                // Pushed transmission first so that reflection is expanded first.
+                stack.extend(children.into_iter().rev().flatten());
             }
         }
+        scratch.work = stack;
         l
     }
 }
