@@ -200,3 +200,16 @@ fn a_hall_of_mirrors_100000_deep_does_not_exhaust_the_stack() {
         );
     }
 }
+
+#[test]
+fn singular_transforms_leave_shapes_out_without_nan() {
+    // The lit unit sphere alone: its centre pixel sees the point light head on,
+    // L = Kd/π · I / d² · cos = 0.5/π · 25 / 16 at the nearest point (d = 4).
+    let (img, _) = render_file("scenes/stress/singular.pbrt", None, None);
+    let c = img.pixel(8, 8).x as f64;
+    let expect = 0.5 / std::f64::consts::PI * 25.0 / 16.0;
+    assert!(
+        (c - expect).abs() < 0.03 * expect,
+        "centre {c}, expected about {expect}"
+    );
+}

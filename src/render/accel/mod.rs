@@ -128,7 +128,7 @@ impl Geometry {
         }
         for (si, s) in spheres.iter().enumerate() {
             let b = s.bounds();
-            if !(b.min.is_finite() && b.max.is_finite()) || s.radius <= 0.0 {
+            if !(b.min.is_finite() && b.max.is_finite()) || s.radius <= 0.0 || !s.is_invertible() {
                 continue;
             }
             bounds = bounds.union(&b);

@@ -89,6 +89,12 @@ impl Sphere {
         self.area
     }
 
+    /// False for singular transforms (e.g. `Scale 0 0 0`): such a sphere has
+    /// no area and is left out of the scene.
+    pub fn is_invertible(&self) -> bool {
+        self.world_to_object.is_finite() && self.area > 0.0 && self.area.is_finite()
+    }
+
     pub fn bounds(&self) -> Bounds3 {
         let r = self.radius;
         let mut b = Bounds3::EMPTY;
@@ -145,7 +151,7 @@ impl Sphere {
         }
         let t_max = t_max as f64;
         for t in [t0, t1] {
-            if t <= 0.0 || t >= t_max || t as f32 <= 0.0 {
+            if !(t > 0.0 && t < t_max && t as f32 > 0.0) {
                 continue;
             }
             let mut p = oo + t * od;
