@@ -437,9 +437,10 @@ impl Shapes<'_> {
         !bvh.ray_traverse_miss(r, |_, id| {
             let prim = self.level.prims[id];
             if prim.mesh == INSTANCE_TAG {
-                // Any hit before t_max ends the query: report one at t_max/2.
+                // Any hit before t_max ends the query, and obvhs stops at any
+                // returned distance below its tmax (> 0): report 0.
                 return if instance_hit(prim.index) {
-                    0.5 * t_max / k
+                    0.0
                 } else {
                     f32::INFINITY
                 };
