@@ -57,6 +57,15 @@ const EXPECT: &[Expect] = &[
         ],
     },
     Expect {
+        file: "cornell-dragon-glass.pbrt",
+        warnings: &[],
+        shapes: 7,
+        triangles: 43_546,
+        area_lights: 1,
+        materials: &[("glass", 1), ("matte", 3)],
+        lines: &["materials:  4 (1 glass, 3 matte)"],
+    },
+    Expect {
         file: "cornell-glass.pbrt",
         warnings: &[],
         shapes: 8,
@@ -79,6 +88,15 @@ const EXPECT: &[Expect] = &[
             "integrator: path, maxdepth 8",
             "sampler:    halton, 64 samples per pixel",
         ],
+    },
+    Expect {
+        file: "instancing-dragons.pbrt",
+        warnings: &[],
+        shapes: 1,
+        triangles: 2,
+        area_lights: 0,
+        materials: &[("matte", 2)],
+        lines: &["objects:    1 (1 shapes, 43534 triangles), 100 instances"],
     },
 ];
 

@@ -3,7 +3,8 @@
 //! shapes. Every lookup marks its parameter used.
 
 use super::color::{blackbody_to_rgb, sampled_to_rgb, xyz_to_rgb};
-use super::ply::read_ply;
+use super::meshfile::{read_gltf, read_obj};
+use super::ply::{read_ply, PlyMesh};
 use super::Ctx;
 use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::{resolve, Name};
@@ -600,59 +601,7 @@ pub fn geometry(
             })
         }
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
-        "plymesh" => {
-            let Some((file, floc)) = string(p, "filename") else {
-                ctx.error(
-                    name.loc,
-                    "plymesh needs a \"string filename\" parameter",
-                    "no filename",
-                    None,
-                );
-                return None;
-            };
-            alpha_ignored(ctx, p);
-            let path = resolve(&ctx.base_dir, file);
-            if let Some(m) = meshes.get(&path) {
-                return m.clone().map(Geometry::TriangleMesh);
-            }
-            let result = match ctx.loader.load(&path) {
-                Err(e) => Err(format!("cannot read PLY file \"{}\": {e}", path.display())),
-                Ok(bytes) => {
-                    read_ply(&bytes).map_err(|e| format!("PLY file \"{}\": {e}", path.display()))
-                }
-            };
-            let mesh = match result {
-                Ok(m) => {
-                    for n in m.notes {
-                        ctx.warn(
-                            floc,
-                            format!("PLY file \"{}\": {n}", path.display()),
-                            "this mesh",
-                        );
-                    }
-                    if m.mesh.positions.iter().any(|v| !v.is_finite()) {
-                        ctx.error(
-                            floc,
-                            format!(
-                                "PLY file \"{}\" has a vertex that is not a finite 32-bit number",
-                                path.display()
-                            ),
-                            "this mesh",
-                            None,
-                        );
-                        None
-                    } else {
-                        Some(Arc::new(m.mesh))
-                    }
-                }
-                Err(e) => {
-                    ctx.error(floc, e, "this mesh", None);
-                    None
-                }
-            };
-            meshes.insert(path, mesh.clone());
-            mesh.map(Geometry::TriangleMesh)
-        }
+        "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
         other => {
             p.mark_all_used();
             if OTHER_SHAPES.contains(&other) {
@@ -662,7 +611,7 @@ pub fn geometry(
                     "shape skipped",
                 );
             } else {
-                let all: Vec<&str> = ["sphere", "trianglemesh", "plymesh"]
+                let all: Vec<&str> = ["sphere", "trianglemesh", "plymesh", "objmesh", "gltfmesh"]
                     .iter()
                     .chain(OTHER_SHAPES)
                     .copied()
@@ -679,6 +628,90 @@ pub fn geometry(
             None
         }
     }
+}
+
+/// `plymesh`, and the pbrs extensions `objmesh` and `gltfmesh`: a mesh read
+/// from a file (once per file, shared by every shape that names it).
+fn mesh_file(
+    ctx: &mut Ctx,
+    name: &Name,
+    p: &ParamList,
+    meshes: &mut HashMap<PathBuf, Option<Arc<MeshData>>>,
+) -> Option<Geometry> {
+    let kind = match name.value.as_str() {
+        "plymesh" => "PLY",
+        "objmesh" => "OBJ",
+        _ => "glTF",
+    };
+    let Some((file, floc)) = string(p, "filename") else {
+        ctx.error(
+            name.loc,
+            format!("{} needs a \"string filename\" parameter", name.value),
+            "no filename",
+            None,
+        );
+        return None;
+    };
+    alpha_ignored(ctx, p);
+    let path = resolve(&ctx.base_dir, file);
+    if let Some(m) = meshes.get(&path) {
+        return m.clone().map(Geometry::TriangleMesh);
+    }
+    let result = match ctx.loader.load(&path) {
+        Err(e) => Err(format!(
+            "cannot read {kind} file \"{}\": {e}",
+            path.display()
+        )),
+        Ok(bytes) => {
+            let read = match kind {
+                "PLY" => read_ply(&bytes),
+                "OBJ" => read_obj(&bytes).map(|mesh| PlyMesh {
+                    mesh,
+                    notes: Vec::new(),
+                }),
+                _ => {
+                    let dir = path.parent().unwrap_or(std::path::Path::new("."));
+                    let loader = &ctx.loader;
+                    read_gltf(&bytes, dir, &|f| loader.load(f)).map(|mesh| PlyMesh {
+                        mesh,
+                        notes: Vec::new(),
+                    })
+                }
+            };
+            read.map_err(|e| format!("{kind} file \"{}\": {e}", path.display()))
+        }
+    };
+    let mesh = match result {
+        Ok(m) => {
+            for n in m.notes {
+                ctx.warn(
+                    floc,
+                    format!("{kind} file \"{}\": {n}", path.display()),
+                    "this mesh",
+                );
+            }
+            if m.mesh.positions.iter().any(|v| !v.is_finite()) {
+                ctx.error(
+                    floc,
+                    format!(
+                        "{kind} file \"{}\" has a vertex that is not a finite 32-bit number",
+                        path.display()
+                    ),
+                    "this mesh",
+                    None,
+                );
+                None
+            } else {
+                Some(Arc::new(m.mesh))
+            }
+        }
+        Err(e) => {
+            ctx.error(floc, e, "this mesh", None);
+            None
+        }
+    };
+    meshes.insert(path, mesh.clone());
+    mesh.map(Geometry::TriangleMesh)
 }
 
 fn alpha_ignored(ctx: &mut Ctx, p: &ParamList) {

@@ -330,6 +330,9 @@ pub fn read_ply(data: &[u8]) -> Result<PlyMesh, String> {
                         if n < 0.0 || n > r.left() as f64 {
                             return Err(format!("face {f} has a bad vertex count {n}"));
                         }
+                        if n == 0.0 {
+                            return Err(format!("face {f} has no vertex indices"));
+                        }
                         for _ in 0..n as usize {
                             poly.push(r.read(p.ty)?);
                         }

@@ -629,7 +629,10 @@ impl<'s, 'c> Builder<'s, 'c> {
         }
         let geometry = entities::geometry(self.ctx, name, params, &mut self.meshes);
         let Some(geometry) = geometry else {
-            if matches!(name.value.as_str(), "sphere" | "trianglemesh" | "plymesh") {
+            if matches!(
+                name.value.as_str(),
+                "sphere" | "trianglemesh" | "plymesh" | "objmesh" | "gltfmesh"
+            ) {
                 // An error was reported.
             } else {
                 self.unsupported_shapes += 1;

@@ -2,7 +2,7 @@
 //! geometry with a BVH, materials, lights and a camera. Only what the scene
 //! references is built; what was left out is recorded for `--stats`.
 
-use crate::render::accel::Geometry;
+use crate::render::accel::{Geometry, Instance, Object};
 use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, Light, TriangleCache};
@@ -10,6 +10,7 @@ use crate::render::materials::Material;
 use crate::render::shapes::{Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
+use std::sync::Arc;
 
 pub struct RenderScene {
     pub geometry: Geometry,
@@ -30,12 +31,8 @@ impl RenderScene {
         let mut area: Vec<(AreaShape, AreaLightDesc)> = Vec::new();
         let mut notes = Vec::new();
 
-        let mut add_shape = |s: &ShapeDesc, to_world: DMat4, lights_allowed: bool| {
-            let emit = if lights_allowed {
-                s.area_light.filter(|a| a.l.max_element() > 0.0)
-            } else {
-                None
-            };
+        let mut add_shape = |s: &ShapeDesc, to_world: DMat4| {
+            let emit = s.area_light.filter(|a| a.l.max_element() > 0.0);
             match &s.geometry {
                 scene::Geometry::TriangleMesh(m) => {
                     let mesh_index = meshes.len() as u32;
@@ -78,22 +75,45 @@ impl RenderScene {
             }
         };
         for s in &desc.shapes {
-            add_shape(s, s.object_to_world, true);
+            add_shape(s, s.object_to_world);
         }
-        // Instances are flattened into world space here.
-        for inst in &desc.instances {
-            if let Some(obj) = desc.objects.get(inst.object) {
-                for s in &obj.shapes {
-                    add_shape(s, inst.instance_to_world * s.object_to_world, false);
+        // Each instanced object is built once, in its own space, with its own
+        // BVH; instances refer to it (two-level BVH, no copies of geometry).
+        let objects: Vec<Option<Arc<Object>>> = desc
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, obj)| {
+                if !desc.instances.iter().any(|inst| inst.object == i) {
+                    return None;
                 }
+                Some(Arc::new(object(obj)))
+            })
+            .collect();
+        let mut instances = Vec::with_capacity(desc.instances.len());
+        let mut singular = 0usize;
+        for inst in &desc.instances {
+            let Some(Some(obj)) = objects.get(inst.object) else {
+                continue;
+            };
+            match Instance::new(obj.clone(), inst.instance_to_world) {
+                Some(i) => instances.push(i),
+                None => singular += 1,
             }
         }
+        if singular > 0 {
+            notes.push(format!(
+                "{singular} instances with a singular transform left out"
+            ));
+        }
+        let instanced_triangles: u64 = instances.iter().map(|i| i.object().triangle_count()).sum();
+        let object_triangles: u64 = objects.iter().flatten().map(|o| o.triangle_count()).sum();
         let emissive_shapes = desc
             .shapes
             .iter()
             .filter(|s| s.area_light.is_some())
             .count();
-        let geometry = Geometry::new(meshes, spheres);
+        let geometry = Geometry::with_instances(meshes, spheres, instances);
         if geometry.degenerate_triangles > 0 {
             notes.push(format!(
                 "{} zero-area triangles left out of the BVH",
@@ -195,6 +215,15 @@ impl RenderScene {
             area.len(),
             emissive_shapes
         ));
+        if geometry.instance_count() > 0 {
+            notes.push(format!(
+                "instancing: {} instances of {} objects ({} triangles stored once, {} as instanced)",
+                geometry.instance_count(),
+                objects.iter().flatten().count(),
+                object_triangles,
+                instanced_triangles
+            ));
+        }
         let camera = Camera::new(&desc.camera, desc.film.xresolution, desc.film.yresolution);
         RenderScene {
             geometry,
@@ -205,6 +234,38 @@ impl RenderScene {
             notes,
         }
     }
+}
+
+/// Builds an object's shapes in object space and its BVH. Area lights are
+/// never set inside objects (pbrt-v3 ignores them there).
+fn object(obj: &scene::ObjectDesc) -> Object {
+    let mut meshes = Vec::new();
+    let mut spheres = Vec::new();
+    for s in &obj.shapes {
+        match &s.geometry {
+            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(
+                m,
+                s.object_to_world,
+                s.reverse_orientation,
+                s.material.0,
+            )),
+            &scene::Geometry::Sphere {
+                radius,
+                z_min,
+                z_max,
+                phi_max,
+            } => spheres.push(Sphere::new(
+                radius,
+                z_min,
+                z_max,
+                phi_max,
+                s.object_to_world,
+                s.reverse_orientation,
+                s.material.0,
+            )),
+        }
+    }
+    Object::new(meshes, spheres)
 }
 
 /// Transform an object-space mesh to world space (positions in f64 before

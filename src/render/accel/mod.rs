@@ -1,19 +1,35 @@
-//! Acceleration: one compressed wide BVH (obvhs's CWBVH) over every primitive
-//! of the scene, with closest-hit and occlusion queries.
+//! Acceleration: obvhs's compressed wide BVHs with closest-hit and occlusion
+//! queries, in two levels.
+//!
+//! - The scene level: one CWBVH over the world-space primitives (triangles of
+//!   meshes, spheres) and over the world bounds of object instances.
+//! - The object level: one CWBVH per instanced object, over its primitives in
+//!   the object's own space. An instance is a transform and an object index, so
+//!   a thousand instances of an object cost a thousand transforms, not a
+//!   thousand copies of its triangles (obvhs has no ready-made top level: the
+//!   scene level's leaf closure traces the object's BVH).
+//!
+//! Instance rays are the world ray mapped to object space by the inverse
+//! transform without renormalising the direction, so `t` means the same at
+//! both levels and the closest hit is found across levels by `t` alone.
 
-use crate::render::geometry::{Bounds3, Ray};
+use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
 use crate::render::shapes::{intersect_triangle, Sphere, SurfacePoint, TriangleMesh};
-use glam::{DVec3, Vec3, Vec3A};
+use glam::{DMat3, DMat4, DVec3, Mat3, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
 use obvhs::BvhBuildParams;
+use std::sync::Arc;
 use std::time::Duration;
 
 const SPHERE_TAG: u32 = u32::MAX;
+const INSTANCE_TAG: u32 = u32::MAX - 1;
+/// `Hit::instance` for a hit on world-space geometry.
+const NO_INSTANCE: u32 = u32::MAX;
 
-/// A primitive: triangle `index` of mesh `mesh`, or sphere `index` when
-/// `mesh == SPHERE_TAG`.
+/// A primitive: triangle `index` of mesh `mesh`, sphere `index` when
+/// `mesh == SPHERE_TAG`, or instance `index` when `mesh == INSTANCE_TAG`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PrimRef {
     mesh: u32,
@@ -30,13 +46,21 @@ impl PrimRef {
             index: i,
         }
     }
+    fn instance(i: u32) -> Self {
+        Self {
+            mesh: INSTANCE_TAG,
+            index: i,
+        }
+    }
 }
 
 /// What a closest-hit query found.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub t: f32,
+    /// The primitive hit (of the instance's object when `instance` is set).
     pub prim: PrimRef,
+    instance: u32,
     local: HitLocal,
 }
 
@@ -55,19 +79,170 @@ pub struct SurfaceHit {
     pub light: Option<u32>,
 }
 
-/// All geometry of a scene and the BVH over it.
-pub struct Geometry {
-    pub meshes: Vec<TriangleMesh>,
-    pub spheres: Vec<Sphere>,
+/// The BVH over shapes in one space (world space for the scene
+/// level, object space for an object).
+struct Level {
     /// Primitives in BVH order (so leaves index them directly).
     prims: Vec<PrimRef>,
     bvh: Option<CwBvh>,
-    pub bounds: Bounds3,
+    bounds: Bounds3,
     /// Length of ray directions as obvhs sees them (see `to_obvhs_ray`).
     ray_length: f32,
-    /// Triangles left out because they have zero area.
-    pub degenerate_triangles: u64,
-    pub build_time: Duration,
+    degenerate: u64,
+}
+
+/// An object definition, built once and shared by all its instances.
+pub struct Object {
+    meshes: Vec<TriangleMesh>,
+    spheres: Vec<Sphere>,
+    level: Level,
+}
+
+impl Object {
+    /// Builds the object's BVH over its shapes (given in object space).
+    pub fn new(meshes: Vec<TriangleMesh>, spheres: Vec<Sphere>) -> Object {
+        let level = Level::build(&meshes, &spheres, &[]);
+        Object {
+            meshes,
+            spheres,
+            level,
+        }
+    }
+
+    pub fn triangle_count(&self) -> u64 {
+        self.meshes.iter().map(|m| m.triangle_count() as u64).sum()
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        self.level.bounds
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.level.bvh.is_none()
+    }
+
+    fn shapes(&self) -> Shapes<'_> {
+        Shapes {
+            level: &self.level,
+            meshes: &self.meshes,
+            spheres: &self.spheres,
+        }
+    }
+}
+
+/// A placement of an object: its transforms (f64 for the ray and point
+/// mappings, f32 for normals and error bounds).
+pub struct Instance {
+    object: Arc<Object>,
+    world_to_object: DMat4,
+    object_to_world: DMat4,
+    /// Linear part of object-to-world, entry-wise absolute, for error bounds.
+    abs_linear: Mat3,
+    /// |translation| of object-to-world, for error bounds.
+    abs_translation: Vec3,
+    /// Inverse transpose of the linear part: maps normals.
+    normal_matrix: Mat3,
+}
+
+impl Instance {
+    /// `None` if the transform cannot be inverted.
+    pub fn new(object: Arc<Object>, object_to_world: DMat4) -> Option<Instance> {
+        let lin = DMat3::from_mat4(object_to_world);
+        let det = lin.determinant();
+        if !(det.is_finite() && det != 0.0 && object_to_world.is_finite()) {
+            return None;
+        }
+        let world_to_object = object_to_world.inverse();
+        if !world_to_object.is_finite() {
+            return None;
+        }
+        let l = lin.as_mat3();
+        Some(Instance {
+            object,
+            world_to_object,
+            object_to_world,
+            abs_linear: Mat3::from_cols(l.x_axis.abs(), l.y_axis.abs(), l.z_axis.abs()),
+            abs_translation: object_to_world.w_axis.truncate().as_vec3().abs(),
+            normal_matrix: lin.inverse().transpose().as_mat3(),
+        })
+    }
+
+    pub fn object(&self) -> &Object {
+        &self.object
+    }
+
+    /// World bounds: the object's box corners mapped to world space, rounded
+    /// outwards.
+    fn world_bounds(&self) -> Bounds3 {
+        let b = self.object.level.bounds;
+        let mut out = Bounds3::EMPTY;
+        for i in 0..8 {
+            let c = DVec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x } as f64,
+                if i & 2 == 0 { b.min.y } else { b.max.y } as f64,
+                if i & 4 == 0 { b.min.z } else { b.max.z } as f64,
+            );
+            let w = self.object_to_world.transform_point3(c);
+            let lo = w.as_vec3();
+            let lo = Vec3::new(
+                next_float_down(lo.x),
+                next_float_down(lo.y),
+                next_float_down(lo.z),
+            );
+            let hi = w.as_vec3();
+            let hi = Vec3::new(
+                next_float_up(hi.x),
+                next_float_up(hi.y),
+                next_float_up(hi.z),
+            );
+            out = out.union_point(lo).union_point(hi);
+        }
+        out
+    }
+
+    /// The world ray in object space (same `t` parameterisation).
+    #[inline]
+    fn object_ray(&self, ray: &Ray) -> Ray {
+        let o = self
+            .world_to_object
+            .transform_point3(ray.o.as_dvec3())
+            .as_vec3();
+        let d = self
+            .world_to_object
+            .transform_vector3(ray.d.as_dvec3())
+            .as_vec3();
+        Ray {
+            o,
+            d,
+            t_max: ray.t_max,
+        }
+    }
+
+    /// An object-space surface point in world space: the position mapped in
+    /// f64, its error bound grown conservatively (pbrt-v3's
+    /// `Transform::operator()(p, pError, &absError)`), normals by the inverse
+    /// transpose. The object-space normal is already oriented (ReverseOrientation
+    /// and the shape's handedness); mapping it by the inverse transpose keeps
+    /// it on the same side of the surface whatever the instance's handedness,
+    /// so no further flip is needed (flattening instead recomputes the normal
+    /// from world-space vertices, whose cross product flips with a mirroring
+    /// transform: that is where its `flip_normal` term comes from).
+    #[inline]
+    fn to_world(&self, s: SurfacePoint, has_vertex_normals: bool) -> SurfacePoint {
+        let p = self
+            .object_to_world
+            .transform_point3(s.p.as_dvec3())
+            .as_vec3();
+        let p_error = (1.0 + gamma(3)) * (self.abs_linear * s.p_error)
+            + gamma(3) * (self.abs_linear * s.p.abs() + self.abs_translation);
+        let mut n = (self.normal_matrix * s.n).normalize();
+        let ns = (self.normal_matrix * s.ns).normalize();
+        if has_vertex_normals {
+            // As for world-space meshes: per-vertex normals decide the side.
+            n = crate::render::geometry::face_forward(n, ns);
+        }
+        SurfacePoint { p, p_error, n, ns }
+    }
 }
 
 /// obvhs's node test clamps the entry distance to an absolute 1e-4 (its
@@ -75,7 +250,8 @@ pub struct Geometry {
 /// So obvhs gets the ray with its direction scaled by an exact power of two
 /// `k` chosen so that |d|·k is 1e-12 of the scene's size: obvhs's parameter is
 /// t' = t / k, every hit farther than ~1e-16 of the scene's size has t' > 1e-4,
-/// and nothing overflows for any scene scale.
+/// and nothing overflows for any scene scale. Each BVH level does this with
+/// its own size and its own `k`; hits cross levels as unscaled `t`.
 #[inline]
 fn to_obvhs_ray(ray: &Ray, target_len: f32) -> (obvhs::ray::Ray, f32) {
     let len = ray.d.length();
@@ -105,11 +281,27 @@ fn to_obvhs_ray(ray: &Ray, target_len: f32) -> (obvhs::ray::Ray, f32) {
     (r, k)
 }
 
-impl Geometry {
-    /// Builds the BVH (in parallel, with obvhs's PLOC builder). Zero-area
-    /// triangles are left out; an empty scene builds no BVH at all.
-    pub fn new(meshes: Vec<TriangleMesh>, spheres: Vec<Sphere>) -> Geometry {
-        let start = std::time::Instant::now();
+fn ray_length_for(bounds: &Bounds3) -> f32 {
+    let size = if bounds.is_empty() {
+        1.0
+    } else {
+        bounds
+            .diagonal()
+            .length()
+            .max(bounds.max.abs().max_element())
+    };
+    if size.is_finite() && size > 0.0 {
+        size * 1e-12
+    } else {
+        1e-12
+    }
+}
+
+impl Level {
+    /// Builds the BVH (in parallel, with obvhs's PLOC builder) over the shapes
+    /// and the given extra boxes (instances). Zero-area triangles are left
+    /// out; an empty level builds no BVH at all.
+    fn build(meshes: &[TriangleMesh], spheres: &[Sphere], extra: &[Bounds3]) -> Level {
         let mut prims = Vec::new();
         let mut aabbs = Vec::new();
         let mut bounds = Bounds3::EMPTY;
@@ -135,6 +327,14 @@ impl Geometry {
             prims.push(PrimRef::sphere(si as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
+        for (ii, b) in extra.iter().enumerate() {
+            if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
+                continue;
+            }
+            bounds = bounds.union(b);
+            prims.push(PrimRef::instance(ii as u32));
+            aabbs.push(Aabb::new(b.min.into(), b.max.into()));
+        }
         let bvh = if prims.is_empty() {
             None
         } else {
@@ -148,41 +348,28 @@ impl Geometry {
                 .collect();
             Some(bvh)
         };
-        let size = if bounds.is_empty() {
-            1.0
-        } else {
-            bounds
-                .diagonal()
-                .length()
-                .max(bounds.max.abs().max_element())
-        };
-        let ray_length = if size.is_finite() && size > 0.0 {
-            size * 1e-12
-        } else {
-            1e-12
-        };
-        Geometry {
-            meshes,
-            spheres,
+        Level {
             prims,
             bvh,
+            ray_length: ray_length_for(&bounds),
             bounds,
-            ray_length,
-            degenerate_triangles: degenerate,
-            build_time: start.elapsed(),
+            degenerate,
         }
     }
+}
 
-    pub fn primitive_count(&self) -> usize {
-        self.prims.len()
-    }
+/// A level's BVH with the shapes its leaves refer to.
+#[derive(Clone, Copy)]
+struct Shapes<'a> {
+    level: &'a Level,
+    meshes: &'a [TriangleMesh],
+    spheres: &'a [Sphere],
+}
 
-    pub fn has_bvh(&self) -> bool {
-        self.bvh.is_some()
-    }
-
+impl Shapes<'_> {
+    /// Intersects a triangle or a sphere of this level (not an instance).
     #[inline]
-    fn intersect_prim(
+    fn intersect_shape(
         &self,
         prim: PrimRef,
         o: Vec3,
@@ -200,20 +387,37 @@ impl Geometry {
         }
     }
 
-    /// Closest hit along the ray, if any.
+    /// Closest hit among this level's shapes with `t < ray.t_max`; instances
+    /// are resolved by `instance_hit`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
+    fn intersect(
+        &self,
+        ray: &Ray,
+        mut instance_hit: impl FnMut(u32, f32) -> Option<Hit>,
+    ) -> Option<Hit> {
+        let bvh = self.level.bvh.as_ref()?;
         let mut rh = RayHit::none();
         let mut best: Option<Hit> = None;
         let (o, d) = (ray.o, ray.d);
-        let (r, k) = to_obvhs_ray(ray, self.ray_length);
+        let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
         bvh.ray_traverse(r, &mut rh, |r, id| {
-            let prim = self.prims[id];
-            match self.intersect_prim(prim, o, d, (r.tmax * k).min(ray.t_max)) {
-                Some((t, local)) => {
-                    best = Some(Hit { t, prim, local });
-                    t / k
+            let prim = self.level.prims[id];
+            let t_max = (r.tmax * k).min(ray.t_max);
+            let hit = if prim.mesh == INSTANCE_TAG {
+                instance_hit(prim.index, t_max)
+            } else {
+                self.intersect_shape(prim, o, d, t_max)
+                    .map(|(t, local)| Hit {
+                        t,
+                        prim,
+                        instance: NO_INSTANCE,
+                        local,
+                    })
+            };
+            match hit {
+                Some(h) => {
+                    best = Some(h);
+                    h.t / k
                 }
                 None => f32::INFINITY,
             }
@@ -221,42 +425,177 @@ impl Geometry {
         best
     }
 
-    /// True if anything blocks the ray before `t_max`.
+    /// True if any of this level's shapes (or instances, by `instance_hit`)
+    /// blocks the ray before `ray.t_max`.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else {
+    fn occluded(&self, ray: &Ray, mut instance_hit: impl FnMut(u32) -> bool) -> bool {
+        let Some(bvh) = self.level.bvh.as_ref() else {
             return false;
         };
         let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
-        let (r, k) = to_obvhs_ray(ray, self.ray_length);
+        let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
         !bvh.ray_traverse_miss(r, |_, id| {
-            match self.intersect_prim(self.prims[id], o, d, t_max) {
+            let prim = self.level.prims[id];
+            if prim.mesh == INSTANCE_TAG {
+                // Any hit before t_max ends the query, and obvhs stops at any
+                // returned distance below its tmax (> 0): report 0.
+                return if instance_hit(prim.index) {
+                    0.0
+                } else {
+                    f32::INFINITY
+                };
+            }
+            match self.intersect_shape(prim, o, d, t_max) {
                 Some((t, _)) => t / k,
                 None => f32::INFINITY,
             }
         })
     }
 
+    #[inline]
+    fn surface(&self, prim: PrimRef, local: HitLocal) -> (SurfaceHit, bool) {
+        match local {
+            HitLocal::Bary(b) => {
+                let m = &self.meshes[prim.mesh as usize];
+                (
+                    SurfaceHit {
+                        point: m.surface_point(prim.index, b),
+                        material: m.material,
+                        light: m.first_light.map(|l| l + prim.index),
+                    },
+                    m.n.is_some(),
+                )
+            }
+            HitLocal::SpherePoint(p) => {
+                let s = &self.spheres[prim.index as usize];
+                (
+                    SurfaceHit {
+                        point: s.surface_point(p),
+                        material: s.material,
+                        light: s.light,
+                    },
+                    false,
+                )
+            }
+        }
+    }
+}
+
+/// All geometry of a scene and the BVHs over it.
+pub struct Geometry {
+    /// World-space meshes (lights refer to their triangles by index).
+    pub meshes: Vec<TriangleMesh>,
+    /// World-space spheres.
+    pub spheres: Vec<Sphere>,
+    top: Level,
+    instances: Vec<Instance>,
+    /// World bounds of everything, instances included.
+    pub bounds: Bounds3,
+    /// Triangles left out because they have zero area (each object's counted
+    /// once, however often it is instanced).
+    pub degenerate_triangles: u64,
+    pub build_time: Duration,
+}
+
+impl Geometry {
+    /// Builds the scene-level BVH over world-space shapes alone.
+    pub fn new(meshes: Vec<TriangleMesh>, spheres: Vec<Sphere>) -> Geometry {
+        Geometry::with_instances(meshes, spheres, Vec::new())
+    }
+
+    /// Builds the scene-level BVH over world-space shapes and instances (whose
+    /// objects were built before). Instances of empty objects are dropped.
+    pub fn with_instances(
+        meshes: Vec<TriangleMesh>,
+        spheres: Vec<Sphere>,
+        instances: Vec<Instance>,
+    ) -> Geometry {
+        let start = std::time::Instant::now();
+        let instances: Vec<Instance> = instances
+            .into_iter()
+            .filter(|i| !i.object.is_empty())
+            .collect();
+        let boxes: Vec<Bounds3> = instances.iter().map(Instance::world_bounds).collect();
+        let top = Level::build(&meshes, &spheres, &boxes);
+        let mut degenerate = top.degenerate;
+        let mut seen: Vec<*const Object> = Vec::new();
+        for i in &instances {
+            let p = Arc::as_ptr(&i.object);
+            if !seen.contains(&p) {
+                seen.push(p);
+                degenerate += i.object.level.degenerate;
+            }
+        }
+        Geometry {
+            meshes,
+            spheres,
+            bounds: top.bounds,
+            top,
+            instances,
+            degenerate_triangles: degenerate,
+            build_time: start.elapsed(),
+        }
+    }
+
+    fn shapes(&self) -> Shapes<'_> {
+        Shapes {
+            level: &self.top,
+            meshes: &self.meshes,
+            spheres: &self.spheres,
+        }
+    }
+
+    /// Primitives in the scene-level BVH (an instance counts as one).
+    pub fn primitive_count(&self) -> usize {
+        self.top.prims.len()
+    }
+
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
+    }
+
+    pub fn has_bvh(&self) -> bool {
+        self.top.bvh.is_some()
+    }
+
+    /// Closest hit along the ray, if any.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.shapes().intersect(ray, |i, t_max| {
+            let inst = &self.instances[i as usize];
+            let mut r = inst.object_ray(ray);
+            r.t_max = t_max;
+            inst.object
+                .shapes()
+                .intersect(&r, |_, _| None)
+                .map(|h| Hit { instance: i, ..h })
+        })
+    }
+
+    /// True if anything blocks the ray before `t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.shapes().occluded(ray, |i| {
+            let inst = &self.instances[i as usize];
+            inst.object
+                .shapes()
+                .occluded(&inst.object_ray(ray), |_| false)
+        })
+    }
+
     /// Shading data of a hit.
     #[inline]
     pub fn surface(&self, hit: &Hit) -> SurfaceHit {
-        match hit.local {
-            HitLocal::Bary(b) => {
-                let m = &self.meshes[hit.prim.mesh as usize];
-                SurfaceHit {
-                    point: m.surface_point(hit.prim.index, b),
-                    material: m.material,
-                    light: m.first_light.map(|l| l + hit.prim.index),
-                }
-            }
-            HitLocal::SpherePoint(p) => {
-                let s = &self.spheres[hit.prim.index as usize];
-                SurfaceHit {
-                    point: s.surface_point(p),
-                    material: s.material,
-                    light: s.light,
-                }
-            }
+        if hit.instance == NO_INSTANCE {
+            return self.shapes().surface(hit.prim, hit.local).0;
+        }
+        let inst = &self.instances[hit.instance as usize];
+        let (s, vertex_normals) = inst.object.shapes().surface(hit.prim, hit.local);
+        SurfaceHit {
+            point: inst.to_world(s.point, vertex_normals),
+            material: s.material,
+            // Area lights inside objects are ignored (as pbrt-v3).
+            light: None,
         }
     }
 }
