@@ -114,3 +114,67 @@ fn emitting_sphere_with_more_bounces_sums_the_series() {
     check("emitting/path-2", EMITTING, path(2), 64, 0.875);
     check("emitting/path-64", EMITTING, path(64), 256, 1.0);
 }
+
+const MIRROR: &str = "scenes/analytic/sphere-mirror.pbrt";
+const GLASS: &str = "scenes/analytic/sphere-glass.pbrt";
+
+/// Le (1 + r + … + r^(n−1)).
+fn series(le: f64, r: f64, n: u32) -> f64 {
+    (0..n).map(|k| le * r.powi(k as i32)).sum()
+}
+
+#[test]
+fn specular_recursion_stops_at_maxdepth() {
+    for max_depth in 1..=5 {
+        for (scene, r) in [(MIRROR, 0.5), (GLASS, 0.04)] {
+            let want = series(0.5, r, max_depth);
+            for (kind, i) in [
+                (
+                    "all",
+                    IntegratorDesc::DirectLighting {
+                        max_depth,
+                        strategy: DirectStrategy::All,
+                    },
+                ),
+                (
+                    "one",
+                    IntegratorDesc::DirectLighting {
+                        max_depth,
+                        strategy: DirectStrategy::One,
+                    },
+                ),
+                ("whitted", IntegratorDesc::Whitted { max_depth }),
+            ] {
+                let name = format!("{scene} {kind} maxdepth {max_depth}");
+                let sigma = check(&name, scene, i, 4, want);
+                assert!(sigma < 1e-5, "{name}: σ {sigma}");
+            }
+        }
+    }
+    // path counts emission after each specular bounce up to maxdepth
+    // bounces (no Russian roulette before bounce 4).
+    check("mirror path-3", MIRROR, path(3), 4, series(0.5, 0.5, 4));
+}
+
+#[test]
+fn rays_with_negative_zero_direction_components_hit() {
+    // Camera rays through pixel column 16 have x = 0, their mirror
+    // reflections -0.0: these missed the sphere in the BVH (obvhs picks slab
+    // planes by `d < 0.0`, false for -0.0, while the reciprocal was -1e30).
+    use glam::Vec3;
+    use pbrs::render::geometry::Ray;
+    let sc = pbrs::render::scene::RenderScene::new(&load(MIRROR));
+    for d in [
+        Vec3::new(-0.0, 0.590_631, -0.806_942),
+        Vec3::new(0.0, 0.590_631, -0.806_942),
+        Vec3::new(-0.0, -0.0, 1.0),
+        Vec3::new(0.3, -0.0, -0.954),
+    ] {
+        let o = Vec3::new(0.0, -0.590_630_6, 0.806_941_2);
+        assert!(
+            sc.geometry.intersect(&Ray::new(o, d)).is_some(),
+            "{d:?} misses"
+        );
+        assert!(sc.geometry.intersect(&Ray::new(Vec3::ZERO, d)).is_some());
+    }
+}
