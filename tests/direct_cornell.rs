@@ -93,3 +93,19 @@ fn whitted_matches_directlighting() {
     let d = with_integrator(IntegratorDesc::Whitted { max_depth: 5 });
     check_unbiased("cornell-whitted", d, 64, 2);
 }
+
+#[test]
+fn strategy_all_with_several_light_samples_is_unbiased() {
+    // nsamples 4 on the light: per-pixel arrays of 4 (Halton rounds counts
+    // to powers of two) for each of the two light triangles at every depth.
+    let mut d = load(SCENE);
+    let mut n = 0;
+    for s in d.shapes.iter_mut() {
+        if let Some(a) = s.area_light.as_mut() {
+            a.n_samples = 4;
+            n += 1;
+        }
+    }
+    assert!(n > 0);
+    check_unbiased("cornell-direct-nsamples4", d, 64, 2);
+}
