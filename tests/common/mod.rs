@@ -130,3 +130,33 @@ pub fn assert_matches(name: &str, img: &Image, reference: &Image, b: Bounds) -> 
 pub fn exists(p: &Path) -> bool {
     p.exists()
 }
+
+/// Renders with an explicit seed (independent scrambling per seed).
+pub fn render_seeded(
+    mut desc: SceneDescription,
+    res: u32,
+    spp: u32,
+    seed: u64,
+) -> (Image, RenderStats) {
+    desc.film.xresolution = res;
+    desc.film.yresolution = res;
+    desc.sampler.pixel_samples = spp;
+    render(
+        &desc,
+        &RenderOptions {
+            threads: None,
+            seed,
+        },
+        &|_, _| {},
+    )
+    .expect("render failed")
+}
+
+/// Pixel-wise mean of images of the same size.
+pub fn average(images: &[Image]) -> Image {
+    let mut out = images[0].clone();
+    for (i, v) in out.data.iter_mut().enumerate() {
+        *v = images.iter().map(|im| im.data[i] as f64).sum::<f64>() as f32 / images.len() as f32;
+    }
+    out
+}

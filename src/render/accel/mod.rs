@@ -263,10 +263,16 @@ fn to_obvhs_ray(ray: &Ray, target_len: f32) -> (obvhs::ray::Ray, f32) {
         1.0
     };
     let d = ray.d * k;
-    // Finite reciprocals (no inf·0 = NaN in the slab tests).
+    // Finite reciprocals (no inf·0 = NaN in the slab tests), with the sign
+    // obvhs assumes: it picks near and far planes by `direction < 0.0`,
+    // which is false for -0.0, so -0.0 must get a positive reciprocal.
     let inv = |x: f32| {
         if x.abs() < 1e-30 {
-            1e30f32.copysign(x)
+            if x < 0.0 {
+                -1e30
+            } else {
+                1e30
+            }
         } else {
             1.0 / x
         }

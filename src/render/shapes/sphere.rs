@@ -304,7 +304,16 @@ impl Sphere {
         match hit(o, wi) {
             Some((_, p_obj)) => {
                 let h = self.surface_point(p_obj);
-                area_to_solid_angle(p, h.p, h.n, self.pdf_area(h.p))
+                // pbrt-v3's Shape::Pdf: the cosine with the ray direction wi
+                // (not with p→hit: the ray starts at the offset origin, and
+                // the mixed form is off by ~|offset|/(2cos²θ) at grazing wi).
+                let d2 = h.p.distance_squared(p);
+                let pdf = self.pdf_area(h.p) * d2 / h.n.dot(wi).abs();
+                if pdf.is_finite() {
+                    pdf
+                } else {
+                    0.0
+                }
             }
             None => 0.0,
         }
