@@ -179,3 +179,12 @@ fn hundred_dragons_fit_in_twice_the_memory_of_one() {
     eprintln!("peak memory: one dragon {one} MiB, 100 instanced dragons {many} MiB");
     assert!(many <= 2.0 * one, "{many} MiB > 2 × {one} MiB");
 }
+
+#[test]
+fn instanced_scene_does_not_depend_on_thread_count() {
+    let one = render_at(load("scenes/instancing-dragons.pbrt"), 48, 2, Some(1)).0;
+    let two = render_at(load("scenes/instancing-dragons.pbrt"), 48, 2, Some(2)).0;
+    let bits =
+        |i: &pbrs::render::film::Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&one), bits(&two));
+}
