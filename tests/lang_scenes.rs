@@ -45,6 +45,15 @@ const EXPECT: &[Expect] = &[
         ],
     },
     Expect {
+        file: "cornell-dragon-glass.pbrt",
+        warnings: &[],
+        shapes: 7,
+        triangles: 43_546,
+        area_lights: 1,
+        materials: &[("glass", 1), ("matte", 3)],
+        lines: &["materials:  4 (1 glass, 3 matte)"],
+    },
+    Expect {
         file: "cornell-dragon.pbrt",
         warnings: &[],
         shapes: 7,
@@ -55,15 +64,6 @@ const EXPECT: &[Expect] = &[
             "camera:     perspective, fov 90°, lens radius 0.02",
             "light samples uniform",
         ],
-    },
-    Expect {
-        file: "cornell-dragon-glass.pbrt",
-        warnings: &[],
-        shapes: 7,
-        triangles: 43_546,
-        area_lights: 1,
-        materials: &[("glass", 1), ("matte", 3)],
-        lines: &["materials:  4 (1 glass, 3 matte)"],
     },
     Expect {
         file: "cornell-glass.pbrt",

@@ -1,13 +1,14 @@
 //! The whole load path from bytes: tokenize, parse, build a scene from an
-//! in-memory text whose Includes and PLY meshes are served from the same input,
-//! and the PLY reader on arbitrary bytes. Nothing may panic or allocate without
+//! in-memory text whose Includes and mesh files are served from the same input,
+//! and the PLY, OBJ and glTF readers on arbitrary bytes. Nothing may panic or allocate without
 //! bound.
 //!
 //! Input layout: `scene text [0xFF files]`: every file name the scene asks for
-//! (Include, plymesh) is served the bytes after the first 0xFF.
+//! (Include, plymesh, objmesh, gltfmesh) is served the bytes after the first 0xFF.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use pbrs::build::meshfile::{read_gltf, read_obj};
 use pbrs::build::{load_scene_with, ply::read_ply};
 use pbrs::lang::FileLoader;
 use std::path::Path;
@@ -28,6 +29,8 @@ fuzz_target!(|data: &[u8]| {
     let (scene, files) = (&data[..split], data.get(split + 1..).unwrap_or(&[]));
     let _ = read_ply(data);
     let _ = read_ply(files);
+    let _ = read_obj(files);
+    let _ = read_gltf(files, Path::new("."), &|_| Err("not served".into()));
     if let Ok(text) = std::str::from_utf8(scene) {
         let _ = load_scene_with(text, Path::new("fuzz.pbrt"), Box::new(Served(files.to_vec())));
     }

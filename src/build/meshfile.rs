@@ -101,7 +101,39 @@ pub fn read_gltf(
     dir: &Path,
     load: &dyn Fn(&Path) -> Result<Vec<u8>, String>,
 ) -> Result<MeshData, String> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a valid glTF file: {e}"))?;
+    // The gltf crate's validation indexes accessors without a bounds check
+    // (gltf-json 1.4.1 `primitive_validate_hook`), so those indices are checked
+    // first; the rest runs under `catch_unwind` as a last guard.
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| format!("not a valid glTF file: {e}"))?;
+    let root = gltf.document.as_json();
+    for (mi, mesh) in root.meshes.iter().enumerate() {
+        for prim in &mesh.primitives {
+            let accessors = prim.attributes.values().chain(prim.indices.as_ref());
+            for a in accessors {
+                if a.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "mesh {mi} refers to accessor {}, but the file has {}",
+                        a.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        use gltf::json::validation::Validate;
+        let mut errors = Vec::new();
+        root.validate(root, gltf::json::Path::new, &mut |path, e| {
+            errors.push(format!("{}: {e}", path()))
+        });
+        errors
+    }))
+    .map_err(|_| "the glTF file failed validation".to_string())
+    .and_then(|errors| match errors.first() {
+        None => Ok(()),
+        Some(e) => Err(format!("not a valid glTF file: {e}")),
+    })?;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in gltf.document.buffers() {
         let data = match b.source() {
@@ -287,7 +319,7 @@ mod tests {
         let m = read_obj(b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
         assert_eq!(m.triangle_count(), 2);
         assert_eq!(
-            [0, 1, 2, 0, 2, 3].map(|i| m.positions[m.indices[i] as usize]),
+            [0, 1, 2, 3, 4, 5].map(|k| m.positions[m.indices[k] as usize]),
             [0, 1, 2, 0, 2, 3].map(|i| [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y][i])
         );
         assert!(read_obj(b"v 0 0 0\nf 1 2 3\n").is_err());

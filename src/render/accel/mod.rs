@@ -221,12 +221,16 @@ impl Instance {
     /// An object-space surface point in world space: the position mapped in
     /// f64, its error bound grown conservatively (pbrt-v3's
     /// `Transform::operator()(p, pError, &absError)`), normals by the inverse
-    /// transpose. The object-space normal is already oriented (ReverseOrientation
-    /// and the shape's handedness); mapping it by the inverse transpose keeps
-    /// it on the same side of the surface whatever the instance's handedness,
-    /// so no further flip is needed (flattening instead recomputes the normal
-    /// from world-space vertices, whose cross product flips with a mirroring
-    /// transform: that is where its `flip_normal` term comes from).
+    /// transpose, as pbrt-v3's `TransformedPrimitive` does.
+    ///
+    /// Orientation: the object-space normal is already oriented (the shape's
+    /// ReverseOrientation and handedness, inside the object). The instance's
+    /// handedness adds no flip: for triangles this gives exactly the side a
+    /// placed (non-instanced) copy gets, because a placed mesh's normal is the
+    /// cross product of world-space edges, which a mirror flips once and its
+    /// `flip_normal` flips back. For spheres under a mirroring instance it
+    /// differs from a placed sphere as it does in pbrt-v3 (a placed sphere's
+    /// normal is flipped by its transform's handedness; an instance's is not).
     #[inline]
     fn to_world(&self, s: SurfacePoint, has_vertex_normals: bool) -> SurfacePoint {
         let p = self
