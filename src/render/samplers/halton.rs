@@ -154,37 +154,9 @@ impl HaltonSampler {
         self.sample_index = sample_index;
         self.dimension = 0;
         self.interval_index = self.index_for_sample(sample_index as u64);
-        // Arrays: entry k of this sample's array is sample `index * n + k` of
-        // the pixel, as GlobalSampler::StartPixel lays them out.
-        let mut arrays = std::mem::take(&mut self.arrays);
-        for (i, (&n, data)) in arrays
-            .sizes_1d
-            .iter()
-            .zip(arrays.data_1d.iter_mut())
-            .enumerate()
-        {
-            let first = sample_index as u64 * n as u64;
-            for (k, v) in data.iter_mut().enumerate() {
-                *v = self.sample_dimension(
-                    self.index_for_sample(first + k as u64),
-                    ARRAY_START_DIM + i as u32,
-                );
-            }
-        }
-        let mut dim = ARRAY_START_DIM + arrays.sizes_1d.len() as u32;
-        for (&n, data) in arrays.sizes_2d.iter().zip(arrays.data_2d.iter_mut()) {
-            let first = sample_index as u64 * n as u64;
-            for (k, v) in data.iter_mut().enumerate() {
-                let idx = self.index_for_sample(first + k as u64);
-                *v = Vec2::new(
-                    self.sample_dimension(idx, dim),
-                    self.sample_dimension(idx, dim + 1),
-                );
-            }
-            dim += 2;
-        }
-        arrays.reset();
-        self.arrays = arrays;
+        // Arrays are filled when asked for (integrators request arrays for
+        // every depth, but most paths end long before using them all).
+        self.arrays.reset();
     }
 
     #[inline]
@@ -212,11 +184,39 @@ impl HaltonSampler {
 
     #[inline]
     pub fn get_1d_array(&mut self, n: u32) -> Option<&[f32]> {
+        // Entry k of this sample's array is sample `index * n + k` of the
+        // pixel, as pbrt-v3's GlobalSampler::StartPixel lays them out.
+        let i = self.arrays.next_1d;
+        if i < self.arrays.sizes_1d.len() && self.arrays.sizes_1d[i] == n {
+            let mut data = std::mem::take(&mut self.arrays.data_1d[i]);
+            let first = self.sample_index as u64 * n as u64;
+            for (k, v) in data.iter_mut().enumerate() {
+                *v = self.sample_dimension(
+                    self.index_for_sample(first + k as u64),
+                    ARRAY_START_DIM + i as u32,
+                );
+            }
+            self.arrays.data_1d[i] = data;
+        }
         self.arrays.get_1d(n, 0)
     }
 
     #[inline]
     pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
+        let i = self.arrays.next_2d;
+        if i < self.arrays.sizes_2d.len() && self.arrays.sizes_2d[i] == n {
+            let mut data = std::mem::take(&mut self.arrays.data_2d[i]);
+            let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
+            let first = self.sample_index as u64 * n as u64;
+            for (k, v) in data.iter_mut().enumerate() {
+                let idx = self.index_for_sample(first + k as u64);
+                *v = Vec2::new(
+                    self.sample_dimension(idx, dim),
+                    self.sample_dimension(idx, dim + 1),
+                );
+            }
+            self.arrays.data_2d[i] = data;
+        }
         self.arrays.get_2d(n, 0)
     }
 
