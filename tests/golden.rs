@@ -13,7 +13,6 @@ mod golden;
 
 use common::*;
 use golden::{manifest, Check, PBRS_REFERENCE_SPP};
-use pbrs::render::driver::{render, RenderOptions};
 use pbrs::render::film::compare::compare;
 use pbrs::render::film::io::read_image;
 
@@ -68,23 +67,12 @@ fn every_scene_has_a_golden_entry() {
     }
 }
 
-fn render_seeded(
+/// The golden renders: 128×128 at 64 spp with a given sampler seed.
+fn render_golden(
     scene: &str,
     seed: u64,
 ) -> (pbrs::render::film::Image, pbrs::render::driver::RenderStats) {
-    let mut desc = load(scene);
-    desc.film.xresolution = 128;
-    desc.film.yresolution = 128;
-    desc.sampler.pixel_samples = 64;
-    render(
-        &desc,
-        &RenderOptions {
-            threads: None,
-            seed,
-        },
-        &|_, _| {},
-    )
-    .unwrap()
+    render_seeded(load(scene), 128, 64, seed)
 }
 
 fn check(kind: &str) {
@@ -98,7 +86,7 @@ fn check(kind: &str) {
         match &e.check {
             Check::Pbrt(stem) if kind == "pbrt" => {
                 checked += 1;
-                let (img, stats) = render_seeded(&e.scene, 0);
+                let (img, stats) = render_golden(&e.scene, 0);
                 assert_eq!(stats.dropped_samples(), 0, "{}", e.scene);
                 assert_matches(&name, &img, &reference(stem), Bounds::against_pbrt(stem));
             }
@@ -112,13 +100,13 @@ fn check(kind: &str) {
                     Check::PbrtOwnNoise(stem) => reference(stem),
                     _ => unreachable!(),
                 };
-                let (a, stats) = render_seeded(&e.scene, 0);
+                let (a, stats) = render_golden(&e.scene, 0);
                 assert_eq!(stats.dropped_samples(), 0, "{}", e.scene);
                 // The noise of one 64-spp render, measured against a second,
                 // independently seeded one: E[relMSE(a, b)] = 2 × noise. The
                 // estimate is itself noisy (relative MSE is dominated by a few
                 // pixels at light edges), so the stated factor is 2, not 1.5.
-                let (b, _) = render_seeded(&e.scene, 1);
+                let (b, _) = render_golden(&e.scene, 1);
                 let ab = compare(&a, &b);
                 let ref_share = 1.0 + 64.0 / PBRS_REFERENCE_SPP as f64;
                 let bounds = Bounds {
