@@ -21,11 +21,7 @@ use glam::{IVec2, Vec2, Vec3};
 pub const FILTER_TABLE_WIDTH: usize = 16;
 const TABLE_SIZE: usize = FILTER_TABLE_WIDTH * FILTER_TABLE_WIDTH;
 
-/// Luminance of linear RGB (pbrt-v3's `RGBSpectrum::y()`).
-#[inline]
-pub fn luminance(rgb: Vec3) -> f32 {
-    0.212671 * rgb.x + 0.715160 * rgb.y + 0.072169 * rgb.z
-}
+pub use crate::render::geometry::luminance;
 
 /// A linear RGB image: `data` holds `width * height` RGB triples, rows from
 /// top to bottom.
