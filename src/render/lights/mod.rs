@@ -7,11 +7,9 @@ mod distribution;
 pub use distribution::{LightSampler, LightSamplerKind};
 
 use crate::render::accel::Geometry;
-use crate::render::geometry::{
-    gamma, luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray,
-};
+use crate::render::geometry::{luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray};
 use crate::render::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
-use crate::render::shapes::{intersect_triangle, ShapeSample, SurfacePoint};
+use crate::render::shapes::{intersect_triangle, sample_triangle_point, ShapeSample, SurfacePoint};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -167,15 +165,13 @@ impl Light {
                 tri,
                 ..
             } => {
-                let b = crate::render::sampling::uniform_sample_triangle(u);
-                let [p0, p1, p2] = tri.p;
-                let q = b.x * p0 + b.y * p1 + (1.0 - b.x - b.y) * p2;
+                let (b, q, _) = sample_triangle_point(tri.p, u);
                 let d = q - p;
                 let dist2 = d.length_squared();
                 let n = if tri.n != Vec3::ZERO {
                     tri.n
                 } else {
-                    geom.meshes[mesh as usize].oriented_normal(t, [b.x, b.y, 1.0 - b.x - b.y])
+                    geom.meshes[mesh as usize].oriented_normal(t, b)
                 };
                 let cos = -n.dot(d) / dist2.sqrt();
                 if dist2 == 0.0 || (!two_sided && cos <= 0.0) {
@@ -220,12 +216,7 @@ impl Light {
                     AreaShape::Triangle { mesh, tri } => {
                         let s = if cache.n != Vec3::ZERO {
                             // pbrt-v3 Triangle::Sample from the cached vertices.
-                            let b = crate::render::sampling::uniform_sample_triangle(u);
-                            let b = [b.x, b.y, 1.0 - b.x - b.y];
-                            let [p0, p1, p2] = cache.p;
-                            let p = b[0] * p0 + b[1] * p1 + b[2] * p2;
-                            let p_error = gamma(6)
-                                * ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs());
+                            let (_, p, p_error) = sample_triangle_point(cache.p, u);
                             ShapeSample {
                                 point: SurfacePoint {
                                     p,

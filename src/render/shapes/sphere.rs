@@ -18,7 +18,8 @@ pub struct Sphere {
     pub world_to_object: DMat4,
     /// Inverse transpose of the linear part, for normals.
     normal_matrix: DMat3,
-    /// |det| of the linear part (area scale for uniform scaling).
+    /// |det| of the linear part of the transform.
+    det_abs: f64,
     pub flip_normal: bool,
     pub material: u32,
     pub light: Option<u32>,
@@ -77,6 +78,7 @@ impl Sphere {
             object_to_world,
             world_to_object: object_to_world.inverse(),
             normal_matrix,
+            det_abs: det.abs(),
             flip_normal: reverse ^ (det < 0.0),
             material,
             light: None,
@@ -213,29 +215,24 @@ impl Sphere {
         let phi = self.phi_max * u.y as f64;
         let rxy = (r * r - z * z).max(0.0).sqrt();
         let p_obj = DVec3::new(rxy * phi.cos(), rxy * phi.sin(), z);
-        let point = self.surface_point(p_obj);
-        let obj_area = self.phi_max * r * (self.z_max - self.z_min);
-        // dA_world / dA_obj = |det M| · |M^-T n_obj|.
-        let n_obj = p_obj / r;
-        let jac = self.normal_matrix_det_abs() * (self.normal_matrix * n_obj).length();
         ShapeSample {
-            point,
-            pdf: (1.0 / (obj_area * jac)) as f32,
+            point: self.surface_point(p_obj),
+            pdf: self.area_density(p_obj / r),
         }
     }
 
-    fn normal_matrix_det_abs(&self) -> f64 {
-        DMat3::from_mat4(self.object_to_world).determinant().abs()
+    /// World-area density of `sample_area` at the point with object-space
+    /// unit normal `n_obj`: dA_world / dA_obj = |det M| · |M^-T n_obj|.
+    #[inline]
+    fn area_density(&self, n_obj: DVec3) -> f32 {
+        let obj_area = self.phi_max * self.radius * (self.z_max - self.z_min);
+        (1.0 / (obj_area * self.det_abs * (self.normal_matrix * n_obj).length())) as f32
     }
 
     /// Density by area at a world point of this sphere (for area sampling).
     pub fn pdf_area(&self, p_world: Vec3) -> f32 {
         let p_obj = self.world_to_object.transform_point3(p_world.as_dvec3());
-        let r = self.radius;
-        let n_obj = p_obj / p_obj.length().max(1e-300);
-        let obj_area = self.phi_max * r * (self.z_max - self.z_min);
-        let jac = self.normal_matrix_det_abs() * (self.normal_matrix * n_obj).length();
-        (1.0 / (obj_area * jac)) as f32
+        self.area_density(p_obj / p_obj.length().max(1e-300))
     }
 
     /// If a reference point sees the whole sphere as a cone, (centre, radius, cosθmax).

@@ -98,16 +98,26 @@ impl TriangleMesh {
 
     /// Uniform sample by area (pbrt-v3 Triangle::Sample).
     pub fn sample_area(&self, tri: u32, u: Vec2) -> ShapeSample {
-        let b = uniform_sample_triangle(u);
-        let b = [b.x, b.y, 1.0 - b.x - b.y];
+        let (b, p, p_error) = sample_triangle_point(self.vertices(tri), u);
         let mut point = self.surface_point(tri, b);
-        let [p0, p1, p2] = self.vertices(tri);
-        point.p_error = gamma(6) * ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs());
+        point.p = p;
+        point.p_error = p_error;
         ShapeSample {
             point,
             pdf: 1.0 / self.area(tri),
         }
     }
+}
+
+/// A uniformly sampled point of a triangle (pbrt-v3 Triangle::Sample):
+/// barycentrics, position, and the position's error bound.
+#[inline]
+pub fn sample_triangle_point(p: [Vec3; 3], u: Vec2) -> ([f32; 3], Vec3, Vec3) {
+    let b = uniform_sample_triangle(u);
+    let b = [b.x, b.y, 1.0 - b.x - b.y];
+    let q = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
+    let err = gamma(6) * ((b[0] * p[0]).abs() + (b[1] * p[1]).abs() + (b[2] * p[2]).abs());
+    (b, q, err)
 }
 
 /// pbrt-v3's watertight ray–triangle test with its conservative check that
