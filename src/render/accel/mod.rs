@@ -14,7 +14,7 @@
 //! both levels and the closest hit is found across levels by `t` alone.
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
-use crate::render::shapes::{intersect_triangle, Sphere, SurfacePoint, TriangleMesh};
+use crate::render::shapes::{Sphere, SurfacePoint, TriangleMesh, TriangleRay};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -84,6 +84,10 @@ pub struct SurfaceHit {
 struct Level {
     /// Primitives in BVH order (so leaves index them directly).
     prims: Vec<PrimRef>,
+    /// Vertices of the triangle at each BVH position (zero for spheres and
+    /// instances): the hot loop reads one record instead of going through
+    /// the mesh's index and vertex arrays.
+    tris: Vec<[Vec3; 3]>,
     bvh: Option<CwBvh>,
     bounds: Bounds3,
     /// Length of ray directions as obvhs sees them (see `to_obvhs_ray`).
@@ -345,6 +349,7 @@ impl Level {
             prims.push(PrimRef::instance(ii as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
+        let mut tris = Vec::new();
         let bvh = if prims.is_empty() {
             None
         } else {
@@ -356,10 +361,21 @@ impl Level {
                 .iter()
                 .map(|&i| prims[i as usize])
                 .collect();
+            tris = prims
+                .iter()
+                .map(|p| {
+                    if p.mesh == SPHERE_TAG || p.mesh == INSTANCE_TAG {
+                        [Vec3::ZERO; 3]
+                    } else {
+                        meshes[p.mesh as usize].vertices(p.index)
+                    }
+                })
+                .collect();
             Some(bvh)
         };
         Level {
             prims,
+            tris,
             bvh,
             ray_length: ray_length_for(&bounds),
             bounds,
@@ -377,23 +393,24 @@ struct Shapes<'a> {
 }
 
 impl Shapes<'_> {
-    /// Intersects a triangle or a sphere of this level (not an instance).
-    #[inline]
+    /// Intersects the triangle or sphere at BVH position `id` (not an instance).
+    #[inline(always)]
     fn intersect_shape(
         &self,
         prim: PrimRef,
-        o: Vec3,
-        d: Vec3,
+        id: usize,
+        tr: &TriangleRay,
+        ray: &Ray,
         t_max: f32,
     ) -> Option<(f32, HitLocal)> {
         if prim.mesh == SPHERE_TAG {
             let s = &self.spheres[prim.index as usize];
-            s.intersect(o, d, t_max)
+            s.intersect(ray.o, ray.d, t_max)
                 .map(|(t, p)| (t, HitLocal::SpherePoint(p)))
         } else {
-            let m = &self.meshes[prim.mesh as usize];
-            let [p0, p1, p2] = m.vertices(prim.index);
-            intersect_triangle(o, d, t_max, p0, p1, p2).map(|(t, b)| (t, HitLocal::Bary(b)))
+            let [p0, p1, p2] = self.level.tris[id];
+            tr.intersect(t_max, p0, p1, p2)
+                .map(|(t, b)| (t, HitLocal::Bary(b)))
         }
     }
 
@@ -408,7 +425,7 @@ impl Shapes<'_> {
         let bvh = self.level.bvh.as_ref()?;
         let mut rh = RayHit::none();
         let mut best: Option<Hit> = None;
-        let (o, d) = (ray.o, ray.d);
+        let tr = TriangleRay::new(ray.o, ray.d);
         let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
         bvh.ray_traverse(r, &mut rh, |r, id| {
             let prim = self.level.prims[id];
@@ -416,7 +433,7 @@ impl Shapes<'_> {
             let hit = if prim.mesh == INSTANCE_TAG {
                 instance_hit(prim.index, t_max)
             } else {
-                self.intersect_shape(prim, o, d, t_max)
+                self.intersect_shape(prim, id, &tr, ray, t_max)
                     .map(|(t, local)| Hit {
                         t,
                         prim,
@@ -442,7 +459,7 @@ impl Shapes<'_> {
         let Some(bvh) = self.level.bvh.as_ref() else {
             return false;
         };
-        let (o, d, t_max) = (ray.o, ray.d, ray.t_max);
+        let tr = TriangleRay::new(ray.o, ray.d);
         let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
         !bvh.ray_traverse_miss(r, |_, id| {
             let prim = self.level.prims[id];
@@ -455,7 +472,7 @@ impl Shapes<'_> {
                     f32::INFINITY
                 };
             }
-            match self.intersect_shape(prim, o, d, t_max) {
+            match self.intersect_shape(prim, id, &tr, ray, ray.t_max) {
                 Some((t, _)) => t / k,
                 None => f32::INFINITY,
             }

@@ -6,7 +6,7 @@ mod triangle;
 
 pub use sphere::Sphere;
 pub use sphere::{area_to_solid_angle, to_solid_angle};
-pub use triangle::{intersect_triangle, sample_triangle_point, TriangleMesh};
+pub use triangle::{intersect_triangle, sample_triangle_point, TriangleMesh, TriangleRay};
 
 use glam::Vec3;
 

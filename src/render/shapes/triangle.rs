@@ -131,82 +131,129 @@ pub fn intersect_triangle(
     p1: Vec3,
     p2: Vec3,
 ) -> Option<(f32, [f32; 3])> {
-    // Translate to the ray origin, permute so z is the largest direction axis.
-    let mut p0t = p0 - o;
-    let mut p1t = p1 - o;
-    let mut p2t = p2 - o;
-    let ad = d.abs();
-    let kz = if ad.x > ad.y {
-        if ad.x > ad.z {
-            0
+    TriangleRay::new(o, d).intersect(t_max, p0, p1, p2)
+}
+
+/// The per-ray part of pbrt-v3's watertight triangle test (the axis
+/// permutation and the shear), computed once per ray instead of once per
+/// triangle. The permutation is applied with static swizzles: `kz` is the
+/// same for every triangle a ray meets, so the branch on it is predicted.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay {
+    o: Vec3,
+    kz: u8,
+    /// (Sx, Sy, Sz) of pbrt-v3.
+    shear: Vec3,
+}
+
+impl TriangleRay {
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3) -> TriangleRay {
+        let ad = d.abs();
+        let kz = if ad.x > ad.y {
+            if ad.x > ad.z {
+                0
+            } else {
+                2
+            }
+        } else if ad.y > ad.z {
+            1
         } else {
             2
+        };
+        let dp = permute(kz, d);
+        let sz = 1.0 / dp.z;
+        TriangleRay {
+            o,
+            kz,
+            shear: Vec3::new(-dp.x * sz, -dp.y * sz, sz),
         }
-    } else if ad.y > ad.z {
-        1
-    } else {
-        2
-    };
-    let kx = if kz == 2 { 0 } else { kz + 1 };
-    let ky = if kx == 2 { 0 } else { kx + 1 };
-    let perm = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
-    let dp = perm(d);
-    p0t = perm(p0t);
-    p1t = perm(p1t);
-    p2t = perm(p2t);
-    // Shear so the ray runs along +z.
-    let sz = 1.0 / dp.z;
-    let sx = -dp.x * sz;
-    let sy = -dp.y * sz;
-    p0t.x += sx * p0t.z;
-    p0t.y += sy * p0t.z;
-    p1t.x += sx * p1t.z;
-    p1t.y += sy * p1t.z;
-    p2t.x += sx * p2t.z;
-    p2t.y += sy * p2t.z;
-    let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
-    let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
-    let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        // Exactly on an edge in f32: decide in f64 (watertightness).
-        e0 = (p1t.x as f64 * p2t.y as f64 - p1t.y as f64 * p2t.x as f64) as f32;
-        e1 = (p2t.x as f64 * p0t.y as f64 - p2t.y as f64 * p0t.x as f64) as f32;
-        e2 = (p0t.x as f64 * p1t.y as f64 - p0t.y as f64 * p1t.x as f64) as f32;
     }
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
+
+    /// Hit distance and barycentrics for `0 < t < t_max`.
+    #[inline(always)]
+    pub fn intersect(&self, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<(f32, [f32; 3])> {
+        match self.kz {
+            0 => self.intersect_k::<0>(t_max, p0, p1, p2),
+            1 => self.intersect_k::<1>(t_max, p0, p1, p2),
+            _ => self.intersect_k::<2>(t_max, p0, p1, p2),
+        }
     }
-    let det = e0 + e1 + e2;
-    if det == 0.0 || !det.is_finite() {
-        return None;
+
+    #[inline(always)]
+    fn intersect_k<const KZ: u8>(
+        &self,
+        t_max: f32,
+        p0: Vec3,
+        p1: Vec3,
+        p2: Vec3,
+    ) -> Option<(f32, [f32; 3])> {
+        // Translate to the ray origin, permute so z is the largest direction axis.
+        let mut p0t = permute(KZ, p0 - self.o);
+        let mut p1t = permute(KZ, p1 - self.o);
+        let mut p2t = permute(KZ, p2 - self.o);
+        // Shear so the ray runs along +z.
+        let (sx, sy, sz) = (self.shear.x, self.shear.y, self.shear.z);
+        p0t.x += sx * p0t.z;
+        p0t.y += sy * p0t.z;
+        p1t.x += sx * p1t.z;
+        p1t.y += sy * p1t.z;
+        p2t.x += sx * p2t.z;
+        p2t.y += sy * p2t.z;
+        let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
+        let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
+        let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
+        if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+            // Exactly on an edge in f32: decide in f64 (watertightness).
+            e0 = (p1t.x as f64 * p2t.y as f64 - p1t.y as f64 * p2t.x as f64) as f32;
+            e1 = (p2t.x as f64 * p0t.y as f64 - p2t.y as f64 * p0t.x as f64) as f32;
+            e2 = (p0t.x as f64 * p1t.y as f64 - p0t.y as f64 * p1t.x as f64) as f32;
+        }
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        p0t.z *= sz;
+        p1t.z *= sz;
+        p2t.z *= sz;
+        let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+            return None;
+        }
+        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let t = t_scaled * inv_det;
+        // Conservatively reject hits whose t cannot be told apart from zero.
+        let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+        let delta_z = gamma(3) * max_zt;
+        let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
+        let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
+        let delta_x = gamma(5) * (max_xt + max_zt);
+        let delta_y = gamma(5) * (max_yt + max_zt);
+        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some((t, [e0 * inv_det, e1 * inv_det, e2 * inv_det]))
     }
-    p0t.z *= sz;
-    p1t.z *= sz;
-    p2t.z *= sz;
-    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
+}
+
+/// pbrt-v3's permutation (kx, ky, kz) = (kz+1, kz+2, kz) mod 3, as a swizzle.
+#[inline(always)]
+fn permute(kz: u8, v: Vec3) -> Vec3 {
+    match kz {
+        0 => Vec3::new(v.y, v.z, v.x),
+        1 => Vec3::new(v.z, v.x, v.y),
+        _ => v,
     }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let t = t_scaled * inv_det;
-    // Conservatively reject hits whose t cannot be told apart from zero.
-    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
-    let delta_z = gamma(3) * max_zt;
-    let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
-    let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t {
-        return None;
-    }
-    Some((t, [e0 * inv_det, e1 * inv_det, e2 * inv_det]))
 }
 
 #[cfg(test)]
