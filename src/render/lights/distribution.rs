@@ -9,6 +9,7 @@ use crate::render::accel::Geometry;
 use crate::render::geometry::Bounds3;
 use crate::render::sampling::Distribution1D;
 use glam::{Vec2, Vec3};
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::OnceLock;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -22,6 +23,8 @@ pub struct LightSampler {
     kind: LightSamplerKind,
     /// Indices of lights that can emit, in scene order.
     active: Vec<u32>,
+    /// Position of each scene light in `active` (`u32::MAX` if it cannot emit).
+    active_pos: Vec<u32>,
     power: Option<Distribution1D>,
     spatial: Option<SpatialGrid>,
 }
@@ -29,7 +32,94 @@ pub struct LightSampler {
 struct SpatialGrid {
     bounds: Bounds3,
     n: [i32; 3],
-    voxels: Vec<OnceLock<Box<Distribution1D>>>,
+    voxels: VoxelStore,
+}
+
+/// The voxels' light-selection CDFs (`active + 1` values each), built on
+/// first use by whichever thread gets there first. Their contents are a
+/// function of the voxel alone, so who builds them never shows in the image.
+enum VoxelStore {
+    /// All voxels in one table, a voxel's state word followed by its CDF (as
+    /// f32 bits): one memory access per lookup. Used while the table stays
+    /// small (few lights).
+    Flat {
+        words: Vec<AtomicU32>,
+        stride: usize,
+    },
+    /// One allocation per built voxel, for many lights.
+    Boxed(Vec<OnceLock<Box<[f32]>>>),
+}
+
+/// Largest flat voxel table, in bytes.
+const FLAT_BUDGET: usize = 16 << 20;
+const EMPTY: u32 = 0;
+const BUILDING: u32 = 1;
+const READY: u32 = 2;
+
+/// A voxel's light choice: the CDF over the active lights.
+#[derive(Clone, Copy)]
+pub struct VoxelCdf<'a> {
+    cdf: CdfRef<'a>,
+}
+
+#[derive(Clone, Copy)]
+enum CdfRef<'a> {
+    Words(&'a [AtomicU32]),
+    Floats(&'a [f32]),
+}
+
+impl VoxelCdf<'_> {
+    #[inline(always)]
+    fn at(&self, i: usize) -> f32 {
+        match self.cdf {
+            CdfRef::Words(w) => f32::from_bits(w[i].load(Ordering::Relaxed)),
+            CdfRef::Floats(f) => f[i],
+        }
+    }
+
+    #[inline(always)]
+    fn len(&self) -> usize {
+        match self.cdf {
+            CdfRef::Words(w) => w.len(),
+            CdfRef::Floats(f) => f.len(),
+        }
+    }
+
+    /// Bin `i` with `cdf[i] <= u < cdf[i + 1]` and its probability.
+    #[inline]
+    fn sample(&self, u: f32) -> (usize, f32) {
+        let n = self.len() - 1;
+        let u = if u >= 0.0 {
+            u.min(crate::render::sampling::ONE_MINUS_EPSILON)
+        } else {
+            0.0
+        };
+        let i = if n <= 16 {
+            let mut i = 0;
+            while i + 1 < n && self.at(i + 1) <= u {
+                i += 1;
+            }
+            i
+        } else {
+            let (mut lo, mut hi) = (0usize, n);
+            // Invariant: cdf[lo] <= u, and the answer is below hi.
+            while hi - lo > 1 {
+                let mid = (lo + hi) / 2;
+                if self.at(mid) <= u {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            lo
+        };
+        (i, self.pmf(i))
+    }
+
+    #[inline]
+    fn pmf(&self, i: usize) -> f32 {
+        (self.at(i + 1) - self.at(i)).max(0.0)
+    }
 }
 
 /// Voxels along the longest axis of the scene bounds. pbrt-v3 uses 64; 32
@@ -75,6 +165,10 @@ impl LightSampler {
         let active: Vec<u32> = (0..lights.len() as u32)
             .filter(|&i| lights[i as usize].power() > 0.0)
             .collect();
+        let mut active_pos = vec![u32::MAX; lights.len()];
+        for (k, &i) in active.iter().enumerate() {
+            active_pos[i as usize] = k as u32;
+        }
         let kind = if active.len() <= 1 {
             LightSamplerKind::Uniform
         } else {
@@ -99,15 +193,21 @@ impl LightSampler {
                 }
             }
             let count = (n[0] * n[1] * n[2]) as usize;
-            SpatialGrid {
-                bounds,
-                n,
-                voxels: (0..count).map(|_| OnceLock::new()).collect(),
-            }
+            let stride = active.len() + 2;
+            let voxels = if count.saturating_mul(stride).saturating_mul(4) <= FLAT_BUDGET {
+                VoxelStore::Flat {
+                    words: (0..count * stride).map(|_| AtomicU32::new(EMPTY)).collect(),
+                    stride,
+                }
+            } else {
+                VoxelStore::Boxed((0..count).map(|_| OnceLock::new()).collect())
+            };
+            SpatialGrid { bounds, n, voxels }
         });
         LightSampler {
             kind,
             active,
+            active_pos,
             power,
             spatial,
         }
@@ -123,9 +223,13 @@ impl LightSampler {
 
     /// Number of voxel distributions built so far (spatial only).
     pub fn voxels_built(&self) -> usize {
-        self.spatial
-            .as_ref()
-            .map_or(0, |s| s.voxels.iter().filter(|v| v.get().is_some()).count())
+        self.spatial.as_ref().map_or(0, |s| match &s.voxels {
+            VoxelStore::Flat { words, stride } => words
+                .chunks(*stride)
+                .filter(|v| v[0].load(Ordering::Acquire) == READY)
+                .count(),
+            VoxelStore::Boxed(v) => v.iter().filter(|v| v.get().is_some()).count(),
+        })
     }
 
     /// Choose a light for shading point `p`: (light index, probability).
@@ -142,26 +246,53 @@ impl LightSampler {
                 (i, pmf)
             }
             LightSamplerKind::Spatial => {
-                let (i, pmf, _) = self
-                    .spatial
-                    .as_ref()?
-                    .lookup(p, &self.active, lights, geom)
-                    .sample_discrete(u);
-                (i, pmf)
+                let spatial = self.spatial.as_ref()?;
+                let mut local = Vec::new();
+                spatial
+                    .lookup(p, &self.active, lights, geom, &mut local)
+                    .sample(u)
             }
         };
         (pmf > 0.0).then(|| (self.active[i], pmf))
     }
+
+    /// Probability that `sample` at `p` chooses scene light `light`.
+    #[inline]
+    pub fn pmf(&self, p: Vec3, light: u32, lights: &[Light], geom: &Geometry) -> f32 {
+        let n = self.active.len();
+        let Some(&k) = self.active_pos.get(light as usize) else {
+            return 0.0;
+        };
+        if k == u32::MAX {
+            return 0.0;
+        }
+        match self.kind {
+            LightSamplerKind::Uniform => 1.0 / n as f32,
+            LightSamplerKind::Power => self
+                .power
+                .as_ref()
+                .map_or(0.0, |d| d.discrete_pdf(k as usize)),
+            LightSamplerKind::Spatial => self.spatial.as_ref().map_or(0.0, |s| {
+                let mut local = Vec::new();
+                s.lookup(p, &self.active, lights, geom, &mut local)
+                    .pmf(k as usize)
+            }),
+        }
+    }
 }
 
 impl SpatialGrid {
-    fn lookup(
-        &self,
+    /// The CDF of the voxel holding `p`, built now if no thread has built it
+    /// yet (`local` receives it when another thread is still publishing it).
+    #[inline]
+    fn lookup<'a>(
+        &'a self,
         p: Vec3,
         active: &[u32],
         lights: &[Light],
         geom: &Geometry,
-    ) -> &Distribution1D {
+        local: &'a mut Vec<f32>,
+    ) -> VoxelCdf<'a> {
         let o = self.bounds.offset(p);
         let mut v = [0i32; 3];
         for i in 0..3 {
@@ -169,19 +300,41 @@ impl SpatialGrid {
             v[i] = x.clamp(0, self.n[i] - 1);
         }
         let idx = ((v[2] * self.n[1] + v[1]) * self.n[0] + v[0]) as usize;
-        self.voxels[idx].get_or_init(|| Box::new(self.compute(v, active, lights, geom)))
+        match &self.voxels {
+            VoxelStore::Flat { words, stride } => {
+                let slot = &words[idx * stride..(idx + 1) * stride];
+                if slot[0].load(Ordering::Acquire) != READY {
+                    *local = self.compute(v, active, lights, geom);
+                    if slot[0]
+                        .compare_exchange(EMPTY, BUILDING, Ordering::Acquire, Ordering::Relaxed)
+                        .is_ok()
+                    {
+                        for (w, c) in slot[1..].iter().zip(local.iter()) {
+                            w.store(c.to_bits(), Ordering::Relaxed);
+                        }
+                        slot[0].store(READY, Ordering::Release);
+                    }
+                    return VoxelCdf {
+                        cdf: CdfRef::Floats(local),
+                    };
+                }
+                VoxelCdf {
+                    cdf: CdfRef::Words(&slot[1..]),
+                }
+            }
+            VoxelStore::Boxed(voxels) => VoxelCdf {
+                cdf: CdfRef::Floats(
+                    voxels[idx]
+                        .get_or_init(|| self.compute(v, active, lights, geom).into_boxed_slice()),
+                ),
+            },
+        }
     }
 
     /// pbrt-v3's SpatialLightDistribution::ComputeDistribution: estimate each
     /// light's contribution (Li/pdf, visibility ignored) at 128 Halton points
     /// of the voxel, and floor every light at 0.1% of the average.
-    fn compute(
-        &self,
-        v: [i32; 3],
-        active: &[u32],
-        lights: &[Light],
-        geom: &Geometry,
-    ) -> Distribution1D {
+    fn compute(&self, v: [i32; 3], active: &[u32], lights: &[Light], geom: &Geometry) -> Vec<f32> {
         let d = self.bounds.diagonal();
         let vmin = self.bounds.min
             + d * Vec3::new(
@@ -213,6 +366,26 @@ impl SpatialGrid {
         for c in &mut contrib {
             *c = c.max(min);
         }
-        Distribution1D::new(&contrib)
+        cdf_of(&contrib)
     }
+}
+
+/// The CDF (`f.len() + 1` values from 0 to 1) of positive weights `f`,
+/// accumulated in f64.
+fn cdf_of(f: &[f32]) -> Vec<f32> {
+    let total: f64 = f.iter().map(|&v| v as f64).sum();
+    let n = f.len();
+    let mut cdf = Vec::with_capacity(n + 1);
+    cdf.push(0.0);
+    if total > 0.0 && total.is_finite() {
+        let mut acc = 0.0f64;
+        for &v in f {
+            acc += v as f64;
+            cdf.push((acc / total) as f32);
+        }
+    } else {
+        cdf.extend((1..=n).map(|i| i as f32 / n as f32));
+    }
+    cdf[n] = 1.0;
+    cdf
 }
