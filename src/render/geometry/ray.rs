@@ -1,4 +1,3 @@
-use super::{next_float_down, next_float_up};
 use glam::Vec3;
 
 /// Fraction of a shadow segment left out at its far end (pbrt-v3's ShadowEpsilon),
@@ -45,16 +44,26 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     )
 }
 
-/// Move `v` one ulp in the direction of the sign of `dir` (not at all for 0).
+/// Move `v` one ulp in the direction of the sign of `dir` (not at all for 0),
+/// as `next_float_up` / `next_float_down` do, without branches: the signs
+/// here are as good as random, so branches would be mispredicted half the
+/// time. Infinities and NaN stay as they are.
 #[inline(always)]
 fn step_away(v: f32, dir: f32) -> f32 {
-    if dir > 0.0 {
-        next_float_up(v)
-    } else if dir < 0.0 {
-        next_float_down(v)
+    let b = v.to_bits();
+    let mag = b & 0x7fff_ffff;
+    let dir_sign = dir.to_bits() & 0x8000_0000;
+    // Away from zero when v and dir share a sign, towards zero otherwise;
+    // from ±0 to the smallest subnormal of dir's sign.
+    let moved = if mag == 0 {
+        1 | dir_sign
+    } else if (b & 0x8000_0000) == dir_sign {
+        b + 1
     } else {
-        v
-    }
+        b - 1
+    };
+    let keep = dir == 0.0 || dir.is_nan() || mag >= 0x7f80_0000;
+    f32::from_bits(if keep { b } else { moved })
 }
 
 /// A ray leaving a surface point in direction `d`.
@@ -83,5 +92,45 @@ pub fn spawn_ray_to_point(p0: Vec3, e0: Vec3, n0: Vec3, p1: Vec3) -> Ray {
         o: pf,
         d: p1 - pf,
         t_max: 1.0 - SHADOW_EPSILON,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::geometry::{next_float_down, next_float_up};
+
+    #[test]
+    fn step_away_matches_next_float() {
+        let values = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            1e30,
+            -3.5e-20,
+            f32::MAX,
+            -f32::MAX,
+        ];
+        for &v in &values {
+            assert_eq!(
+                step_away(v, 2.0).to_bits(),
+                next_float_up(v).to_bits(),
+                "{v} up"
+            );
+            assert_eq!(
+                step_away(v, -2.0).to_bits(),
+                next_float_down(v).to_bits(),
+                "{v} down"
+            );
+            assert_eq!(step_away(v, 0.0).to_bits(), v.to_bits());
+            assert_eq!(step_away(v, -0.0).to_bits(), v.to_bits());
+        }
+        assert_eq!(step_away(f32::INFINITY, 1.0), f32::INFINITY);
+        assert_eq!(step_away(f32::NEG_INFINITY, -1.0), f32::NEG_INFINITY);
     }
 }

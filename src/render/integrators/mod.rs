@@ -9,6 +9,7 @@ use crate::render::materials::{Bsdf, LobeFilter};
 use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
+use crate::render::shapes::SurfacePoint;
 use crate::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
 use glam::{Vec2, Vec3};
 
@@ -315,7 +316,20 @@ fn escaped(scene: &RenderScene) -> Vec3 {
         .sum()
 }
 
-/// pbrt-v3's PathIntegrator::Li.
+/// The path tracer: pbrt-v3's PathIntegrator (next-event estimation,
+/// power-heuristic MIS, `maxdepth`, pbrt-v3's Russian roulette with
+/// `rrthreshold`), with the MIS structure of pbrt-v4 and Mitsuba: the BSDF
+/// sample that continues the path is also the BSDF strategy of MIS, so a
+/// vertex draws one BSDF sample instead of two and needs no separate ray or
+/// light-shape test for it. When the continued path hits an emitter (or
+/// escapes to an infinite light) after a non-specular bounce, its emission
+/// is weighted against the density with which next-event estimation at the
+/// previous vertex would have produced that direction (light choice
+/// probability times the light's solid-angle density); light samples are
+/// weighted the same way. Both estimators are unbiased and the weights of
+/// each direction sum to one, so the expected image is pbrt-v3's; the path
+/// lengths covered are the same (emission is collected at depth `maxdepth`,
+/// next-event estimation happens below it).
 fn path_li(
     mut ray: Ray,
     scene: &RenderScene,
@@ -331,19 +345,40 @@ fn path_li(
     let mut eta_scale = 1.0f32;
     let mut bounces = 0u32;
     let mut pass = 0u32;
+    // The last scattering vertex and the BSDF density of the direction
+    // sampled there (for the MIS weight of emission found along it).
+    let mut prev: Option<SurfacePoint> = None;
+    let mut bsdf_pdf = 0.0f32;
     loop {
         scratch.counts.closest += 1;
         let hit = scene.geometry.intersect(&ray);
         let Some(hit) = hit else {
-            if bounces == 0 || specular_bounce {
-                l += beta * escaped(scene);
+            for &i in &scene.infinite_lights {
+                let light = &scene.lights[i as usize];
+                let le = light.le_escaped();
+                let w = match prev {
+                    Some(r) if !specular_bounce => {
+                        bsdf_mis_weight(scene, lights, &r, i, ray.d, bsdf_pdf)
+                    }
+                    _ => 1.0,
+                };
+                l += beta * le * w;
             }
             break;
         };
         let s = scene.geometry.surface(&hit);
         let wo = -ray.d;
-        if bounces == 0 || specular_bounce {
-            l += beta * emitted(scene, &s, wo);
+        if let Some(light_index) = s.light {
+            let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
+            if le != Vec3::ZERO {
+                let w = match prev {
+                    Some(r) if !specular_bounce => {
+                        bsdf_mis_weight(scene, lights, &r, light_index, ray.d, bsdf_pdf)
+                    }
+                    _ => 1.0,
+                };
+                l += beta * le * w;
+            }
         }
         if bounces >= max_depth {
             break;
@@ -360,7 +395,7 @@ fn path_li(
         }
         let bsdf = material.bsdf(s.point.ns, s.point.n, true);
         if bsdf.has_non_specular() {
-            l += beta * sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights);
+            l += beta * sample_light_mis(scene, &s, &bsdf, wo, sampler, scratch, lights);
         }
         let u = sampler.get_2d();
         let Some(bs) = bsdf.sample(wo, u, LobeFilter::All) else {
@@ -371,6 +406,8 @@ fn path_li(
         }
         beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
         specular_bounce = bs.specular;
+        bsdf_pdf = bs.pdf;
+        prev = Some(s.point);
         if bs.specular && bs.transmission {
             let eta2 = bsdf.eta * bsdf.eta;
             eta_scale *= if wo.dot(s.point.n) > 0.0 {
@@ -392,6 +429,71 @@ fn path_li(
         bounces += 1;
     }
     l
+}
+
+/// Power-heuristic weight of emission from light `light` reached by a BSDF
+/// sample in direction `wi` (density `bsdf_pdf`) from `r`, against
+/// next-event estimation at `r` choosing that light and sampling `wi`.
+#[inline(never)]
+fn bsdf_mis_weight(
+    scene: &RenderScene,
+    lights: &LightSampler,
+    r: &SurfacePoint,
+    light: u32,
+    wi: Vec3,
+    bsdf_pdf: f32,
+) -> f32 {
+    let pmf = lights.pmf(r.p, light, &scene.lights, &scene.geometry);
+    if pmf == 0.0 {
+        return 1.0;
+    }
+    let light_pdf = pmf * scene.lights[light as usize].pdf_li(r, wi, &scene.geometry);
+    power_heuristic(1, bsdf_pdf, 1, light_pdf)
+}
+
+/// Next-event estimation of the path tracer: choose a light, sample it,
+/// trace the shadow ray, weight against the BSDF strategy (whose sample is
+/// the path's continuation, see `path_li`).
+#[inline]
+fn sample_light_mis(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+    lights: &LightSampler,
+) -> Vec3 {
+    if scene.lights.is_empty() {
+        return Vec3::ZERO;
+    }
+    let u = sampler.get_1d();
+    let u_light = sampler.get_2d();
+    let Some((light_index, pmf)) = lights.sample(s.point.p, u, &scene.lights, &scene.geometry)
+    else {
+        return Vec3::ZERO;
+    };
+    let light = &scene.lights[light_index as usize];
+    let Some(ls) = light.sample_li(&s.point, u_light, &scene.geometry) else {
+        return Vec3::ZERO;
+    };
+    if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let f = bsdf.f(wo, ls.wi) * ls.wi.dot(s.point.ns).abs();
+    if f == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    scratch.counts.shadow += 1;
+    if scene.geometry.occluded(&ls.shadow) {
+        return Vec3::ZERO;
+    }
+    let light_pdf = pmf * ls.pdf;
+    if light.is_delta() {
+        return f * ls.li / light_pdf;
+    }
+    let scattering_pdf = bsdf.pdf(wo, ls.wi);
+    f * ls.li * power_heuristic(1, light_pdf, 1, scattering_pdf) / light_pdf
 }
 
 /// pbrt-v3's UniformSampleOneLight with a light distribution.
