@@ -477,7 +477,7 @@ fn sample_light_mis(
     let Some(ls) = light.sample_li(&s.point, u_light, &scene.geometry) else {
         return Vec3::ZERO;
     };
-    if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+    if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
     let f = bsdf.f(wo, ls.wi) * ls.wi.dot(s.point.ns).abs();
