@@ -181,10 +181,11 @@ fn render_tile(
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
+    let lens = scene.camera.uses_lens();
     for pixel in bounds.iter() {
         for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
-            let cs = sampler.get_camera_sample(pixel);
+            let cs = sampler.camera_sample(pixel, lens);
             let ray = scene.camera.generate_ray(&cs);
             let mut l = integrator.li(ray, scene, &mut sampler, &mut scratch);
             // pbrt-v3: samples with NaN, infinite or negative radiance are

@@ -354,8 +354,7 @@ impl Level {
             None
         } else {
             let mut t = Duration::ZERO;
-            let bvh =
-                obvhs::cwbvh::builder::build_cwbvh(&aabbs, build_params(aabbs.len()), &mut t);
+            let bvh = obvhs::cwbvh::builder::build_cwbvh(&aabbs, build_params(aabbs.len()), &mut t);
             prims = bvh
                 .primitive_indices
                 .iter()

@@ -46,6 +46,13 @@ impl Camera {
         }
     }
 
+    /// True if `generate_ray` reads the sample's lens position (a thin lens;
+    /// time is never read: there is no motion blur).
+    #[inline]
+    pub fn uses_lens(&self) -> bool {
+        self.lens_radius > 0.0
+    }
+
     /// The camera ray for a film position (raster coordinates) and lens sample.
     #[inline]
     pub fn generate_ray(&self, cs: &CameraSample) -> Ray {

@@ -137,8 +137,8 @@ impl HaltonSampler {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
             1 => radical_inverse(&BASE3, self.scale1.div(index)),
             d if (d as usize) < PRIME_TABLE_SIZE => {
-                let (b, perm) = self.tables.dimension(d as usize);
-                scrambled_radical_inverse(b, perm, index)
+                let (b, perm, tail) = self.tables.dimension(d as usize);
+                scrambled_radical_inverse(b, perm, tail, index)
             }
             d => hash_to_unit(mix64(
                 mix64(index ^ self.seed_hash)
@@ -157,6 +157,14 @@ impl HaltonSampler {
         // Arrays are filled when asked for (integrators request arrays for
         // every depth, but most paths end long before using them all).
         self.arrays.reset();
+    }
+
+    /// Consumes `n` dimensions below the array dimensions without computing
+    /// them.
+    #[inline]
+    pub fn skip(&mut self, n: u32) {
+        debug_assert!(self.dimension + n <= ARRAY_START_DIM);
+        self.dimension += n;
     }
 
     #[inline]

@@ -120,7 +120,7 @@ pub fn radical_inverse(b: &DigitBase, mut a: u64) -> f32 {
 /// Radical inverse with every digit (including the infinitely many leading
 /// zeros) mapped through `perm` (pbrt-v3's `ScrambledRadicalInverse`).
 #[inline]
-pub fn scrambled_radical_inverse(b: &DigitBase, perm: &[u16], mut a: u64) -> f32 {
+pub fn scrambled_radical_inverse(b: &DigitBase, perm: &[u16], tail: f64, mut a: u64) -> f32 {
     let base = b.base as u64;
     debug_assert_eq!(perm.len(), b.base as usize);
     let mut reversed: u64 = 0;
@@ -145,9 +145,15 @@ pub fn scrambled_radical_inverse(b: &DigitBase, perm: &[u16], mut a: u64) -> f32
             .wrapping_add(perm[a as usize] as u64);
         inv_base_n *= b.inv_base;
     }
-    // The tail of permuted zero digits sums to perm[0] / (base - 1).
-    let tail = perm[0] as f64 / (base - 1) as f64;
+    // The tail of permuted zero digits sums to perm[0] / (base - 1)
+    // (`tail`, see `scramble_tail`).
     ((inv_base_n * (reversed as f64 + tail)) as f32).min(ONE_MINUS_EPSILON)
+}
+
+/// The value of infinitely many permuted zero digits, `perm[0] / (base - 1)`
+/// (the `tail` of `scrambled_radical_inverse`).
+pub fn scramble_tail(perm: &[u16]) -> f64 {
+    perm[0] as f64 / (perm.len() - 1) as f64
 }
 
 /// Inverse of the radical inverse on the first `n_digits` digits
@@ -170,6 +176,7 @@ pub struct PermutationTables {
     perms: Vec<u16>,
     offsets: Vec<u32>,
     bases: Vec<DigitBase>,
+    tails: Vec<f64>,
 }
 
 impl PermutationTables {
@@ -194,10 +201,16 @@ impl PermutationTables {
             off += p as usize;
         }
         let bases = PRIMES.iter().map(|&p| DigitBase::new(p)).collect();
+        let tails = PRIMES
+            .iter()
+            .zip(&offsets)
+            .map(|(&p, &off)| scramble_tail(&perms[off as usize..off as usize + p as usize]))
+            .collect();
         Self {
             perms,
             offsets,
             bases,
+            tails,
         }
     }
 
@@ -223,12 +236,13 @@ impl PermutationTables {
         t
     }
 
-    /// Permutation and base of prime dimension `dim` (< PRIME_TABLE_SIZE).
+    /// Base, permutation and zero-digit tail of prime dimension `dim`
+    /// (< PRIME_TABLE_SIZE).
     #[inline(always)]
-    pub fn dimension(&self, dim: usize) -> (&DigitBase, &[u16]) {
+    pub fn dimension(&self, dim: usize) -> (&DigitBase, &[u16], f64) {
         let b = &self.bases[dim];
         let off = self.offsets[dim] as usize;
-        (b, &self.perms[off..off + b.base as usize])
+        (b, &self.perms[off..off + b.base as usize], self.tails[dim])
     }
 }
 
@@ -290,14 +304,14 @@ mod tests {
         let t = PermutationTables::shared(0);
         let mut r = Pcg32::with_sequence(11);
         for dim in [0usize, 1, 2, 3, 7, 50, 300, 999] {
-            let (b, perm) = t.dimension(dim);
+            let (b, perm, tail) = t.dimension(dim);
             for k in 0..3000u64 {
                 let a = match k % 3 {
                     0 => k,
                     1 => r.uniform_u32() as u64,
                     _ => ((r.uniform_u32() as u64) << 8) ^ r.uniform_u32() as u64,
                 };
-                let fast = scrambled_radical_inverse(b, perm, a);
+                let fast = scrambled_radical_inverse(b, perm, tail, a);
                 let slow =
                     (scrambled_reference(b.base as u64, perm, a) as f32).min(ONE_MINUS_EPSILON);
                 assert!(
@@ -325,7 +339,10 @@ mod tests {
         let b7 = DigitBase::new(7);
         for a in 0..500 {
             assert!(
-                (scrambled_radical_inverse(&b7, &id, a) - radical_inverse(&b7, a)).abs() < 1e-7
+                (scrambled_radical_inverse(&b7, &id, scramble_tail(&id), a)
+                    - radical_inverse(&b7, a))
+                .abs()
+                    < 1e-7
             );
         }
         assert_eq!(inverse_radical_inverse(3, 5, 2), 7); // digits 12 -> 21
@@ -337,7 +354,7 @@ mod tests {
     fn permutations_are_permutations() {
         let t = PermutationTables::shared(0);
         for dim in [0, 1, 2, 10, 999] {
-            let (b, p) = t.dimension(dim);
+            let (b, p, _) = t.dimension(dim);
             let mut s: Vec<u16> = p.to_vec();
             s.sort();
             assert_eq!(s, (0..b.base as u16).collect::<Vec<_>>());

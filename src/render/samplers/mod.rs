@@ -116,12 +116,29 @@ impl Sampler {
     /// `p_lens = get_2d()`. Call right after `start_pixel_sample`.
     #[inline]
     pub fn get_camera_sample(&mut self, pixel: IVec2) -> CameraSample {
+        self.camera_sample(pixel, true)
+    }
+
+    /// As `get_camera_sample`; with `lens == false` the time and lens
+    /// dimensions are consumed (later dimensions are the same) but their
+    /// values are not computed and read 0.5: for a pinhole camera without
+    /// motion, which never reads them.
+    #[inline]
+    pub fn camera_sample(&mut self, pixel: IVec2, lens: bool) -> CameraSample {
         let base = pixel.as_vec2();
         // Keep p_film inside the pixel even when `pixel + offset` rounds up.
         let top = Vec2::new(next_below(base.x + 1.0), next_below(base.y + 1.0));
         let p_film = (base + self.get_2d()).min(top);
-        let time = self.get_1d();
-        let p_lens = self.get_2d();
+        let (time, p_lens) = match self {
+            Sampler::Halton(h) if !lens => {
+                h.skip(3);
+                (0.5, Vec2::splat(0.5))
+            }
+            _ => {
+                let time = self.get_1d();
+                (time, self.get_2d())
+            }
+        };
         CameraSample {
             p_film,
             p_lens,
