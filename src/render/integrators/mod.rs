@@ -273,6 +273,11 @@ impl Integrator {
                 .into_iter()
                 .enumerate()
                 {
+                    if !bsdf.has_specular() {
+                        // pbrt-v3 draws the sample and the BSDF ignores it.
+                        sampler.skip_2d();
+                        continue;
+                    }
                     let u = sampler.get_2d();
                     if let Some(bs) = bsdf.sample(wo, u, filter) {
                         let cos = bs.wi.dot(s.point.ns).abs();

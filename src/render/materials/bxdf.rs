@@ -163,6 +163,15 @@ impl Bsdf {
         )
     }
 
+    /// True if the BSDF has a specular lobe.
+    #[inline]
+    pub fn has_specular(&self) -> bool {
+        matches!(
+            self.lobes,
+            Lobes::Mirror { .. } | Lobes::FresnelSpecular { .. } | Lobes::SplitGlass { .. }
+        )
+    }
+
     /// True if the BSDF has no lobes at all.
     #[inline]
     pub fn is_empty(&self) -> bool {

@@ -167,6 +167,15 @@ impl HaltonSampler {
         self.dimension += n;
     }
 
+    /// Consumes the dimensions `get_2d` would, without computing them.
+    #[inline]
+    pub fn skip_2d(&mut self) {
+        if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
+            self.dimension = self.array_end_dim;
+        }
+        self.dimension += 2;
+    }
+
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
         if self.dimension >= ARRAY_START_DIM && self.dimension < self.array_end_dim {

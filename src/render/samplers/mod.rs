@@ -112,6 +112,18 @@ impl Sampler {
         dispatch!(self, s => s.get_2d())
     }
 
+    /// Consumes a 2D sample whose value is not needed (a BSDF with no lobe
+    /// that would read it): the sampler is left where `get_2d` leaves it.
+    #[inline]
+    pub fn skip_2d(&mut self) {
+        match self {
+            Sampler::Halton(h) => h.skip_2d(),
+            _ => {
+                let _ = self.get_2d();
+            }
+        }
+    }
+
     /// pbrt-v3's order: `p_film = pixel + get_2d()`, `time = get_1d()`,
     /// `p_lens = get_2d()`. Call right after `start_pixel_sample`.
     #[inline]
