@@ -93,6 +93,9 @@ struct Level {
     /// Length of ray directions as obvhs sees them (see `to_obvhs_ray`).
     ray_length: f32,
     degenerate: u64,
+    /// True if every primitive is a triangle (no spheres, no instances): the
+    /// leaf test then skips the primitive-kind checks.
+    triangles_only: bool,
 }
 
 /// An object definition, built once and shared by all its instances.
@@ -270,25 +273,21 @@ fn to_obvhs_ray(ray: &Ray, target_len: f32) -> (obvhs::ray::Ray, f32) {
     } else {
         1.0
     };
-    let d = ray.d * k;
+    let d = Vec3A::from(ray.d * k);
     // Finite reciprocals (no inf·0 = NaN in the slab tests), with the sign
     // obvhs assumes: it picks near and far planes by `direction < 0.0`,
     // which is false for -0.0, so -0.0 must get a positive reciprocal.
-    let inv = |x: f32| {
-        if x.abs() < 1e-30 {
-            if x < 0.0 {
-                -1e30
-            } else {
-                1e30
-            }
-        } else {
-            1.0 / x
-        }
-    };
+    let tiny = d.abs().cmplt(Vec3A::splat(1e-30));
+    let big = Vec3A::select(
+        d.cmplt(Vec3A::ZERO),
+        Vec3A::splat(-1e30),
+        Vec3A::splat(1e30),
+    );
+    let inv = Vec3A::select(tiny, big, d.recip());
     let r = obvhs::ray::Ray {
         origin: Vec3A::from(ray.o),
-        direction: Vec3A::from(d),
-        inv_direction: Vec3A::new(inv(d.x), inv(d.y), inv(d.z)),
+        direction: d,
+        inv_direction: inv,
         tmin: 0.0,
         tmax: ray.t_max / k,
     };
@@ -372,7 +371,11 @@ impl Level {
                 .collect();
             Some(bvh)
         };
+        let triangles_only = prims
+            .iter()
+            .all(|p| p.mesh != SPHERE_TAG && p.mesh != INSTANCE_TAG);
         Level {
+            triangles_only,
             prims,
             tris,
             bvh,
@@ -423,9 +426,30 @@ impl Shapes<'_> {
     ) -> Option<Hit> {
         let bvh = self.level.bvh.as_ref()?;
         let mut rh = RayHit::none();
-        let mut best: Option<Hit> = None;
         let tr = TriangleRay::new(ray.o, ray.d);
         let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
+        if self.level.triangles_only {
+            // Triangles only: keep the best (t, position, barycentrics) and
+            // build the hit once at the end.
+            let mut best: Option<(f32, usize, [f32; 3])> = None;
+            bvh.ray_traverse(r, &mut rh, |r, id| {
+                let [p0, p1, p2] = self.level.tris[id];
+                match tr.intersect((r.tmax * k).min(ray.t_max), p0, p1, p2) {
+                    Some((t, b)) => {
+                        best = Some((t, id, b));
+                        t / k
+                    }
+                    None => f32::INFINITY,
+                }
+            });
+            return best.map(|(t, id, b)| Hit {
+                t,
+                prim: self.level.prims[id],
+                instance: NO_INSTANCE,
+                local: HitLocal::Bary(b),
+            });
+        }
+        let mut best: Option<Hit> = None;
         bvh.ray_traverse(r, &mut rh, |r, id| {
             let prim = self.level.prims[id];
             let t_max = (r.tmax * k).min(ray.t_max);
@@ -460,6 +484,15 @@ impl Shapes<'_> {
         };
         let tr = TriangleRay::new(ray.o, ray.d);
         let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
+        if self.level.triangles_only {
+            return !bvh.ray_traverse_miss(r, |_, id| {
+                let [p0, p1, p2] = self.level.tris[id];
+                match tr.intersect(ray.t_max, p0, p1, p2) {
+                    Some((t, _)) => t / k,
+                    None => f32::INFINITY,
+                }
+            });
+        }
         !bvh.ray_traverse_miss(r, |_, id| {
             let prim = self.level.prims[id];
             if prim.mesh == INSTANCE_TAG {
