@@ -273,12 +273,8 @@ impl FilmTile {
             l *= self.max_sample_luminance / y;
         }
         let p_discrete = p_film - Vec2::splat(0.5);
-        let p0 = (p_discrete - self.radius)
-            .ceil()
-            .as_ivec2()
-            .max(self.pixel_bounds.min);
-        let p1 =
-            ((p_discrete + self.radius).floor().as_ivec2() + IVec2::ONE).min(self.pixel_bounds.max);
+        let p0 = ceil_i(p_discrete - self.radius).max(self.pixel_bounds.min);
+        let p1 = (floor_i(p_discrete + self.radius) + IVec2::ONE).min(self.pixel_bounds.max);
         if p0.x >= p1.x || p0.y >= p1.y {
             return;
         }
@@ -286,7 +282,7 @@ impl FilmTile {
         let n_y = (p1.y - p0.y) as usize;
         let scale = FILTER_TABLE_WIDTH as f32;
         let offset = |d: f32, inv_r: f32| -> usize {
-            (((d * inv_r * scale).abs()).floor() as usize).min(FILTER_TABLE_WIDTH - 1)
+            (((d * inv_r * scale).abs()) as usize).min(FILTER_TABLE_WIDTH - 1)
         };
         let lw = (l * sample_weight).as_dvec3();
         let width = self.pixel_bounds.width() as usize;
@@ -335,5 +331,39 @@ impl FilmTile {
         let w = self.pixel_bounds.width();
         let o = p - self.pixel_bounds.min;
         self.pixels[(o.y * w + o.x) as usize]
+    }
+}
+
+/// `v.floor()` as integers, without a libm call (the x86-64 baseline has no
+/// rounding instruction): truncate, then step down where that rounded up.
+/// Film coordinates are far inside the i32 range; NaN gives 0.
+#[inline(always)]
+fn floor_i(v: Vec2) -> IVec2 {
+    let t = v.as_ivec2();
+    let up = v.cmplt(t.as_vec2());
+    t - IVec2::new(up.test(0) as i32, up.test(1) as i32)
+}
+
+/// `v.ceil()` as integers (see `floor_i`).
+#[inline(always)]
+fn ceil_i(v: Vec2) -> IVec2 {
+    -floor_i(-v)
+}
+
+#[cfg(test)]
+mod rounding_tests {
+    use super::*;
+
+    #[test]
+    fn floor_and_ceil_match_std() {
+        for &x in &[
+            -2.5f32, -2.0, -1.0e-7, -0.0, 0.0, 1.0e-7, 0.5, 1.0, 1.5, 511.99, 4096.0,
+        ] {
+            for &y in &[-3.25f32, 0.0, 2.75, 100.0] {
+                let v = Vec2::new(x, y);
+                assert_eq!(floor_i(v), v.floor().as_ivec2(), "{v}");
+                assert_eq!(ceil_i(v), v.ceil().as_ivec2(), "{v}");
+            }
+        }
     }
 }
