@@ -3,9 +3,15 @@
 //! (the render is box-downsampled to 128×128 first), so that a speed-up that
 //! costs accuracy shows.
 //!
-//! cargo run --release --example bench -- [--spp N] [--res N] [--threads N] [SCENE ...]
+//! cargo run --release --example bench -- [--spp N] [--res N] [--threads N]
+//!     [--baseline PBRS_BINARY] [SCENE ...]
 //!
 //! Each scene runs in its own process so that peak memory is per scene.
+//! With `--baseline`, another pbrs build (e.g. one of an earlier commit,
+//! `git worktree add /tmp/base COMMIT && cargo build --release` there) renders
+//! each scene right before this one, at the scene's own resolution, and the
+//! table gains its wall time and the ratio: on a shared, noisy machine the
+//! ratio of two runs made side by side means more than either time alone.
 
 use pbrs::build::load_scene;
 use pbrs::render::driver::{peak_memory_bytes, render, RenderOptions};
@@ -41,6 +47,7 @@ struct Opts {
     threads: Option<usize>,
     scenes: Vec<PathBuf>,
     child: bool,
+    baseline: Option<PathBuf>,
 }
 
 fn parse() -> Result<Opts, String> {
@@ -50,6 +57,7 @@ fn parse() -> Result<Opts, String> {
         threads: Some(2),
         scenes: Vec::new(),
         child: false,
+        baseline: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -63,6 +71,11 @@ fn parse() -> Result<Opts, String> {
             "--res" => o.res = num("--res")? as u32,
             "--threads" => o.threads = Some(num("--threads")? as usize),
             "--child" => o.child = true,
+            "--baseline" => {
+                o.baseline = Some(PathBuf::from(
+                    args.next().ok_or("--baseline needs a pbrs binary")?,
+                ))
+            }
             s if s.starts_with("--") => return Err(format!("unknown option {s}")),
             s => o.scenes.push(PathBuf::from(s)),
         }
@@ -158,10 +171,16 @@ fn main() {
     );
     println!("{}×{}, {} spp, threads {:?}; error: downsampled to 128×128 against the converged pbrt-v3 reference", o.res, o.res, o.spp, o.threads);
     println!();
-    println!("| scene | wall s | render s | rays M (closest + shadow) | Mrays/s | ns/ray | peak MiB | rel. MSE | block err |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    let base_cols = if o.baseline.is_some() {
+        (" baseline wall s | ratio |", "---|---|")
+    } else {
+        ("", "")
+    };
+    println!("| scene | wall s | render s | rays M (closest + shadow) | Mrays/s | ns/ray | peak MiB | rel. MSE | block err |{}", base_cols.0);
+    println!("|---|---|---|---|---|---|---|---|---|{}", base_cols.1);
     let exe = std::env::current_exe().expect("current exe");
     for scene in &o.scenes {
+        let base_wall = o.baseline.as_ref().and_then(|b| run_baseline(b, scene, &o));
         let mut cmd = Command::new(&exe);
         cmd.arg("--child").arg(scene).args([
             "--spp",
@@ -196,8 +215,13 @@ fn main() {
         let (wall, closest, shadow, render_s, mem, rel, block) =
             (v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
         let rays = closest + shadow;
+        let base = match base_wall {
+            Some(b) => format!(" {b:.2} | {:.2} |", wall / b),
+            None if o.baseline.is_some() => " failed | |".to_string(),
+            None => String::new(),
+        };
         println!(
-            "| {} | {:.2} | {:.2} | {:.1} ({:.1} + {:.1}) | {:.2} | {:.0} | {:.1} | {:.5} | {:.5} |",
+            "| {} | {:.2} | {:.2} | {:.1} ({:.1} + {:.1}) | {:.2} | {:.0} | {:.1} | {:.5} | {:.5} |{base}",
             scene.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default(),
             wall,
             render_s,
@@ -211,4 +235,22 @@ fn main() {
             block
         );
     }
+}
+
+/// Wall time of the baseline binary rendering `scene` (its own resolution;
+/// the same spp and threads), output to a temporary file.
+fn run_baseline(bin: &Path, scene: &Path, o: &Opts) -> Option<f64> {
+    let out = std::env::temp_dir().join(format!("pbrs-bench-baseline-{}.exr", std::process::id()));
+    let mut cmd = Command::new(bin);
+    cmd.arg(scene)
+        .args(["--spp", &o.spp.to_string(), "--quiet", "--outfile"])
+        .arg(&out);
+    if let Some(t) = o.threads {
+        cmd.args(["--threads", &t.to_string()]);
+    }
+    let start = Instant::now();
+    let status = cmd.output().ok()?.status;
+    let wall = start.elapsed().as_secs_f64();
+    let _ = std::fs::remove_file(&out);
+    status.success().then_some(wall)
 }
