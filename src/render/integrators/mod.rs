@@ -478,6 +478,26 @@ fn sample_light_mis(
     else {
         return Vec3::ZERO;
     };
+    light_strategy(scene, s, bsdf, wo, light_index, u_light, pmf, scratch)
+}
+
+/// The light-sampling strategy of MIS: sample light `light_index`, trace the
+/// shadow ray, and weight the sample by the power heuristic against the BSDF
+/// density. `pmf` is the light's selection probability as the weights should
+/// see it: the path tracer's weights include it; pbrt-v3's EstimateDirect
+/// passes 1 and divides by the selection probability afterwards.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn light_strategy(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    light_index: u32,
+    u_light: Vec2,
+    pmf: f32,
+    scratch: &mut Scratch,
+) -> Vec3 {
     let light = &scene.lights[light_index as usize];
     let Some(ls) = light.sample_li(&s.point, u_light, &scene.geometry) else {
         return Vec3::ZERO;
@@ -579,23 +599,7 @@ fn estimate_direct(
     let light = &scene.lights[light_index as usize];
     let geom = &scene.geometry;
     let ns = s.point.ns;
-    let mut ld = Vec3::ZERO;
-    if let Some(ls) = light.sample_li(&s.point, u_light, geom) {
-        if ls.pdf > 0.0 && ls.li != Vec3::ZERO {
-            let f = bsdf.f(wo, ls.wi) * ls.wi.dot(ns).abs();
-            if f != Vec3::ZERO {
-                scratch.counts.shadow += 1;
-                if !geom.occluded(&ls.shadow) {
-                    if light.is_delta() {
-                        ld += f * ls.li / ls.pdf;
-                    } else {
-                        let scattering_pdf = bsdf.pdf(wo, ls.wi);
-                        ld += f * ls.li * power_heuristic(1, ls.pdf, 1, scattering_pdf) / ls.pdf;
-                    }
-                }
-            }
-        }
-    }
+    let mut ld = light_strategy(scene, s, bsdf, wo, light_index, u_light, 1.0, scratch);
     if !light.is_delta() {
         if let Some(bs) = bsdf.sample(wo, u_scatter, LobeFilter::NonSpecular) {
             let f = bs.f * bs.wi.dot(ns).abs();
