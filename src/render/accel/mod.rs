@@ -93,9 +93,6 @@ struct Level {
     /// Length of ray directions as obvhs sees them (see `to_obvhs_ray`).
     ray_length: f32,
     degenerate: u64,
-    /// True if every primitive is a triangle (no spheres, no instances): the
-    /// leaf test then skips the primitive-kind checks.
-    triangles_only: bool,
 }
 
 /// An object definition, built once and shared by all its instances.
@@ -371,11 +368,7 @@ impl Level {
                 .collect();
             Some(bvh)
         };
-        let triangles_only = prims
-            .iter()
-            .all(|p| p.mesh != SPHERE_TAG && p.mesh != INSTANCE_TAG);
         Level {
-            triangles_only,
             prims,
             tris,
             bvh,
@@ -428,27 +421,6 @@ impl Shapes<'_> {
         let mut rh = RayHit::none();
         let tr = TriangleRay::new(ray.o, ray.d);
         let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
-        if self.level.triangles_only {
-            // Triangles only: keep the best (t, position, barycentrics) and
-            // build the hit once at the end.
-            let mut best: Option<(f32, usize, [f32; 3])> = None;
-            bvh.ray_traverse(r, &mut rh, |r, id| {
-                let [p0, p1, p2] = self.level.tris[id];
-                match tr.intersect((r.tmax * k).min(ray.t_max), p0, p1, p2) {
-                    Some((t, b)) => {
-                        best = Some((t, id, b));
-                        t / k
-                    }
-                    None => f32::INFINITY,
-                }
-            });
-            return best.map(|(t, id, b)| Hit {
-                t,
-                prim: self.level.prims[id],
-                instance: NO_INSTANCE,
-                local: HitLocal::Bary(b),
-            });
-        }
         let mut best: Option<Hit> = None;
         bvh.ray_traverse(r, &mut rh, |r, id| {
             let prim = self.level.prims[id];
@@ -484,15 +456,6 @@ impl Shapes<'_> {
         };
         let tr = TriangleRay::new(ray.o, ray.d);
         let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
-        if self.level.triangles_only {
-            return !bvh.ray_traverse_miss(r, |_, id| {
-                let [p0, p1, p2] = self.level.tris[id];
-                match tr.intersect(ray.t_max, p0, p1, p2) {
-                    Some((t, _)) => t / k,
-                    None => f32::INFINITY,
-                }
-            });
-        }
         !bvh.ray_traverse_miss(r, |_, id| {
             let prim = self.level.prims[id];
             if prim.mesh == INSTANCE_TAG {

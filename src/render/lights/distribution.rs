@@ -7,6 +7,7 @@
 use super::Light;
 use crate::render::accel::Geometry;
 use crate::render::geometry::Bounds3;
+use crate::render::sampling::distribution::{find_interval_by, sanitise_u};
 use crate::render::sampling::Distribution1D;
 use glam::{Vec2, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -88,31 +89,7 @@ impl VoxelCdf<'_> {
     /// Bin `i` with `cdf[i] <= u < cdf[i + 1]` and its probability.
     #[inline]
     fn sample(&self, u: f32) -> (usize, f32) {
-        let n = self.len() - 1;
-        let u = if u >= 0.0 {
-            u.min(crate::render::sampling::ONE_MINUS_EPSILON)
-        } else {
-            0.0
-        };
-        let i = if n <= 16 {
-            let mut i = 0;
-            while i + 1 < n && self.at(i + 1) <= u {
-                i += 1;
-            }
-            i
-        } else {
-            let (mut lo, mut hi) = (0usize, n);
-            // Invariant: cdf[lo] <= u, and the answer is below hi.
-            while hi - lo > 1 {
-                let mid = (lo + hi) / 2;
-                if self.at(mid) <= u {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            lo
-        };
+        let i = find_interval_by(self.len(), sanitise_u(u), |i| self.at(i));
         (i, self.pmf(i))
     }
 

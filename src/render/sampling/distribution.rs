@@ -32,7 +32,7 @@ fn sanitise(v: f32) -> f32 {
 
 /// `u` clamped to `[0, 1)`; NaN becomes 0.
 #[inline]
-fn sanitise_u(u: f32) -> f32 {
+pub(crate) fn sanitise_u(u: f32) -> f32 {
     if u >= 0.0 {
         u.min(ONE_MINUS_EPSILON)
     } else {
@@ -44,9 +44,24 @@ fn sanitise_u(u: f32) -> f32 {
 /// (pbrt's `FindInterval`).
 #[inline]
 fn find_interval(cdf: &[f32], u: f32) -> usize {
-    // partition_point: first index where cdf[i] > u.
-    let first_greater = cdf.partition_point(|&c| c <= u);
-    first_greater.saturating_sub(1).min(cdf.len() - 2)
+    find_interval_by(cdf.len(), u, |i| cdf[i])
+}
+
+/// `find_interval` over a non-decreasing CDF of `len` (at least 2) values
+/// read through `cdf` (for CDFs not stored as an `f32` slice).
+#[inline]
+pub(crate) fn find_interval_by(len: usize, u: f32, cdf: impl Fn(usize) -> f32) -> usize {
+    // Bisection for the first index where cdf > u.
+    let (mut lo, mut hi) = (0usize, len);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if cdf(mid) <= u {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo.saturating_sub(1).min(len - 2)
 }
 
 /// `(offset + du) / n` strictly inside bin `offset` and strictly below 1, so
