@@ -1,24 +1,25 @@
-//! Acceleration: obvhs's compressed wide BVHs with closest-hit and occlusion
-//! queries, in two levels.
+//! Acceleration: BVHs built by obvhs and traced four-wide in SIMD
+//! ([`bvh4`]), with closest-hit and occlusion queries, in two levels.
 //!
-//! - The scene level: one CWBVH over the world-space primitives (triangles of
+//! - The scene level: one BVH over the world-space primitives (triangles of
 //!   meshes, spheres) and over the world bounds of object instances.
-//! - The object level: one CWBVH per instanced object, over its primitives in
+//! - The object level: one BVH per instanced object, over its primitives in
 //!   the object's own space. An instance is a transform and an object index, so
 //!   a thousand instances of an object cost a thousand transforms, not a
-//!   thousand copies of its triangles (obvhs has no ready-made top level: the
-//!   scene level's leaf closure traces the object's BVH).
+//!   thousand copies of its triangles (the scene level's leaf callback traces
+//!   the object's BVH).
 //!
 //! Instance rays are the world ray mapped to object space by the inverse
 //! transform without renormalising the direction, so `t` means the same at
 //! both levels and the closest hit is found across levels by `t` alone.
 
+mod bvh4;
+
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
-use crate::render::shapes::{Sphere, SurfacePoint, TriangleMesh, TriangleRay};
-use glam::{DMat3, DMat4, DVec3, Mat3, Vec3, Vec3A};
+use crate::render::shapes::{Sphere, SurfacePoint, TriangleMesh};
+use bvh4::{Bvh4, Candidate};
+use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
-use obvhs::cwbvh::CwBvh;
-use obvhs::ray::RayHit;
 use obvhs::BvhBuildParams;
 use std::sync::Arc;
 use std::time::Duration;
@@ -84,14 +85,8 @@ pub struct SurfaceHit {
 struct Level {
     /// Primitives in BVH order (so leaves index them directly).
     prims: Vec<PrimRef>,
-    /// Vertices of the triangle at each BVH position (zero for spheres and
-    /// instances): the hot loop reads one record instead of going through
-    /// the mesh's index and vertex arrays.
-    tris: Vec<[Vec3; 3]>,
-    bvh: Option<CwBvh>,
+    bvh: Option<Bvh4>,
     bounds: Bounds3,
-    /// Length of ray directions as obvhs sees them (see `to_obvhs_ray`).
-    ray_length: f32,
     degenerate: u64,
 }
 
@@ -253,60 +248,6 @@ impl Instance {
     }
 }
 
-/// obvhs's node test clamps the entry distance to an absolute 1e-4 (its
-/// `EPSILON`), which would cull real hits closer than that in small scenes.
-/// So obvhs gets the ray with its direction scaled by an exact power of two
-/// `k` chosen so that |d|·k is 1e-12 of the scene's size: obvhs's parameter is
-/// t' = t / k, every hit farther than ~1e-16 of the scene's size has t' > 1e-4,
-/// and nothing overflows for any scene scale. Each BVH level does this with
-/// its own size and its own `k`; hits cross levels as unscaled `t`.
-#[inline]
-fn to_obvhs_ray(ray: &Ray, target_len: f32) -> (obvhs::ray::Ray, f32) {
-    let len = ray.d.length();
-    let want = target_len / len;
-    // Round to a power of two (keep only sign and exponent bits): exact scaling.
-    let k = if want.is_finite() && want > 0.0 {
-        f32::from_bits(want.to_bits() & 0x7f80_0000).max(f32::MIN_POSITIVE)
-    } else {
-        1.0
-    };
-    let d = Vec3A::from(ray.d * k);
-    // Finite reciprocals (no inf·0 = NaN in the slab tests), with the sign
-    // obvhs assumes: it picks near and far planes by `direction < 0.0`,
-    // which is false for -0.0, so -0.0 must get a positive reciprocal.
-    let tiny = d.abs().cmplt(Vec3A::splat(1e-30));
-    let big = Vec3A::select(
-        d.cmplt(Vec3A::ZERO),
-        Vec3A::splat(-1e30),
-        Vec3A::splat(1e30),
-    );
-    let inv = Vec3A::select(tiny, big, d.recip());
-    let r = obvhs::ray::Ray {
-        origin: Vec3A::from(ray.o),
-        direction: d,
-        inv_direction: inv,
-        tmin: 0.0,
-        tmax: ray.t_max / k,
-    };
-    (r, k)
-}
-
-fn ray_length_for(bounds: &Bounds3) -> f32 {
-    let size = if bounds.is_empty() {
-        1.0
-    } else {
-        bounds
-            .diagonal()
-            .length()
-            .max(bounds.max.abs().max_element())
-    };
-    if size.is_finite() && size > 0.0 {
-        size * 1e-12
-    } else {
-        1e-12
-    }
-}
-
 impl Level {
     /// Builds the BVH (in parallel, with obvhs's PLOC builder) over the shapes
     /// and the given extra boxes (instances). Zero-area triangles are left
@@ -345,34 +286,20 @@ impl Level {
             prims.push(PrimRef::instance(ii as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
-        let mut tris = Vec::new();
         let bvh = if prims.is_empty() {
             None
         } else {
-            let mut t = Duration::ZERO;
-            let bvh = obvhs::cwbvh::builder::build_cwbvh(&aabbs, build_params(aabbs.len()), &mut t);
-            prims = bvh
-                .primitive_indices
-                .iter()
-                .map(|&i| prims[i as usize])
-                .collect();
-            tris = prims
-                .iter()
-                .map(|p| {
-                    if p.mesh == SPHERE_TAG || p.mesh == INSTANCE_TAG {
-                        [Vec3::ZERO; 3]
-                    } else {
-                        meshes[p.mesh as usize].vertices(p.index)
-                    }
-                })
-                .collect();
+            let (bvh, order) = Bvh4::build(&aabbs, build_params(aabbs.len()), |i| {
+                let p = prims[i];
+                (p.mesh != SPHERE_TAG && p.mesh != INSTANCE_TAG)
+                    .then(|| meshes[p.mesh as usize].vertices(p.index))
+            });
+            prims = order.iter().map(|&i| prims[i as usize]).collect();
             Some(bvh)
         };
         Level {
             prims,
-            tris,
             bvh,
-            ray_length: ray_length_for(&bounds),
             bounds,
             degenerate,
         }
@@ -388,29 +315,8 @@ struct Shapes<'a> {
 }
 
 impl Shapes<'_> {
-    /// Intersects the triangle or sphere at BVH position `id` (not an instance).
-    #[inline(always)]
-    fn intersect_shape(
-        &self,
-        prim: PrimRef,
-        id: usize,
-        tr: &TriangleRay,
-        ray: &Ray,
-        t_max: f32,
-    ) -> Option<(f32, HitLocal)> {
-        if prim.mesh == SPHERE_TAG {
-            let s = &self.spheres[prim.index as usize];
-            s.intersect(ray.o, ray.d, t_max)
-                .map(|(t, p)| (t, HitLocal::SpherePoint(p)))
-        } else {
-            let [p0, p1, p2] = self.level.tris[id];
-            tr.intersect(t_max, p0, p1, p2)
-                .map(|(t, b)| (t, HitLocal::Bary(b)))
-        }
-    }
-
-    /// Closest hit among this level's shapes with `t < ray.t_max`; instances
-    /// are resolved by `instance_hit`.
+    /// Closest hit among this level's shapes with `t <= ray.t_max`;
+    /// instances are resolved by `instance_hit`.
     #[inline]
     fn intersect(
         &self,
@@ -418,31 +324,33 @@ impl Shapes<'_> {
         mut instance_hit: impl FnMut(u32, f32) -> Option<Hit>,
     ) -> Option<Hit> {
         let bvh = self.level.bvh.as_ref()?;
-        let mut rh = RayHit::none();
-        let tr = TriangleRay::new(ray.o, ray.d);
-        let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
         let mut best: Option<Hit> = None;
-        bvh.ray_traverse(r, &mut rh, |r, id| {
-            let prim = self.level.prims[id];
-            let t_max = (r.tmax * k).min(ray.t_max);
-            let hit = if prim.mesh == INSTANCE_TAG {
-                instance_hit(prim.index, t_max)
-            } else {
-                self.intersect_shape(prim, id, &tr, ray, t_max)
-                    .map(|(t, local)| Hit {
-                        t,
-                        prim,
-                        instance: NO_INSTANCE,
-                        local,
-                    })
-            };
-            match hit {
-                Some(h) => {
-                    best = Some(h);
-                    h.t / k
+        bvh.closest(ray, ray.t_max, |c, t_max| {
+            let hit = match c {
+                Candidate::Triangle { pos, t, b } => Some(Hit {
+                    t,
+                    prim: self.level.prims[pos as usize],
+                    instance: NO_INSTANCE,
+                    local: HitLocal::Bary(b),
+                }),
+                Candidate::Other { pos } => {
+                    let prim = self.level.prims[pos as usize];
+                    if prim.mesh == INSTANCE_TAG {
+                        instance_hit(prim.index, t_max)
+                    } else {
+                        let s = &self.spheres[prim.index as usize];
+                        s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
+                            t,
+                            prim,
+                            instance: NO_INSTANCE,
+                            local: HitLocal::SpherePoint(p),
+                        })
+                    }
                 }
-                None => f32::INFINITY,
-            }
+            };
+            let h = hit?;
+            best = Some(h);
+            Some(h.t)
         });
         best
     }
@@ -454,22 +362,14 @@ impl Shapes<'_> {
         let Some(bvh) = self.level.bvh.as_ref() else {
             return false;
         };
-        let tr = TriangleRay::new(ray.o, ray.d);
-        let (r, k) = to_obvhs_ray(ray, self.level.ray_length);
-        !bvh.ray_traverse_miss(r, |_, id| {
-            let prim = self.level.prims[id];
+        bvh.any(ray, ray.t_max, |pos| {
+            let prim = self.level.prims[pos as usize];
             if prim.mesh == INSTANCE_TAG {
-                // Any hit before t_max ends the query, and obvhs stops at any
-                // returned distance below its tmax (> 0): report 0.
-                return if instance_hit(prim.index) {
-                    0.0
-                } else {
-                    f32::INFINITY
-                };
-            }
-            match self.intersect_shape(prim, id, &tr, ray, ray.t_max) {
-                Some((t, _)) => t / k,
-                None => f32::INFINITY,
+                instance_hit(prim.index)
+            } else {
+                self.spheres[prim.index as usize]
+                    .intersect(ray.o, ray.d, ray.t_max)
+                    .is_some()
             }
         })
     }

@@ -1,7 +1,7 @@
 use super::{ShapeSample, SurfacePoint};
 use crate::render::geometry::{face_forward, gamma, Bounds3};
 use crate::render::sampling::uniform_sample_triangle;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// A triangle mesh with vertices in world space. Vertex arrays are shared by
 /// all triangles (32-bit indices).
@@ -244,6 +244,236 @@ impl TriangleRay {
         }
         Some((t, [e0 * inv_det, e1 * inv_det, e2 * inv_det]))
     }
+}
+
+/// Four triangles in SIMD lanes: `v[3 * k + axis]` holds coordinate `axis`
+/// of vertex `k` of the four triangles.
+pub type TrianglePack = [Vec4; 9];
+
+/// Puts up to four triangles in lanes (missing lanes are zero; callers mask
+/// them out).
+pub fn pack_triangles(tris: &[[Vec3; 3]]) -> TrianglePack {
+    assert!(tris.len() <= 4);
+    let mut a = [[0.0f32; 4]; 9];
+    for (lane, t) in tris.iter().enumerate() {
+        for (k, p) in t.iter().enumerate() {
+            a[3 * k][lane] = p.x;
+            a[3 * k + 1][lane] = p.y;
+            a[3 * k + 2][lane] = p.z;
+        }
+    }
+    a.map(Vec4::from_array)
+}
+
+/// [`TriangleRay`] for four-lane tests: the permuted origin and the shear
+/// splatted into lanes once per ray.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay4 {
+    /// Origin coordinates (kx, ky, kz).
+    o: [Vec4; 3],
+    /// (Sx, Sy, Sz).
+    s: [Vec4; 3],
+    kz: u8,
+    scalar: TriangleRay,
+}
+
+impl TriangleRay4 {
+    #[inline(always)]
+    pub fn new(o: Vec3, d: Vec3) -> TriangleRay4 {
+        let scalar = TriangleRay::new(o, d);
+        let po = permute(scalar.kz, o);
+        TriangleRay4 {
+            o: [Vec4::splat(po.x), Vec4::splat(po.y), Vec4::splat(po.z)],
+            s: [
+                Vec4::splat(scalar.shear.x),
+                Vec4::splat(scalar.shear.y),
+                Vec4::splat(scalar.shear.z),
+            ],
+            kz: scalar.kz,
+            scalar,
+        }
+    }
+
+    /// The closest of the pack's triangles in `lanes` (a bit mask) with
+    /// `0 < t <= t_max`: (lane, t, barycentrics). The same arithmetic as
+    /// [`TriangleRay::intersect`] in four lanes, so hits, distances and
+    /// barycentrics are bit-identical to testing the triangles one by one;
+    /// ties go to the lower lane.
+    #[inline(always)]
+    pub fn intersect4(
+        &self,
+        v: &TrianglePack,
+        t_max: f32,
+        lanes: u32,
+    ) -> Option<(u32, f32, [f32; 3])> {
+        let r = match self.kz {
+            0 => self.lanes_k::<0>(v, t_max, lanes),
+            1 => self.lanes_k::<1>(v, t_max, lanes),
+            _ => self.lanes_k::<2>(v, t_max, lanes),
+        };
+        let Some(r) = r else {
+            return self.scalar.intersect4_scalar(v, t_max, lanes);
+        };
+        if r.mask == 0 {
+            return None;
+        }
+        let t = r.t.to_array();
+        let mut lane = r.mask.trailing_zeros();
+        let mut rest = r.mask & (r.mask - 1);
+        while rest != 0 {
+            let l = rest.trailing_zeros();
+            if t[l as usize] < t[lane as usize] {
+                lane = l;
+            }
+            rest &= rest - 1;
+        }
+        let i = lane as usize;
+        let inv = r.inv_det.to_array()[i];
+        Some((
+            lane,
+            t[i],
+            [
+                r.e0.to_array()[i] * inv,
+                r.e1.to_array()[i] * inv,
+                r.e2.to_array()[i] * inv,
+            ],
+        ))
+    }
+
+    /// True if any of the pack's triangles in `lanes` is hit with
+    /// `0 < t <= t_max`.
+    #[inline(always)]
+    pub fn any4(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> bool {
+        let r = match self.kz {
+            0 => self.lanes_k::<0>(v, t_max, lanes),
+            1 => self.lanes_k::<1>(v, t_max, lanes),
+            _ => self.lanes_k::<2>(v, t_max, lanes),
+        };
+        match r {
+            Some(r) => r.mask != 0,
+            None => self.scalar.intersect4_scalar(v, t_max, lanes).is_some(),
+        }
+    }
+
+    /// The four-lane body of `intersect_k`. `None` if a lane in `lanes` has
+    /// an edge value of exactly zero (the caller then decides lane by lane).
+    #[inline(always)]
+    fn lanes_k<const KZ: u8>(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> Option<Lanes> {
+        let kz = KZ as usize;
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let [ox, oy, oz] = self.o;
+        // Translate and permute.
+        let mut p0x = v[kx] - ox;
+        let mut p0y = v[ky] - oy;
+        let mut p0z = v[kz] - oz;
+        let mut p1x = v[3 + kx] - ox;
+        let mut p1y = v[3 + ky] - oy;
+        let mut p1z = v[3 + kz] - oz;
+        let mut p2x = v[6 + kx] - ox;
+        let mut p2y = v[6 + ky] - oy;
+        let mut p2z = v[6 + kz] - oz;
+        // Shear.
+        let [sx, sy, sz] = self.s;
+        p0x += sx * p0z;
+        p0y += sy * p0z;
+        p1x += sx * p1z;
+        p1y += sy * p1z;
+        p2x += sx * p2z;
+        p2y += sy * p2z;
+        let e0 = p1x * p2y - p1y * p2x;
+        let e1 = p2x * p0y - p2y * p0x;
+        let e2 = p0x * p1y - p0y * p1x;
+        let zero = Vec4::ZERO;
+        if (e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero)).bitmask() & lanes != 0 {
+            return None;
+        }
+        let neg = e0.cmplt(zero) | e1.cmplt(zero) | e2.cmplt(zero);
+        let pos = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
+        let inside = !(neg & pos);
+        if inside.bitmask() & lanes == 0 {
+            // Most packs a ray reaches miss in every lane.
+            return Some(Lanes {
+                mask: 0,
+                t: zero,
+                e0,
+                e1,
+                e2,
+                inv_det: zero,
+            });
+        }
+        let det = e0 + e1 + e2;
+        let finite = det.abs().cmplt(Vec4::INFINITY);
+        let mut ok = inside & det.cmpne(zero) & finite;
+        p0z *= sz;
+        p1z *= sz;
+        p2z *= sz;
+        let t_scaled = e0 * p0z + e1 * p1z + e2 * p2z;
+        let tmd = Vec4::splat(t_max) * det;
+        let reject_neg = det.cmplt(zero) & (t_scaled.cmpge(zero) | t_scaled.cmplt(tmd));
+        let reject_pos = det.cmpgt(zero) & (t_scaled.cmple(zero) | t_scaled.cmpgt(tmd));
+        ok &= !(reject_neg | reject_pos);
+        let inv_det = Vec4::ONE / det;
+        let t = t_scaled * inv_det;
+        let max_zt = p0z.abs().max(p1z.abs()).max(p2z.abs());
+        let delta_z = Vec4::splat(gamma(3)) * max_zt;
+        let max_xt = p0x.abs().max(p1x.abs()).max(p2x.abs());
+        let max_yt = p0y.abs().max(p1y.abs()).max(p2y.abs());
+        let g5 = Vec4::splat(gamma(5));
+        let delta_x = g5 * (max_xt + max_zt);
+        let delta_y = g5 * (max_yt + max_zt);
+        let delta_e = Vec4::splat(2.0)
+            * (Vec4::splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t = Vec4::splat(3.0)
+            * (Vec4::splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
+            * inv_det.abs();
+        ok &= t.cmpgt(delta_t);
+        Some(Lanes {
+            mask: ok.bitmask() & lanes,
+            t,
+            e0,
+            e1,
+            e2,
+            inv_det,
+        })
+    }
+}
+
+impl TriangleRay {
+    /// Lane by lane with the scalar test (which decides edge values that are
+    /// exactly zero in f64).
+    #[cold]
+    fn intersect4_scalar(
+        &self,
+        v: &TrianglePack,
+        t_max: f32,
+        lanes: u32,
+    ) -> Option<(u32, f32, [f32; 3])> {
+        let a = v.map(|x| x.to_array());
+        let vertex = |k: usize, l: usize| Vec3::new(a[3 * k][l], a[3 * k + 1][l], a[3 * k + 2][l]);
+        let mut best: Option<(u32, f32, [f32; 3])> = None;
+        for l in 0..4 {
+            if lanes & (1 << l) == 0 {
+                continue;
+            }
+            if let Some((t, b)) = self.intersect(t_max, vertex(0, l), vertex(1, l), vertex(2, l)) {
+                if best.is_none_or(|(_, bt, _)| t < bt) {
+                    best = Some((l as u32, t, b));
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Per-lane results of the four-lane triangle test.
+struct Lanes {
+    mask: u32,
+    t: Vec4,
+    e0: Vec4,
+    e1: Vec4,
+    e2: Vec4,
+    inv_det: Vec4,
 }
 
 /// pbrt-v3's permutation (kx, ky, kz) = (kz+1, kz+2, kz) mod 3, as a swizzle.

@@ -1,0 +1,713 @@
+//! A four-wide BVH traced with SIMD box and triangle tests.
+//!
+//! obvhs builds the tree (PLOC and SAH reinsertion, the same steps as its
+//! CWBVH builder); this module collapses obvhs's binary tree into nodes of up
+//! to four children and leaves of up to four primitives. A node holds its
+//! children's boxes as six four-lane vectors, so one ray meets all four boxes
+//! in a handful of SIMD instructions; a leaf holds its triangles' vertices in
+//! lanes, so one ray meets up to four triangles in one pass of the watertight
+//! test ([`TriangleRay::intersect4`], bit-identical to the scalar test).
+//! Spheres and instances in a leaf are handed to the caller one by one.
+//!
+//! On the Cornell box (36 triangles) a ray visits a node or two and a few
+//! leaves; obvhs's CWBVH traversal, which decodes compressed boxes and calls
+//! back per primitive, was about a third of the render time there.
+//!
+//! Box tests follow pbrt-v3's `Bounds3::IntersectP`: slab distances with the
+//! far distance scaled by `1 + 2γ(3)`, so that rounding never culls a box the
+//! ray touches. Zero direction components get a reciprocal of ±1e30 (finite,
+//! so no `0·∞`), with the sign of the component's sign bit ignored: a slab
+//! parallel to the ray is then either all of `t` or none of it.
+
+use crate::render::geometry::{gamma, Ray};
+use crate::render::shapes::{pack_triangles, TrianglePack, TriangleRay4};
+use glam::{Vec3, Vec3A, Vec4};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::bvh2::Bvh2;
+use obvhs::ploc::PlocBuilder;
+use obvhs::BvhBuildParams;
+
+/// A child reference with this bit set is a leaf.
+const LEAF: u32 = 1 << 31;
+/// Most primitives in a leaf (one SIMD pack).
+const LEAF_SIZE: usize = 4;
+/// Traversal stack sizes (entries): a tiny one for small trees, kept in the
+/// caller's frame (zeroing it is part of every ray's cost), and larger ones
+/// in frames of their own.
+const TINY_STACK: usize = 16;
+const SMALL_STACK: usize = 64;
+const LARGE_STACK: usize = 512;
+
+/// Four children's boxes, lane `i` for child `i`: `b[axis]` is the minimum
+/// and `b[3 + axis]` the maximum along `axis`. An unused slot has an empty
+/// box (+∞, −∞) that no ray hits.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node {
+    b: [Vec4; 6],
+    child: [u32; 4],
+}
+
+/// Up to four primitives at BVH positions `first .. first + count`;
+/// `triangles` marks the lanes that are triangles (their vertices in `v`).
+#[derive(Clone, Copy, Debug)]
+struct Leaf {
+    v: TrianglePack,
+    first: u32,
+    count: u32,
+    triangles: u32,
+}
+
+/// What a leaf hands to the closest-hit callback.
+pub(super) enum Candidate {
+    /// A triangle already tested and hit (at BVH position `pos`).
+    Triangle { pos: u32, t: f32, b: [f32; 3] },
+    /// Another primitive at BVH position `pos`, not tested yet.
+    Other { pos: u32 },
+}
+
+pub(super) struct Bvh4 {
+    nodes: Vec<Node>,
+    leaves: Vec<Leaf>,
+    /// Traversal stack entries the deepest path can need.
+    stack_need: usize,
+}
+
+/// The per-ray constants of the box test.
+struct BoxRay {
+    o: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// Index into `Node::b` of the near and the far plane per axis.
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl BoxRay {
+    #[inline(always)]
+    fn new(ray: &Ray) -> BoxRay {
+        let d = Vec3A::from(ray.d);
+        let tiny = d.abs().cmplt(Vec3A::splat(1e-30));
+        let big = Vec3A::select(
+            d.cmplt(Vec3A::ZERO),
+            Vec3A::splat(-1e30),
+            Vec3A::splat(1e30),
+        );
+        let r = Vec3A::select(tiny, big, d.recip());
+        let neg = r.cmplt(Vec3A::ZERO).bitmask();
+        let mut near = [0; 3];
+        let mut far = [0; 3];
+        for a in 0..3 {
+            let n = ((neg >> a) & 1) as usize;
+            near[a] = a + 3 * n;
+            far[a] = a + 3 * (1 - n);
+        }
+        BoxRay {
+            o: [
+                Vec4::splat(ray.o.x),
+                Vec4::splat(ray.o.y),
+                Vec4::splat(ray.o.z),
+            ],
+            inv: [Vec4::splat(r.x), Vec4::splat(r.y), Vec4::splat(r.z)],
+            near,
+            far,
+        }
+    }
+
+    /// Entry distances and the mask of children whose box the ray meets
+    /// within `[0, t_max]`.
+    #[inline(always)]
+    fn test(&self, n: &Node, t_max: f32) -> (Vec4, u32) {
+        let tx0 = (n.b[self.near[0]] - self.o[0]) * self.inv[0];
+        let ty0 = (n.b[self.near[1]] - self.o[1]) * self.inv[1];
+        let tz0 = (n.b[self.near[2]] - self.o[2]) * self.inv[2];
+        let tx1 = (n.b[self.far[0]] - self.o[0]) * self.inv[0];
+        let ty1 = (n.b[self.far[1]] - self.o[1]) * self.inv[1];
+        let tz1 = (n.b[self.far[2]] - self.o[2]) * self.inv[2];
+        let t0 = tx0.max(ty0).max(tz0.max(Vec4::ZERO));
+        let t1 =
+            (tx1.min(ty1).min(tz1) * Vec4::splat(1.0 + 2.0 * gamma(3))).min(Vec4::splat(t_max));
+        (t0, t0.cmple(t1).bitmask())
+    }
+}
+
+impl Bvh4 {
+    /// Builds over the boxes (primitive `i` has box `aabbs[i]`, and is a
+    /// triangle with vertices `triangle(i)` or something else for `None`).
+    /// Returns the BVH and the primitives in BVH order (BVH position `p`
+    /// holds primitive `order[p]`). `aabbs` must not be empty.
+    pub(super) fn build(
+        aabbs: &[Aabb],
+        params: BvhBuildParams,
+        triangle: impl Fn(usize) -> Option<[Vec3; 3]>,
+    ) -> (Bvh4, Vec<u32>) {
+        assert!(!aabbs.is_empty());
+        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+            params.ploc_search_distance,
+            aabbs,
+            (0..aabbs.len() as u32).collect(),
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        Self::from_bvh2(&bvh2, triangle)
+    }
+
+    fn from_bvh2(bvh2: &Bvh2, triangle: impl Fn(usize) -> Option<[Vec3; 3]>) -> (Bvh4, Vec<u32>) {
+        let nodes2 = &bvh2.nodes;
+        // PLOC makes a leaf per primitive; a leaf is never opened below.
+        assert!(
+            nodes2.iter().all(|n| n.prim_count as usize <= LEAF_SIZE),
+            "obvhs BVH2 leaves hold one primitive each"
+        );
+        let counts = subtree_counts(bvh2);
+        let mut order: Vec<u32> = Vec::with_capacity(bvh2.primitive_indices.len());
+        let mut nodes: Vec<Node> = Vec::new();
+        let mut leaves: Vec<Leaf> = Vec::new();
+        let mut max_depth = 0usize;
+
+        let mut make_leaf = |root: usize, order: &mut Vec<u32>| -> u32 {
+            let first = order.len() as u32;
+            // The subtree's primitives, left to right.
+            let mut stack = vec![root];
+            while let Some(i) = stack.pop() {
+                let n = &nodes2[i];
+                if n.prim_count == 0 {
+                    stack.push(n.first_index as usize + 1);
+                    stack.push(n.first_index as usize);
+                } else {
+                    let s = n.first_index as usize;
+                    order.extend_from_slice(&bvh2.primitive_indices[s..s + n.prim_count as usize]);
+                }
+            }
+            let prims = &order[first as usize..];
+            debug_assert!(prims.len() <= LEAF_SIZE);
+            let mut tris = [[Vec3::ZERO; 3]; LEAF_SIZE];
+            let mut mask = 0;
+            for (lane, &p) in prims.iter().enumerate() {
+                if let Some(t) = triangle(p as usize) {
+                    tris[lane] = t;
+                    mask |= 1 << lane;
+                }
+            }
+            leaves.push(Leaf {
+                v: pack_triangles(&tris),
+                first,
+                count: prims.len() as u32,
+                triangles: mask,
+            });
+            (leaves.len() - 1) as u32 | LEAF
+        };
+
+        // Work list: (BVH2 node, BVH4 node to fill, depth).
+        nodes.push(empty_node());
+        let mut work = vec![(0usize, 0usize, 1usize)];
+        while let Some((n2, out, depth)) = work.pop() {
+            max_depth = max_depth.max(depth);
+            // The children: open the largest internal child until there are four.
+            let mut kids: Vec<usize> = if counts[n2] as usize <= LEAF_SIZE {
+                vec![n2] // a root small enough to be one leaf
+            } else {
+                let f = nodes2[n2].first_index as usize;
+                vec![f, f + 1]
+            };
+            while kids.len() < 4 {
+                let open = kids
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &k)| counts[k] as usize > LEAF_SIZE)
+                    .max_by(|a, b| {
+                        nodes2[*a.1]
+                            .aabb
+                            .half_area()
+                            .total_cmp(&nodes2[*b.1].aabb.half_area())
+                    })
+                    .map(|(i, _)| i);
+                let Some(i) = open else { break };
+                let f = nodes2[kids[i]].first_index as usize;
+                kids[i] = f;
+                kids.push(f + 1);
+            }
+            let mut node = empty_node();
+            for (slot, &k) in kids.iter().enumerate() {
+                let a = nodes2[k].aabb;
+                for axis in 0..3 {
+                    node.b[axis][slot] = a.min[axis];
+                    node.b[3 + axis][slot] = a.max[axis];
+                }
+                node.child[slot] = if counts[k] as usize <= LEAF_SIZE {
+                    make_leaf(k, &mut order)
+                } else {
+                    nodes.push(empty_node());
+                    work.push((k, nodes.len() - 1, depth + 1));
+                    (nodes.len() - 1) as u32
+                };
+            }
+            nodes[out] = node;
+        }
+        debug_assert_eq!(order.len(), bvh2.primitive_indices.len());
+        (
+            Bvh4 {
+                nodes,
+                leaves,
+                stack_need: 3 * max_depth + 1,
+            },
+            order,
+        )
+    }
+
+    /// Closest hit with `t <= t_max`: triangles are tested here, other
+    /// primitives by `hit`, which is also told of every triangle hit and
+    /// returns the distance of what it accepted (a closer `t_max` from then
+    /// on). Returns whether anything was hit.
+    #[inline]
+    pub(super) fn closest(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        hit: impl FnMut(Candidate, f32) -> Option<f32>,
+    ) -> bool {
+        if self.stack_need <= TINY_STACK {
+            let mut stack = [(0u32, 0f32); TINY_STACK];
+            self.closest_with(ray, t_max, hit, &mut stack)
+        } else {
+            self.closest_deep(ray, t_max, hit)
+        }
+    }
+
+    #[inline(never)]
+    fn closest_deep(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        hit: impl FnMut(Candidate, f32) -> Option<f32>,
+    ) -> bool {
+        if self.stack_need <= SMALL_STACK {
+            let mut stack = [(0u32, 0f32); SMALL_STACK];
+            self.closest_with(ray, t_max, hit, &mut stack)
+        } else if self.stack_need <= LARGE_STACK {
+            self.closest_large(ray, t_max, hit)
+        } else {
+            // Degenerate trees only (hundreds of levels deep).
+            let mut stack = vec![(0u32, 0f32); self.stack_need];
+            self.closest_with(ray, t_max, hit, &mut stack)
+        }
+    }
+
+    #[inline(never)]
+    fn closest_large(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        hit: impl FnMut(Candidate, f32) -> Option<f32>,
+    ) -> bool {
+        let mut stack = [(0u32, 0f32); LARGE_STACK];
+        self.closest_with(ray, t_max, hit, &mut stack)
+    }
+
+    #[inline(always)]
+    fn closest_with(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        hit: impl FnMut(Candidate, f32) -> Option<f32>,
+        stack: &mut [(u32, f32)],
+    ) -> bool {
+        let br = BoxRay::new(ray);
+        let tr = TriangleRay4::new(ray.o, ray.d);
+        let mut t_max = t_max;
+        let mut hit = hit;
+        let mut found = false;
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (t0, mask) = br.test(n, t_max);
+                match mask.count_ones() {
+                    0 => {}
+                    1 => {
+                        cur = n.child[mask.trailing_zeros() as usize];
+                        continue;
+                    }
+                    _ => {
+                        // Near child next, the others stacked far to near.
+                        let t0 = t0.to_array();
+                        let mut hits = [(0u32, 0f32); 4];
+                        let mut k = 0;
+                        let mut m = mask;
+                        while m != 0 {
+                            let i = m.trailing_zeros() as usize;
+                            // Insertion by descending entry distance.
+                            let e = (n.child[i], t0[i]);
+                            let mut j = k;
+                            while j > 0 && hits[j - 1].1 < e.1 {
+                                hits[j] = hits[j - 1];
+                                j -= 1;
+                            }
+                            hits[j] = e;
+                            k += 1;
+                            m &= m - 1;
+                        }
+                        stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        sp += k - 1;
+                        cur = hits[k - 1].0;
+                        continue;
+                    }
+                }
+            } else {
+                let leaf = &self.leaves[(cur & !LEAF) as usize];
+                if leaf.triangles != 0 {
+                    if let Some((lane, t, b)) = tr.intersect4(&leaf.v, t_max, leaf.triangles) {
+                        let pos = leaf.first + lane;
+                        if let Some(t) = hit(Candidate::Triangle { pos, t, b }, t_max) {
+                            t_max = t;
+                            found = true;
+                        }
+                    }
+                }
+                let others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
+                let mut m = others;
+                while m != 0 {
+                    let pos = leaf.first + m.trailing_zeros();
+                    if let Some(t) = hit(Candidate::Other { pos }, t_max) {
+                        t_max = t;
+                        found = true;
+                    }
+                    m &= m - 1;
+                }
+            }
+            // Next: the nearest stacked entry that can still be closer.
+            loop {
+                if sp == 0 {
+                    return found;
+                }
+                sp -= 1;
+                let (c, t0) = stack[sp];
+                if t0 <= t_max {
+                    cur = c;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// True if something blocks the ray with `t <= t_max`: triangles are
+    /// tested here, other primitives by `blocks(pos)`.
+    #[inline]
+    pub(super) fn any(&self, ray: &Ray, t_max: f32, blocks: impl FnMut(u32) -> bool) -> bool {
+        if self.stack_need <= TINY_STACK {
+            let mut stack = [0u32; TINY_STACK];
+            self.any_with(ray, t_max, blocks, &mut stack)
+        } else {
+            self.any_deep(ray, t_max, blocks)
+        }
+    }
+
+    #[inline(never)]
+    fn any_deep(&self, ray: &Ray, t_max: f32, blocks: impl FnMut(u32) -> bool) -> bool {
+        if self.stack_need <= SMALL_STACK {
+            let mut stack = [0u32; SMALL_STACK];
+            self.any_with(ray, t_max, blocks, &mut stack)
+        } else if self.stack_need <= LARGE_STACK {
+            let mut stack = [0u32; LARGE_STACK];
+            self.any_with(ray, t_max, blocks, &mut stack)
+        } else {
+            let mut stack = vec![0u32; self.stack_need];
+            self.any_with(ray, t_max, blocks, &mut stack)
+        }
+    }
+
+    #[inline(always)]
+    fn any_with(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        blocks: impl FnMut(u32) -> bool,
+        stack: &mut [u32],
+    ) -> bool {
+        let br = BoxRay::new(ray);
+        let tr = TriangleRay4::new(ray.o, ray.d);
+        let mut blocks = blocks;
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (_, mut mask) = br.test(n, t_max);
+                if mask != 0 {
+                    cur = n.child[mask.trailing_zeros() as usize];
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        stack[sp] = n.child[mask.trailing_zeros() as usize];
+                        sp += 1;
+                        mask &= mask - 1;
+                    }
+                    continue;
+                }
+            } else {
+                let leaf = &self.leaves[(cur & !LEAF) as usize];
+                if leaf.triangles != 0 && tr.any4(&leaf.v, t_max, leaf.triangles) {
+                    return true;
+                }
+                let mut m = ((1u32 << leaf.count) - 1) & !leaf.triangles;
+                while m != 0 {
+                    if blocks(leaf.first + m.trailing_zeros()) {
+                        return true;
+                    }
+                    m &= m - 1;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            cur = stack[sp];
+        }
+    }
+}
+
+fn empty_node() -> Node {
+    let mut b = [Vec4::splat(f32::INFINITY); 6];
+    for m in &mut b[3..] {
+        *m = Vec4::splat(f32::NEG_INFINITY);
+    }
+    Node {
+        b,
+        child: [u32::MAX; 4],
+    }
+}
+
+/// Primitive count of every BVH2 node's subtree (without recursion: trees
+/// can be deep).
+fn subtree_counts(bvh2: &Bvh2) -> Vec<u32> {
+    let nodes = &bvh2.nodes;
+    let mut counts = vec![0u32; nodes.len()];
+    // Post-order: a node is finished when it is popped the second time.
+    let mut stack = vec![(0usize, false)];
+    while let Some((i, done)) = stack.pop() {
+        let n = &nodes[i];
+        if n.prim_count != 0 {
+            counts[i] = n.prim_count;
+        } else if done {
+            let f = n.first_index as usize;
+            counts[i] = counts[f] + counts[f + 1];
+        } else {
+            let f = n.first_index as usize;
+            stack.push((i, true));
+            stack.push((f, false));
+            stack.push((f + 1, false));
+        }
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::sampling::rng::Pcg32;
+    use crate::render::shapes::intersect_triangle;
+
+    fn random_triangles(rng: &mut Pcg32, n: usize, spread: f32, size: f32) -> Vec<[Vec3; 3]> {
+        let mut v = |s: f32| {
+            Vec3::new(
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+            ) * s
+        };
+        (0..n)
+            .map(|_| {
+                let c = v(spread);
+                [c + v(size), c + v(size), c + v(size)]
+            })
+            .collect()
+    }
+
+    fn build(tris: &[[Vec3; 3]], others: &[Aabb]) -> (Bvh4, Vec<u32>) {
+        let mut aabbs: Vec<Aabb> = tris
+            .iter()
+            .map(|t| {
+                let mut a = Aabb::empty();
+                for p in t {
+                    a.extend((*p).into());
+                }
+                a
+            })
+            .collect();
+        aabbs.extend_from_slice(others);
+        let n = tris.len();
+        Bvh4::build(&aabbs, BvhBuildParams::medium_build(), |i| {
+            (i < n).then(|| tris[i])
+        })
+    }
+
+    /// Brute-force closest hit: (t, primitive).
+    fn brute(tris: &[[Vec3; 3]], ray: &Ray) -> Option<(f32, u32)> {
+        let mut best: Option<(f32, u32)> = None;
+        for (i, t) in tris.iter().enumerate() {
+            if let Some((th, _)) = intersect_triangle(ray.o, ray.d, ray.t_max, t[0], t[1], t[2]) {
+                if best.is_none_or(|(bt, _)| th < bt) {
+                    best = Some((th, i as u32));
+                }
+            }
+        }
+        best
+    }
+
+    fn random_ray(rng: &mut Pcg32, spread: f32) -> Ray {
+        let o = Vec3::new(
+            rng.uniform_f32() - 0.5,
+            rng.uniform_f32() - 0.5,
+            rng.uniform_f32() - 0.5,
+        ) * spread;
+        let mut d = Vec3::new(
+            rng.uniform_f32() - 0.5,
+            rng.uniform_f32() - 0.5,
+            rng.uniform_f32() - 0.5,
+        );
+        // Some rays along the axes, with +0.0 and -0.0 components.
+        match rng.uniform_u32_below(8) {
+            0 => d = Vec3::new(0.0, -0.0, if d.z < 0.0 { -1.0 } else { 1.0 }),
+            1 => d = Vec3::new(-0.0, d.y, 0.0),
+            2 => d.x = -0.0,
+            _ => {}
+        }
+        let mut r = Ray::new(o, d);
+        if rng.uniform_u32_below(4) == 0 {
+            r.t_max = rng.uniform_f32() * spread;
+        }
+        r
+    }
+
+    /// Checks `rays` random rays; returns how many hit something.
+    fn check(tris: &[[Vec3; 3]], spread: f32, rays: usize, seed: u64) -> usize {
+        let (bvh, order) = build(tris, &[]);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert!(sorted.iter().copied().eq(0..tris.len() as u32));
+        let mut rng = Pcg32::with_sequence(seed);
+        let mut hits = 0;
+        for _ in 0..rays {
+            let ray = random_ray(&mut rng, spread);
+            let expect = brute(tris, &ray);
+            let mut got: Option<(f32, u32, [f32; 3])> = None;
+            let any_hit = bvh.closest(&ray, ray.t_max, |c, _| match c {
+                Candidate::Triangle { pos, t, b } => {
+                    got = Some((t, order[pos as usize], b));
+                    Some(t)
+                }
+                Candidate::Other { .. } => panic!("no other primitives"),
+            });
+            assert_eq!(any_hit, got.is_some());
+            match (expect, got) {
+                (None, None) => {}
+                (Some((te, ie)), Some((tg, ig, b))) => {
+                    hits += 1;
+                    // Same distance; the primitive may differ only on a tie.
+                    assert_eq!(te, tg, "ray {ray:?}");
+                    let t = tris[ig as usize];
+                    let (ts, bs) =
+                        intersect_triangle(ray.o, ray.d, ray.t_max, t[0], t[1], t[2]).unwrap();
+                    assert_eq!((ts, bs), (tg, b), "four-lane test differs from scalar");
+                    if ie != ig {
+                        assert_eq!(brute(&[t], &ray).map(|h| h.0), Some(te));
+                    }
+                }
+                (e, g) => panic!("ray {ray:?}: brute force {e:?}, BVH {g:?}"),
+            }
+            let occluded = bvh.any(&ray, ray.t_max, |_| panic!("no other primitives"));
+            assert_eq!(occluded, expect.is_some(), "ray {ray:?}");
+        }
+        hits
+    }
+
+    #[test]
+    fn closest_and_any_agree_with_brute_force() {
+        let mut rng = Pcg32::with_sequence(7);
+        for (n, size) in [
+            (1, 0.8),
+            (3, 0.5),
+            (4, 0.5),
+            (5, 0.5),
+            (37, 0.3),
+            (3000, 0.08),
+        ] {
+            let tris = random_triangles(&mut rng, n, 1.0, size);
+            let hits = check(&tris, 1.0, 3000, n as u64);
+            assert!(hits > 50, "{n} triangles: too few hits ({hits}) to test anything");
+        }
+    }
+
+    #[test]
+    fn tiny_and_huge_scales() {
+        let mut rng = Pcg32::with_sequence(9);
+        for scale in [1e-6f32, 1e6] {
+            let tris: Vec<[Vec3; 3]> = random_triangles(&mut rng, 500, 1.0, 0.2)
+                .into_iter()
+                .map(|t| t.map(|p| p * scale))
+                .collect();
+            assert!(check(&tris, scale, 2000, 3) > 200);
+        }
+    }
+
+    #[test]
+    fn deep_trees_fit_their_stack() {
+        // Triangles of geometrically shrinking size nested around a point
+        // make a deep tree.
+        let mut tris = Vec::new();
+        let mut s = 1.0f32;
+        for i in 0..120 {
+            let o = Vec3::splat(0.001 * (i % 2) as f32);
+            tris.push([
+                o + Vec3::new(s, 0.0, 0.0),
+                o + Vec3::new(0.0, s, 0.0),
+                o - Vec3::new(0.0, 0.0, s),
+            ]);
+            s *= 0.8;
+        }
+        let (bvh, _) = build(&tris, &[]);
+        assert!(bvh.stack_need > TINY_STACK, "tree depth {}", bvh.stack_need);
+        assert!(check(&tris, 1.0, 3000, 5) > 300);
+        // The bound holds exactly: a stack of `stack_need` entries suffices.
+        let mut rng = Pcg32::with_sequence(11);
+        for _ in 0..3000 {
+            let ray = random_ray(&mut rng, 1.0);
+            let mut stack = vec![(0u32, 0f32); bvh.stack_need];
+            bvh.closest_with(
+                &ray,
+                ray.t_max,
+                |c, _| match c {
+                    Candidate::Triangle { t, .. } => Some(t),
+                    Candidate::Other { .. } => None,
+                },
+                &mut stack,
+            );
+            let mut stack = vec![0u32; bvh.stack_need];
+            bvh.any_with(&ray, ray.t_max, |_| false, &mut stack);
+        }
+    }
+
+    #[test]
+    fn other_primitives_are_handed_out() {
+        let mut rng = Pcg32::with_sequence(3);
+        let tris = random_triangles(&mut rng, 20, 1.0, 0.3);
+        // Two boxes standing for spheres or instances.
+        let others = [
+            Aabb::new(Vec3::splat(-0.1).into(), Vec3::splat(0.1).into()),
+            Aabb::new(Vec3::splat(0.3).into(), Vec3::splat(0.4).into()),
+        ];
+        let (bvh, order) = build(&tris, &others);
+        let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        let mut seen = Vec::new();
+        bvh.closest(&ray, f32::INFINITY, |c, _| {
+            if let Candidate::Other { pos } = c {
+                seen.push(order[pos as usize]);
+            }
+            None
+        });
+        assert_eq!(seen, vec![20]);
+        let ray = Ray::new(Vec3::new(0.35, 0.35, -5.0), Vec3::Z);
+        assert!(bvh.any(&ray, f32::INFINITY, |pos| order[pos as usize] == 21));
+    }
+}
