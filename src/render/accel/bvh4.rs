@@ -21,7 +21,7 @@
 
 use crate::render::geometry::{gamma, Ray};
 use crate::render::shapes::{pack_triangles, TrianglePack, TriangleRay4};
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{BVec4A, Vec3, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::bvh2::Bvh2;
@@ -114,10 +114,10 @@ impl BoxRay {
         }
     }
 
-    /// Entry distances and the mask of children whose box the ray meets
+    /// Entry distances and the lanes of children whose box the ray meets
     /// within `[0, t_max]`.
     #[inline(always)]
-    fn test(&self, n: &Node, t_max: f32) -> (Vec4, u32) {
+    fn test(&self, n: &Node, t_max: f32) -> (Vec4, BVec4A) {
         let tx0 = (n.b[self.near[0]] - self.o[0]) * self.inv[0];
         let ty0 = (n.b[self.near[1]] - self.o[1]) * self.inv[1];
         let tz0 = (n.b[self.near[2]] - self.o[2]) * self.inv[2];
@@ -127,7 +127,7 @@ impl BoxRay {
         let t0 = tx0.max(ty0).max(tz0.max(Vec4::ZERO));
         let t1 =
             (tx1.min(ty1).min(tz1) * Vec4::splat(1.0 + 2.0 * gamma(3))).min(Vec4::splat(t_max));
-        (t0, t0.cmple(t1).bitmask())
+        (t0, t0.cmple(t1))
     }
 }
 
@@ -250,7 +250,9 @@ impl Bvh4 {
             Bvh4 {
                 nodes,
                 leaves,
-                stack_need: 3 * max_depth + 1,
+                // Three entries per level, and room for the branch-free
+                // pushes that write all four lanes.
+                stack_need: 3 * max_depth + 4,
             },
             order,
         )
@@ -315,50 +317,53 @@ impl Bvh4 {
     ) -> bool {
         let br = BoxRay::new(ray);
         let tr = TriangleRay4::new(ray.o, ray.d);
-        let mut t_max = t_max;
-        let mut hit = hit;
+        match tr.kz() {
+            0 => self.closest_k::<0>(&br, &tr, t_max, hit, stack),
+            1 => self.closest_k::<1>(&br, &tr, t_max, hit, stack),
+            _ => self.closest_k::<2>(&br, &tr, t_max, hit, stack),
+        }
+    }
+
+    /// The traversal for rays whose direction is largest along `KZ`.
+    #[inline(always)]
+    fn closest_k<const KZ: u8>(
+        &self,
+        br: &BoxRay,
+        tr: &TriangleRay4,
+        mut t_max: f32,
+        mut hit: impl FnMut(Candidate, f32) -> Option<f32>,
+        stack: &mut [(u32, f32)],
+    ) -> bool {
         let mut found = false;
         let mut sp = 0usize;
         let mut cur = 0u32;
         loop {
             if cur & LEAF == 0 {
                 let n = &self.nodes[cur as usize];
-                let (t0, mask) = br.test(n, t_max);
-                match mask.count_ones() {
-                    0 => {}
-                    1 => {
-                        cur = n.child[mask.trailing_zeros() as usize];
-                        continue;
+                let (t0, hit_box) = br.test(n, t_max);
+                let mask = hit_box.bitmask();
+                if mask != 0 {
+                    // The nearest child next; the others stacked without
+                    // branches (every lane is written, the stack pointer
+                    // moves past the hit ones), culled by distance when
+                    // popped.
+                    let t0m = Vec4::select(hit_box, t0, Vec4::INFINITY);
+                    let near = (t0m.cmpeq(Vec4::splat(t0m.min_element())).bitmask() & mask)
+                        .trailing_zeros() as usize;
+                    let rest = mask & !(1 << near);
+                    let t0 = t0.to_array();
+                    for i in 0..4 {
+                        stack[sp] = (n.child[i], t0[i]);
+                        sp += ((rest >> i) & 1) as usize;
                     }
-                    _ => {
-                        // Near child next, the others stacked far to near.
-                        let t0 = t0.to_array();
-                        let mut hits = [(0u32, 0f32); 4];
-                        let mut k = 0;
-                        let mut m = mask;
-                        while m != 0 {
-                            let i = m.trailing_zeros() as usize;
-                            // Insertion by descending entry distance.
-                            let e = (n.child[i], t0[i]);
-                            let mut j = k;
-                            while j > 0 && hits[j - 1].1 < e.1 {
-                                hits[j] = hits[j - 1];
-                                j -= 1;
-                            }
-                            hits[j] = e;
-                            k += 1;
-                            m &= m - 1;
-                        }
-                        stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
-                        sp += k - 1;
-                        cur = hits[k - 1].0;
-                        continue;
-                    }
+                    cur = n.child[near];
+                    continue;
                 }
             } else {
                 let leaf = &self.leaves[(cur & !LEAF) as usize];
                 if leaf.triangles != 0 {
-                    if let Some((lane, t, b)) = tr.intersect4(&leaf.v, t_max, leaf.triangles) {
+                    if let Some((lane, t, b)) = tr.intersect4::<KZ>(&leaf.v, t_max, leaf.triangles)
+                    {
                         let pos = leaf.first + lane;
                         if let Some(t) = hit(Candidate::Triangle { pos, t, b }, t_max) {
                             t_max = t;
@@ -428,26 +433,41 @@ impl Bvh4 {
     ) -> bool {
         let br = BoxRay::new(ray);
         let tr = TriangleRay4::new(ray.o, ray.d);
-        let mut blocks = blocks;
+        match tr.kz() {
+            0 => self.any_k::<0>(&br, &tr, t_max, blocks, stack),
+            1 => self.any_k::<1>(&br, &tr, t_max, blocks, stack),
+            _ => self.any_k::<2>(&br, &tr, t_max, blocks, stack),
+        }
+    }
+
+    #[inline(always)]
+    fn any_k<const KZ: u8>(
+        &self,
+        br: &BoxRay,
+        tr: &TriangleRay4,
+        t_max: f32,
+        mut blocks: impl FnMut(u32) -> bool,
+        stack: &mut [u32],
+    ) -> bool {
         let mut sp = 0usize;
         let mut cur = 0u32;
         loop {
             if cur & LEAF == 0 {
                 let n = &self.nodes[cur as usize];
-                let (_, mut mask) = br.test(n, t_max);
+                let mask = br.test(n, t_max).1.bitmask();
                 if mask != 0 {
-                    cur = n.child[mask.trailing_zeros() as usize];
-                    mask &= mask - 1;
-                    while mask != 0 {
-                        stack[sp] = n.child[mask.trailing_zeros() as usize];
-                        sp += 1;
-                        mask &= mask - 1;
+                    let first = mask.trailing_zeros() as usize;
+                    let rest = mask & !(1 << first);
+                    for i in 0..4 {
+                        stack[sp] = n.child[i];
+                        sp += ((rest >> i) & 1) as usize;
                     }
+                    cur = n.child[first];
                     continue;
                 }
             } else {
                 let leaf = &self.leaves[(cur & !LEAF) as usize];
-                if leaf.triangles != 0 && tr.any4(&leaf.v, t_max, leaf.triangles) {
+                if leaf.triangles != 0 && tr.any4::<KZ>(&leaf.v, t_max, leaf.triangles) {
                     return true;
                 }
                 let mut m = ((1u32 << leaf.count) - 1) & !leaf.triangles;
@@ -635,7 +655,10 @@ mod tests {
         ] {
             let tris = random_triangles(&mut rng, n, 1.0, size);
             let hits = check(&tris, 1.0, 3000, n as u64);
-            assert!(hits > 50, "{n} triangles: too few hits ({hits}) to test anything");
+            assert!(
+                hits > 50,
+                "{n} triangles: too few hits ({hits}) to test anything"
+            );
         }
     }
 

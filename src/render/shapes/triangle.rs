@@ -278,6 +278,14 @@ pub struct TriangleRay4 {
 }
 
 impl TriangleRay4 {
+    /// The axis the ray's direction is largest along: the `KZ` to call the
+    /// four-lane tests with (callers branch on it once per ray; a branch per
+    /// test is mispredicted whenever ray directions are random).
+    #[inline(always)]
+    pub fn kz(&self) -> u8 {
+        self.kz
+    }
+
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> TriangleRay4 {
         let scalar = TriangleRay::new(o, d);
@@ -300,18 +308,14 @@ impl TriangleRay4 {
     /// barycentrics are bit-identical to testing the triangles one by one;
     /// ties go to the lower lane.
     #[inline(always)]
-    pub fn intersect4(
+    pub fn intersect4<const KZ: u8>(
         &self,
         v: &TrianglePack,
         t_max: f32,
         lanes: u32,
     ) -> Option<(u32, f32, [f32; 3])> {
-        let r = match self.kz {
-            0 => self.lanes_k::<0>(v, t_max, lanes),
-            1 => self.lanes_k::<1>(v, t_max, lanes),
-            _ => self.lanes_k::<2>(v, t_max, lanes),
-        };
-        let Some(r) = r else {
+        debug_assert_eq!(KZ, self.kz);
+        let Some(r) = self.lanes_k::<KZ>(v, t_max, lanes) else {
             return self.scalar.intersect4_scalar(v, t_max, lanes);
         };
         if r.mask == 0 {
@@ -343,13 +347,9 @@ impl TriangleRay4 {
     /// True if any of the pack's triangles in `lanes` is hit with
     /// `0 < t <= t_max`.
     #[inline(always)]
-    pub fn any4(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> bool {
-        let r = match self.kz {
-            0 => self.lanes_k::<0>(v, t_max, lanes),
-            1 => self.lanes_k::<1>(v, t_max, lanes),
-            _ => self.lanes_k::<2>(v, t_max, lanes),
-        };
-        match r {
+    pub fn any4<const KZ: u8>(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> bool {
+        debug_assert_eq!(KZ, self.kz);
+        match self.lanes_k::<KZ>(v, t_max, lanes) {
             Some(r) => r.mask != 0,
             None => self.scalar.intersect4_scalar(v, t_max, lanes).is_some(),
         }
