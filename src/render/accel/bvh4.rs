@@ -351,9 +351,8 @@ impl Bvh4 {
                     let near = (t0m.cmpeq(Vec4::splat(t0m.min_element())).bitmask() & mask)
                         .trailing_zeros() as usize;
                     let rest = mask & !(1 << near);
-                    let t0 = t0.to_array();
-                    for i in 0..4 {
-                        stack[sp] = (n.child[i], t0[i]);
+                    for (i, (&c, t)) in n.child.iter().zip(t0.to_array()).enumerate() {
+                        stack[sp] = (c, t);
                         sp += ((rest >> i) & 1) as usize;
                     }
                     cur = n.child[near];
