@@ -3,7 +3,7 @@
 
 use super::lowdiscrepancy::{
     inverse_radical_inverse, multiplicative_inverse, radical_inverse, radical_inverse_base2,
-    scrambled_radical_inverse, DigitBase, PermutationTables, PRIME_TABLE_SIZE,
+    DigitBase, PermutationTables, PRIME_TABLE_SIZE,
 };
 use super::ArrayStore;
 use crate::render::geometry::Bounds2i;
@@ -136,10 +136,7 @@ impl HaltonSampler {
         match dim {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
             1 => radical_inverse(&BASE3, self.scale1.div(index)),
-            d if (d as usize) < PRIME_TABLE_SIZE => {
-                let (b, perm, tail) = self.tables.dimension(d as usize);
-                scrambled_radical_inverse(b, perm, tail, index)
-            }
+            d if (d as usize) < PRIME_TABLE_SIZE => self.tables.scrambled(d as usize, index),
             d => hash_to_unit(mix64(
                 mix64(index ^ self.seed_hash)
                     .wrapping_add((d as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)),
