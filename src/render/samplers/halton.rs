@@ -144,6 +144,22 @@ impl HaltonSampler {
         }
     }
 
+    /// Dimensions `dim` and `dim + 1` at `index` (one call for both).
+    #[inline(never)]
+    fn sample_2d_dimensions(&self, index: u64, dim: u32) -> Vec2 {
+        if dim >= 2 && ((dim + 1) as usize) < PRIME_TABLE_SIZE {
+            Vec2::new(
+                self.tables.scrambled(dim as usize, index),
+                self.tables.scrambled(dim as usize + 1, index),
+            )
+        } else {
+            Vec2::new(
+                self.sample_dimension(index, dim),
+                self.sample_dimension(index, dim + 1),
+            )
+        }
+    }
+
     pub fn start_pixel_sample(&mut self, pixel: IVec2, sample_index: u32) {
         if self.pixel_for_offset != Some(pixel) {
             self.compute_pixel_offset(pixel);
@@ -188,10 +204,7 @@ impl HaltonSampler {
         if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
             self.dimension = self.array_end_dim;
         }
-        let p = Vec2::new(
-            self.sample_dimension(self.interval_index, self.dimension),
-            self.sample_dimension(self.interval_index, self.dimension + 1),
-        );
+        let p = self.sample_2d_dimensions(self.interval_index, self.dimension);
         self.dimension += 2;
         p
     }
@@ -232,6 +245,24 @@ impl HaltonSampler {
             self.arrays.data_2d[i] = data;
         }
         self.arrays.get_2d(n, 0)
+    }
+
+    /// `get_2d_array` written into `out` (cleared first) without going
+    /// through the array store; false (and `out` empty) where it gives None.
+    #[inline]
+    pub fn fill_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
+        out.clear();
+        let i = self.arrays.next_2d;
+        if i >= self.arrays.sizes_2d.len() || self.arrays.sizes_2d[i] != n {
+            return false;
+        }
+        self.arrays.next_2d += 1;
+        let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
+        let first = self.sample_index as u64 * n as u64;
+        for k in 0..n as u64 {
+            out.push(self.sample_2d_dimensions(self.index_for_sample(first + k), dim));
+        }
+        true
     }
 
     /// The global Halton index of the current sample (for tests and debugging).
