@@ -506,7 +506,8 @@ fn light_strategy(
     if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let f = bsdf.f(wo, ls.wi) * ls.wi.dot(s.point.ns).abs();
+    let (f, scattering_pdf) = bsdf.f_pdf(wo, ls.wi);
+    let f = f * ls.wi.dot(s.point.ns).abs();
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -518,7 +519,6 @@ fn light_strategy(
     if light.is_delta() {
         return f * ls.li / light_pdf;
     }
-    let scattering_pdf = bsdf.pdf(wo, ls.wi);
     f * ls.li * power_heuristic(1, light_pdf, 1, scattering_pdf) / light_pdf
 }
 
@@ -603,12 +603,12 @@ fn estimate_direct(
         if let Some(bs) = bsdf.sample(wo, u_scatter, LobeFilter::NonSpecular) {
             let f = bs.f * bs.wi.dot(ns).abs();
             if f != Vec3::ZERO && bs.pdf > 0.0 {
-                let light_pdf = light.pdf_li(&s.point, bs.wi, geom);
+                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
                     return ld;
                 }
                 let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
-                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                 scratch.counts.closest += 1;
                 let li = match geom.intersect(&ray) {
                     Some(h) => {
