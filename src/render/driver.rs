@@ -169,6 +169,8 @@ pub fn render(
     Ok((r.image(), r.stats()))
 }
 
+// Not inlined: a stable symbol for profilers (callgrind --toggle-collect).
+#[inline(never)]
 fn render_tile(
     scene: &RenderScene,
     integrator: &Integrator,

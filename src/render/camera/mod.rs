@@ -59,17 +59,21 @@ impl Camera {
         let [x0, x1, y0, y1] = self.screen;
         let sx = x0 + cs.p_film.x / self.resolution.x * (x1 - x0);
         let sy = y1 - cs.p_film.y / self.resolution.y * (y1 - y0);
-        let mut o = Vec3::ZERO;
-        let mut d = Vec3::new(sx * self.tan_half_fov, sy * self.tan_half_fov, 1.0).normalize();
+        let dir = Vec3::new(sx * self.tan_half_fov, sy * self.tan_half_fov, 1.0);
         if self.lens_radius > 0.0 {
+            let d = dir.normalize();
             let lens = self.lens_radius * concentric_sample_disk(cs.p_lens);
             let ft = self.focal_distance / d.z;
             let focus = d * ft;
-            o = Vec3::new(lens.x, lens.y, 0.0);
-            d = (focus - o).normalize();
+            let o = Vec3::new(lens.x, lens.y, 0.0);
+            let d = (focus - o).normalize();
+            let wo = self.camera_to_world.transform_point3(o);
+            let wd = self.camera_to_world.transform_vector3(d).normalize();
+            return Ray::new(wo, wd);
         }
-        let wo = self.camera_to_world.transform_point3(o);
-        let wd = self.camera_to_world.transform_vector3(d).normalize();
+        // Pinhole: one normalisation, after the transform (which may scale).
+        let wo = self.camera_to_world.transform_point3(Vec3::ZERO);
+        let wd = self.camera_to_world.transform_vector3(dir).normalize();
         Ray::new(wo, wd)
     }
 }

@@ -51,19 +51,21 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
 #[inline(always)]
 fn step_away(v: f32, dir: f32) -> f32 {
     let b = v.to_bits();
+    let d = dir.to_bits();
     let mag = b & 0x7fff_ffff;
-    let dir_sign = dir.to_bits() & 0x8000_0000;
-    // Away from zero when v and dir share a sign, towards zero otherwise;
-    // from ±0 to the smallest subnormal of dir's sign.
-    let moved = if mag == 0 {
-        1 | dir_sign
-    } else if (b & 0x8000_0000) == dir_sign {
-        b + 1
-    } else {
-        b - 1
-    };
-    let keep = dir == 0.0 || dir.is_nan() || mag >= 0x7f80_0000;
-    f32::from_bits(if keep { b } else { moved })
+    // Away from zero when v and dir share a sign (b + 1), towards zero
+    // otherwise (b - 1): `differ` is all ones when the signs differ. From ±0
+    // to the smallest subnormal of dir's sign. Selects by mask, not branch.
+    let differ = (((b ^ d) as i32) >> 31) as u32;
+    let stepped = b.wrapping_add(1).wrapping_add(differ << 1);
+    let zero = ((mag == 0) as u32).wrapping_neg();
+    let moved = (zero & ((d & 0x8000_0000) | 1)) | (!zero & stepped);
+    // Keep v where dir is ±0 or NaN (its magnitude minus one wraps or lands
+    // at or past the infinity bits) or v is infinite or NaN.
+    let dmag = d & 0x7fff_ffff;
+    let change =
+        (((dmag.wrapping_sub(1) < 0x7f80_0000) & (mag < 0x7f80_0000)) as u32).wrapping_neg();
+    f32::from_bits((change & moved) | (!change & b))
 }
 
 /// A ray leaving a surface point in direction `d`.
@@ -132,5 +134,8 @@ mod tests {
         }
         assert_eq!(step_away(f32::INFINITY, 1.0), f32::INFINITY);
         assert_eq!(step_away(f32::NEG_INFINITY, -1.0), f32::NEG_INFINITY);
+        assert!(step_away(f32::NAN, 1.0).is_nan());
+        assert_eq!(step_away(1.5, f32::NAN), 1.5);
+        assert_eq!(step_away(-1.5, -f32::NAN), -1.5);
     }
 }

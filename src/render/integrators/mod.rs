@@ -45,6 +45,7 @@ struct Work {
 #[derive(Default)]
 pub struct Scratch {
     u_light: Vec<Vec2>,
+    u_scatter: Vec<Vec2>,
     work: Vec<Work>,
     counts: RayCounts,
 }
@@ -505,7 +506,8 @@ fn light_strategy(
     if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let f = bsdf.f(wo, ls.wi) * ls.wi.dot(s.point.ns).abs();
+    let (f, scattering_pdf) = bsdf.f_pdf(wo, ls.wi);
+    let f = f * ls.wi.dot(s.point.ns).abs();
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -517,7 +519,6 @@ fn light_strategy(
     if light.is_delta() {
         return f * ls.li / light_pdf;
     }
-    let scattering_pdf = bsdf.pdf(wo, ls.wi);
     f * ls.li * power_heuristic(1, light_pdf, 1, scattering_pdf) / light_pdf
 }
 
@@ -555,20 +556,17 @@ fn sample_all_lights(
     n_light_samples: &[u32],
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
+    let mut u_light = std::mem::take(&mut scratch.u_light);
+    let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
     for (j, &n) in n_light_samples.iter().enumerate() {
         let light = j as u32;
-        // The two arrays are consecutive; copy the first into reused scratch.
-        let mut u_light = std::mem::take(&mut scratch.u_light);
-        u_light.clear();
-        let got_light = sampler
-            .get_2d_array(n)
-            .map(|a| u_light.extend_from_slice(a))
-            .is_some();
-        let ld = if let (true, Some(u_scatter)) = (got_light, sampler.get_2d_array(n)) {
+        // Both arrays are always asked for, as pbrt-v3 does.
+        let got_light = sampler.fill_2d_array(n, &mut u_light);
+        let got_scatter = sampler.fill_2d_array(n, &mut u_scatter);
+        let ld = if got_light && got_scatter {
             let mut sum = Vec3::ZERO;
-            for k in 0..n as usize {
-                sum +=
-                    estimate_direct(scene, s, bsdf, wo, light, u_light[k], u_scatter[k], scratch);
+            for (&ul, &us) in u_light.iter().zip(&u_scatter) {
+                sum += estimate_direct(scene, s, bsdf, wo, light, ul, us, scratch);
             }
             sum / n as f32
         } else {
@@ -576,9 +574,10 @@ fn sample_all_lights(
             let us = sampler.get_2d();
             estimate_direct(scene, s, bsdf, wo, light, ul, us, scratch)
         };
-        scratch.u_light = u_light;
         l += ld;
     }
+    scratch.u_light = u_light;
+    scratch.u_scatter = u_scatter;
     l
 }
 
@@ -604,12 +603,12 @@ fn estimate_direct(
         if let Some(bs) = bsdf.sample(wo, u_scatter, LobeFilter::NonSpecular) {
             let f = bs.f * bs.wi.dot(ns).abs();
             if f != Vec3::ZERO && bs.pdf > 0.0 {
-                let light_pdf = light.pdf_li(&s.point, bs.wi, geom);
+                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
                     return ld;
                 }
                 let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
-                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                 scratch.counts.closest += 1;
                 let li = match geom.intersect(&ray) {
                     Some(h) => {

@@ -325,8 +325,20 @@ impl Light {
     #[inline]
     pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
         match *self {
+            Light::Area { .. } => self.pdf_li_ray(r, &spawn_ray(r.p, r.p_error, r.n, wi), geom),
+            Light::Infinite { .. } => uniform_sphere_pdf(),
+            _ => 0.0,
+        }
+    }
+
+    /// `pdf_li` for the direction of `ray`, which must be the ray spawned
+    /// from `r` in that direction (`spawn_ray(r.p, r.p_error, r.n, wi)`):
+    /// for callers that trace that ray anyway.
+    #[inline]
+    pub fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Geometry) -> f32 {
+        match *self {
             Light::Area { shape, tri, .. } => {
-                let ray = spawn_ray(r.p, r.p_error, r.n, wi);
+                let wi = ray.d;
                 match shape {
                     AreaShape::Triangle { .. } => {
                         let [p0, p1, p2] = tri.p;

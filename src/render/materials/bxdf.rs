@@ -191,6 +191,22 @@ impl Bsdf {
         self.lobes.f_local(wo, wi, reflect)
     }
 
+    /// `(f(wo_w, wi_w), pdf(wo_w, wi_w))` in one pass (the local directions
+    /// are computed once).
+    #[inline]
+    pub fn f_pdf(&self, wo_w: Vec3, wi_w: Vec3) -> (Vec3, f32) {
+        let wo = self.frame.to_local(wo_w);
+        if wo.z == 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let wi = self.frame.to_local(wi_w);
+        let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
+        (
+            self.lobes.f_local(wo, wi, reflect),
+            self.lobes.pdf_local(wo, wi),
+        )
+    }
+
     /// Density of `sample` with filter NonSpecular (= All for the
     /// non-specular part) producing `wi_w`, by solid angle.
     #[inline]

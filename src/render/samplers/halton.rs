@@ -3,7 +3,7 @@
 
 use super::lowdiscrepancy::{
     inverse_radical_inverse, multiplicative_inverse, radical_inverse, radical_inverse_base2,
-    scrambled_radical_inverse, DigitBase, PermutationTables, PRIME_TABLE_SIZE,
+    DigitBase, PermutationTables, PRIME_TABLE_SIZE,
 };
 use super::ArrayStore;
 use crate::render::geometry::Bounds2i;
@@ -136,14 +136,27 @@ impl HaltonSampler {
         match dim {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
             1 => radical_inverse(&BASE3, self.scale1.div(index)),
-            d if (d as usize) < PRIME_TABLE_SIZE => {
-                let (b, perm, tail) = self.tables.dimension(d as usize);
-                scrambled_radical_inverse(b, perm, tail, index)
-            }
+            d if (d as usize) < PRIME_TABLE_SIZE => self.tables.scrambled(d as usize, index),
             d => hash_to_unit(mix64(
                 mix64(index ^ self.seed_hash)
                     .wrapping_add((d as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)),
             )),
+        }
+    }
+
+    /// Dimensions `dim` and `dim + 1` at `index` (one call for both).
+    #[inline(never)]
+    fn sample_2d_dimensions(&self, index: u64, dim: u32) -> Vec2 {
+        if dim >= 2 && ((dim + 1) as usize) < PRIME_TABLE_SIZE {
+            Vec2::new(
+                self.tables.scrambled(dim as usize, index),
+                self.tables.scrambled(dim as usize + 1, index),
+            )
+        } else {
+            Vec2::new(
+                self.sample_dimension(index, dim),
+                self.sample_dimension(index, dim + 1),
+            )
         }
     }
 
@@ -191,10 +204,7 @@ impl HaltonSampler {
         if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
             self.dimension = self.array_end_dim;
         }
-        let p = Vec2::new(
-            self.sample_dimension(self.interval_index, self.dimension),
-            self.sample_dimension(self.interval_index, self.dimension + 1),
-        );
+        let p = self.sample_2d_dimensions(self.interval_index, self.dimension);
         self.dimension += 2;
         p
     }
@@ -235,6 +245,24 @@ impl HaltonSampler {
             self.arrays.data_2d[i] = data;
         }
         self.arrays.get_2d(n, 0)
+    }
+
+    /// `get_2d_array` written into `out` (cleared first) without going
+    /// through the array store; false (and `out` empty) where it gives None.
+    #[inline]
+    pub fn fill_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
+        out.clear();
+        let i = self.arrays.next_2d;
+        if i >= self.arrays.sizes_2d.len() || self.arrays.sizes_2d[i] != n {
+            return false;
+        }
+        self.arrays.next_2d += 1;
+        let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
+        let first = self.sample_index as u64 * n as u64;
+        for k in 0..n as u64 {
+            out.push(self.sample_2d_dimensions(self.index_for_sample(first + k), dim));
+        }
+        true
     }
 
     /// The global Halton index of the current sample (for tests and debugging).

@@ -150,6 +150,49 @@ pub fn scrambled_radical_inverse(b: &DigitBase, perm: &[u16], tail: f64, mut a: 
     ((inv_base_n * (reversed as f64 + tail)) as f32).min(ONE_MINUS_EPSILON)
 }
 
+/// `scrambled_radical_inverse` with a table of digit pairs: entry
+/// `hi * base + lo` (< `base²`) is `perm[lo] * base + perm[hi]`, the pair
+/// reversed and permuted, and entry `base² + d` is `perm[d]`; so a pair
+/// costs one load. Bit-identical to `scrambled_radical_inverse`.
+#[inline(always)]
+pub fn scrambled_radical_inverse_pairs(b: &DigitBase, table: &[u16], tail: f64, mut a: u64) -> f32 {
+    let base = b.base as u64;
+    let base2 = b.base2;
+    debug_assert_eq!(table.len() as u64, base2 + base);
+    let mut reversed: u64 = 0;
+    let mut inv_base_n = 1.0f64;
+    // Indices past 2^32 (not met in practice) divide until the rest fits
+    // the multiply-high below.
+    while a > u32::MAX as u64 {
+        let next = a / base2;
+        reversed = reversed
+            .wrapping_mul(base2)
+            .wrapping_add(table[(a - next * base2) as usize] as u64);
+        inv_base_n *= b.inv_base2;
+        a = next;
+    }
+    while a >= base2 {
+        let next = ((a as u128 * b.magic2 as u128) >> 64) as u64;
+        reversed = reversed
+            .wrapping_mul(base2)
+            .wrapping_add(table[(a - next * base2) as usize] as u64);
+        inv_base_n *= b.inv_base2;
+        a = next;
+    }
+    if a >= base {
+        reversed = reversed
+            .wrapping_mul(base2)
+            .wrapping_add(table[a as usize] as u64);
+        inv_base_n *= b.inv_base2;
+    } else if a != 0 {
+        reversed = reversed
+            .wrapping_mul(base)
+            .wrapping_add(table[(base2 + a) as usize] as u64);
+        inv_base_n *= b.inv_base;
+    }
+    ((inv_base_n * (reversed as f64 + tail)) as f32).min(ONE_MINUS_EPSILON)
+}
+
 /// The value of infinitely many permuted zero digits, `perm[0] / (base - 1)`
 /// (the `tail` of `scrambled_radical_inverse`).
 pub fn scramble_tail(perm: &[u16]) -> f64 {
@@ -169,14 +212,32 @@ pub fn inverse_radical_inverse(base: u64, mut inverse: u64, n_digits: u32) -> u6
     index
 }
 
+/// Bases up to this one also get a table of permuted digit pairs (`base²`
+/// entries: 16,129 for 127, all bases together 144,000 entries).
+pub const PAIR_TABLE_MAX_BASE: u32 = 127;
+
+/// Everything one scrambled dimension needs, in one place.
+#[derive(Clone, Copy, Debug)]
+struct ScrambledDim {
+    b: DigitBase,
+    tail: f64,
+    /// Start of the permutation in `perms`.
+    perm: u32,
+    /// Start of the pair table in `pairs`, or `NO_PAIRS`.
+    pairs: u32,
+}
+
+const NO_PAIRS: u32 = u32::MAX;
+
 /// Digit permutations for every prime base, concatenated (pbrt-v3's
-/// `ComputeRadicalInversePermutations`), with per-dimension bases.
+/// `ComputeRadicalInversePermutations`), with per-dimension bases, and
+/// tables of permuted digit pairs (then the permutation again) for the
+/// small bases.
 #[derive(Debug)]
 pub struct PermutationTables {
     perms: Vec<u16>,
-    offsets: Vec<u32>,
-    bases: Vec<DigitBase>,
-    tails: Vec<f64>,
+    pairs: Vec<u16>,
+    dims: Vec<ScrambledDim>,
 }
 
 impl PermutationTables {
@@ -185,10 +246,10 @@ impl PermutationTables {
     pub fn generate(rng: &mut Pcg32) -> Self {
         let total: usize = PRIMES.iter().map(|&p| p as usize).sum();
         let mut perms = vec![0u16; total];
-        let mut offsets = Vec::with_capacity(PRIME_TABLE_SIZE);
+        let mut pairs = Vec::new();
+        let mut dims = Vec::with_capacity(PRIME_TABLE_SIZE);
         let mut off = 0usize;
         for &p in PRIMES.iter() {
-            offsets.push(off as u32);
             let slice = &mut perms[off..off + p as usize];
             for (j, v) in slice.iter_mut().enumerate() {
                 *v = j as u16;
@@ -198,20 +259,27 @@ impl PermutationTables {
                 let other = i + rng.uniform_u32_below(p - i as u32) as usize;
                 slice.swap(i, other);
             }
+            let pair_off = if p <= PAIR_TABLE_MAX_BASE {
+                let start = pairs.len() as u32;
+                for hi in 0..p as usize {
+                    for lo in 0..p as usize {
+                        pairs.push(slice[lo] * p as u16 + slice[hi]);
+                    }
+                }
+                pairs.extend_from_slice(slice);
+                start
+            } else {
+                NO_PAIRS
+            };
+            dims.push(ScrambledDim {
+                b: DigitBase::new(p),
+                tail: scramble_tail(slice),
+                perm: off as u32,
+                pairs: pair_off,
+            });
             off += p as usize;
         }
-        let bases = PRIMES.iter().map(|&p| DigitBase::new(p)).collect();
-        let tails = PRIMES
-            .iter()
-            .zip(&offsets)
-            .map(|(&p, &off)| scramble_tail(&perms[off as usize..off as usize + p as usize]))
-            .collect();
-        Self {
-            perms,
-            offsets,
-            bases,
-            tails,
-        }
+        Self { perms, pairs, dims }
     }
 
     /// Shared tables for a seed: seed 0 gives pbrt-v3's own permutations
@@ -240,9 +308,25 @@ impl PermutationTables {
     /// (< PRIME_TABLE_SIZE).
     #[inline(always)]
     pub fn dimension(&self, dim: usize) -> (&DigitBase, &[u16], f64) {
-        let b = &self.bases[dim];
-        let off = self.offsets[dim] as usize;
-        (b, &self.perms[off..off + b.base as usize], self.tails[dim])
+        let d = &self.dims[dim];
+        let off = d.perm as usize;
+        (&d.b, &self.perms[off..off + d.b.base as usize], d.tail)
+    }
+
+    /// The scrambled radical inverse of `a` in prime dimension `dim`
+    /// (< PRIME_TABLE_SIZE): `scrambled_radical_inverse` with the
+    /// dimension's tables, bit for bit.
+    #[inline(always)]
+    pub fn scrambled(&self, dim: usize, a: u64) -> f32 {
+        let d = &self.dims[dim];
+        if d.pairs != NO_PAIRS {
+            let n = (d.b.base2 + d.b.base as u64) as usize;
+            let table = &self.pairs[d.pairs as usize..d.pairs as usize + n];
+            scrambled_radical_inverse_pairs(&d.b, table, d.tail, a)
+        } else {
+            let perm = &self.perms[d.perm as usize..d.perm as usize + d.b.base as usize];
+            scrambled_radical_inverse(&d.b, perm, d.tail, a)
+        }
     }
 }
 
@@ -317,6 +401,28 @@ mod tests {
                 assert!(
                     (fast - slow).abs() <= 1e-7,
                     "dim {dim} a {a}: {fast} vs {slow}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn pair_tables_are_bit_identical() {
+        let t = PermutationTables::shared(0);
+        let mut r = Pcg32::with_sequence(12);
+        for dim in 0..40usize {
+            let (b, perm, tail) = t.dimension(dim);
+            for k in 0..4000u64 {
+                let a = match k % 4 {
+                    0 => k,
+                    1 => r.uniform_u32() as u64,
+                    2 => ((r.uniform_u32() as u64) << 32) | r.uniform_u32() as u64,
+                    _ => u64::MAX - k,
+                };
+                assert_eq!(
+                    t.scrambled(dim, a).to_bits(),
+                    scrambled_radical_inverse(b, perm, tail, a).to_bits(),
+                    "dim {dim} a {a}"
                 );
             }
         }

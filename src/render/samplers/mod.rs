@@ -169,6 +169,24 @@ impl Sampler {
     pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
         dispatch!(self, s => s.get_2d_array(n))
     }
+
+    /// `get_2d_array` copied into `out` (cleared first): true if there was
+    /// an array, else `out` stays empty. Halton computes the values straight
+    /// into `out`.
+    #[inline]
+    pub fn fill_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
+        if let Sampler::Halton(h) = self {
+            return h.fill_2d_array(n, out);
+        }
+        out.clear();
+        match self.get_2d_array(n) {
+            Some(a) => {
+                out.extend_from_slice(a);
+                true
+            }
+            None => false,
+        }
+    }
 }
 
 /// The largest `f32` below `x` (for finite, positive-step values).

@@ -3,7 +3,7 @@
 //! solid angle or per unit area).
 
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 const INV_2PI: f32 = 0.5 * FRAC_1_PI;
 const INV_4PI: f32 = 0.25 * FRAC_1_PI;
@@ -43,13 +43,32 @@ pub fn concentric_sample_disk(u: Vec2) -> Vec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
+    // θ = π/4·(y/x), or π/2 − π/4·(x/y) whose cosine and sine are the sine
+    // and cosine of π/4·(x/y): either way an angle in [−π/4, π/4].
+    if o.x.abs() > o.y.abs() {
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.y / o.x));
+        o.x * Vec2::new(c, s)
     } else {
-        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
-    };
-    let (s, c) = theta.sin_cos();
-    r * Vec2::new(c, s)
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.x / o.y));
+        o.y * Vec2::new(s, c)
+    }
+}
+
+/// `(sin x, cos x)` for `|x| <= π/4` by their Taylor polynomials (to x⁹ and
+/// x¹⁰: truncation error below 3e-9 there), evaluated in `f32`; within
+/// 2 ulp of the correctly rounded values, without libm's range reduction
+/// and call.
+#[inline(always)]
+pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
+    let x2 = x * x;
+    let s = x + x
+        * x2
+        * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0))));
+    let c = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0
+                + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40_320.0 - x2 * (1.0 / 3_628_800.0)))));
+    (s, c)
 }
 
 /// Polar map from the square to the unit disk (density 1/π).
@@ -169,6 +188,21 @@ mod tests {
         assert_eq!(power_heuristic(1, f32::INFINITY, 1, 5.0), 1.0);
         assert_eq!(power_heuristic(1, 5.0, 1, f32::INFINITY), 0.0);
         assert_eq!(power_heuristic(1, 1e30, 1, 1e30), 0.5);
+    }
+
+    #[test]
+    fn quarter_sin_cos_is_accurate() {
+        let n = 100_000;
+        let mut worst = 0.0f64;
+        for i in 0..=n {
+            let x = (i as f64 / n as f64 * 2.0 - 1.0) * std::f64::consts::FRAC_PI_4;
+            let (s, c) = sin_cos_quarter(x as f32);
+            let xf = x as f32 as f64;
+            worst = worst
+                .max((s as f64 - xf.sin()).abs())
+                .max((c as f64 - xf.cos()).abs());
+        }
+        assert!(worst < 1.2e-7, "max error {worst}");
     }
 
     #[test]
