@@ -59,12 +59,17 @@ struct Leaf {
     triangles: u32,
 }
 
-/// What a leaf hands to the closest-hit callback.
-pub(super) enum Candidate {
-    /// A triangle already tested and hit (at BVH position `pos`).
-    Triangle { pos: u32, t: f32, b: [f32; 3] },
-    /// Another primitive at BVH position `pos`, not tested yet.
-    Other { pos: u32 },
+/// What a closest-hit query found.
+pub(super) enum Closest {
+    Nothing,
+    /// The triangle at BVH position `pos`, at distance `t` and barycentrics `b`.
+    Triangle {
+        pos: u32,
+        t: f32,
+        b: [f32; 3],
+    },
+    /// The last primitive the callback accepted.
+    Other,
 }
 
 pub(super) struct Bvh4 {
@@ -259,21 +264,21 @@ impl Bvh4 {
     }
 
     /// Closest hit with `t <= t_max`: triangles are tested here, other
-    /// primitives by `hit`, which is also told of every triangle hit and
+    /// primitives (at BVH position `pos`) by `other(pos, t_max)`, which
     /// returns the distance of what it accepted (a closer `t_max` from then
-    /// on). Returns whether anything was hit.
+    /// on) and keeps what it needs of it.
     #[inline]
     pub(super) fn closest(
         &self,
         ray: &Ray,
         t_max: f32,
-        hit: impl FnMut(Candidate, f32) -> Option<f32>,
-    ) -> bool {
+        other: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Closest {
         if self.stack_need <= TINY_STACK {
             let mut stack = [(0u32, 0f32); TINY_STACK];
-            self.closest_with(ray, t_max, hit, &mut stack)
+            self.closest_with(ray, t_max, other, &mut stack)
         } else {
-            self.closest_deep(ray, t_max, hit)
+            self.closest_deep(ray, t_max, other)
         }
     }
 
@@ -282,17 +287,17 @@ impl Bvh4 {
         &self,
         ray: &Ray,
         t_max: f32,
-        hit: impl FnMut(Candidate, f32) -> Option<f32>,
-    ) -> bool {
+        other: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Closest {
         if self.stack_need <= SMALL_STACK {
             let mut stack = [(0u32, 0f32); SMALL_STACK];
-            self.closest_with(ray, t_max, hit, &mut stack)
+            self.closest_with(ray, t_max, other, &mut stack)
         } else if self.stack_need <= LARGE_STACK {
-            self.closest_large(ray, t_max, hit)
+            self.closest_large(ray, t_max, other)
         } else {
             // Degenerate trees only (hundreds of levels deep).
             let mut stack = vec![(0u32, 0f32); self.stack_need];
-            self.closest_with(ray, t_max, hit, &mut stack)
+            self.closest_with(ray, t_max, other, &mut stack)
         }
     }
 
@@ -301,10 +306,10 @@ impl Bvh4 {
         &self,
         ray: &Ray,
         t_max: f32,
-        hit: impl FnMut(Candidate, f32) -> Option<f32>,
-    ) -> bool {
+        other: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Closest {
         let mut stack = [(0u32, 0f32); LARGE_STACK];
-        self.closest_with(ray, t_max, hit, &mut stack)
+        self.closest_with(ray, t_max, other, &mut stack)
     }
 
     #[inline(always)]
@@ -312,15 +317,15 @@ impl Bvh4 {
         &self,
         ray: &Ray,
         t_max: f32,
-        hit: impl FnMut(Candidate, f32) -> Option<f32>,
+        other: impl FnMut(u32, f32) -> Option<f32>,
         stack: &mut [(u32, f32)],
-    ) -> bool {
+    ) -> Closest {
         let br = BoxRay::new(ray);
         let tr = TriangleRay4::new(ray.o, ray.d);
         match tr.kz() {
-            0 => self.closest_k::<0>(&br, &tr, t_max, hit, stack),
-            1 => self.closest_k::<1>(&br, &tr, t_max, hit, stack),
-            _ => self.closest_k::<2>(&br, &tr, t_max, hit, stack),
+            0 => self.closest_k::<0>(&br, &tr, t_max, other, stack),
+            1 => self.closest_k::<1>(&br, &tr, t_max, other, stack),
+            _ => self.closest_k::<2>(&br, &tr, t_max, other, stack),
         }
     }
 
@@ -331,10 +336,10 @@ impl Bvh4 {
         br: &BoxRay,
         tr: &TriangleRay4,
         mut t_max: f32,
-        mut hit: impl FnMut(Candidate, f32) -> Option<f32>,
+        mut other: impl FnMut(u32, f32) -> Option<f32>,
         stack: &mut [(u32, f32)],
-    ) -> bool {
-        let mut found = false;
+    ) -> Closest {
+        let mut found = Closest::Nothing;
         let mut sp = 0usize;
         let mut cur = 0u32;
         loop {
@@ -364,19 +369,17 @@ impl Bvh4 {
                     if let Some((lane, t, b)) = tr.intersect4::<KZ>(&leaf.v, t_max, leaf.triangles)
                     {
                         let pos = leaf.first + lane;
-                        if let Some(t) = hit(Candidate::Triangle { pos, t, b }, t_max) {
-                            t_max = t;
-                            found = true;
-                        }
+                        t_max = t;
+                        found = Closest::Triangle { pos, t, b };
                     }
                 }
                 let others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
                 let mut m = others;
                 while m != 0 {
                     let pos = leaf.first + m.trailing_zeros();
-                    if let Some(t) = hit(Candidate::Other { pos }, t_max) {
+                    if let Some(t) = other(pos, t_max) {
                         t_max = t;
-                        found = true;
+                        found = Closest::Other;
                     }
                     m &= m - 1;
                 }
@@ -610,15 +613,11 @@ mod tests {
         for _ in 0..rays {
             let ray = random_ray(&mut rng, spread);
             let expect = brute(tris, &ray);
-            let mut got: Option<(f32, u32, [f32; 3])> = None;
-            let any_hit = bvh.closest(&ray, ray.t_max, |c, _| match c {
-                Candidate::Triangle { pos, t, b } => {
-                    got = Some((t, order[pos as usize], b));
-                    Some(t)
-                }
-                Candidate::Other { .. } => panic!("no other primitives"),
-            });
-            assert_eq!(any_hit, got.is_some());
+            let got = match bvh.closest(&ray, ray.t_max, |_, _| panic!("no other primitives")) {
+                Closest::Nothing => None,
+                Closest::Triangle { pos, t, b } => Some((t, order[pos as usize], b)),
+                Closest::Other => panic!("no other primitives"),
+            };
             match (expect, got) {
                 (None, None) => {}
                 (Some((te, ie)), Some((tg, ig, b))) => {
@@ -696,15 +695,7 @@ mod tests {
         for _ in 0..3000 {
             let ray = random_ray(&mut rng, 1.0);
             let mut stack = vec![(0u32, 0f32); bvh.stack_need];
-            bvh.closest_with(
-                &ray,
-                ray.t_max,
-                |c, _| match c {
-                    Candidate::Triangle { t, .. } => Some(t),
-                    Candidate::Other { .. } => None,
-                },
-                &mut stack,
-            );
+            bvh.closest_with(&ray, ray.t_max, |_, _| None, &mut stack);
             let mut stack = vec![0u32; bvh.stack_need];
             bvh.any_with(&ray, ray.t_max, |_| false, &mut stack);
         }
@@ -722,10 +713,8 @@ mod tests {
         let (bvh, order) = build(&tris, &others);
         let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
         let mut seen = Vec::new();
-        bvh.closest(&ray, f32::INFINITY, |c, _| {
-            if let Candidate::Other { pos } = c {
-                seen.push(order[pos as usize]);
-            }
+        bvh.closest(&ray, f32::INFINITY, |pos, _| {
+            seen.push(order[pos as usize]);
             None
         });
         assert_eq!(seen, vec![20]);

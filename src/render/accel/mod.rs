@@ -17,7 +17,7 @@ mod bvh4;
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
 use crate::render::shapes::{Sphere, SurfacePoint, TriangleMesh};
-use bvh4::{Bvh4, Candidate};
+use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
 use obvhs::BvhBuildParams;
@@ -317,47 +317,46 @@ struct Shapes<'a> {
 impl Shapes<'_> {
     /// Closest hit among this level's shapes with `t <= ray.t_max`;
     /// instances are resolved by `instance_hit`.
-    #[inline]
+    #[inline(always)]
     fn intersect(
         &self,
         ray: &Ray,
         mut instance_hit: impl FnMut(u32, f32) -> Option<Hit>,
     ) -> Option<Hit> {
         let bvh = self.level.bvh.as_ref()?;
-        let mut best: Option<Hit> = None;
-        bvh.closest(ray, ray.t_max, |c, t_max| {
-            let hit = match c {
-                Candidate::Triangle { pos, t, b } => Some(Hit {
+        // Spheres and instances found so far (triangles come back as values).
+        let mut other: Option<Hit> = None;
+        let found = bvh.closest(ray, ray.t_max, |pos, t_max| {
+            let prim = self.level.prims[pos as usize];
+            let h = if prim.mesh == INSTANCE_TAG {
+                instance_hit(prim.index, t_max)
+            } else {
+                let s = &self.spheres[prim.index as usize];
+                s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
                     t,
-                    prim: self.level.prims[pos as usize],
+                    prim,
                     instance: NO_INSTANCE,
-                    local: HitLocal::Bary(b),
-                }),
-                Candidate::Other { pos } => {
-                    let prim = self.level.prims[pos as usize];
-                    if prim.mesh == INSTANCE_TAG {
-                        instance_hit(prim.index, t_max)
-                    } else {
-                        let s = &self.spheres[prim.index as usize];
-                        s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
-                            t,
-                            prim,
-                            instance: NO_INSTANCE,
-                            local: HitLocal::SpherePoint(p),
-                        })
-                    }
-                }
-            };
-            let h = hit?;
-            best = Some(h);
+                    local: HitLocal::SpherePoint(p),
+                })
+            }?;
+            other = Some(h);
             Some(h.t)
         });
-        best
+        match found {
+            Closest::Nothing => None,
+            Closest::Triangle { pos, t, b } => Some(Hit {
+                t,
+                prim: self.level.prims[pos as usize],
+                instance: NO_INSTANCE,
+                local: HitLocal::Bary(b),
+            }),
+            Closest::Other => other,
+        }
     }
 
     /// True if any of this level's shapes (or instances, by `instance_hit`)
     /// blocks the ray before `ray.t_max`.
-    #[inline]
+    #[inline(always)]
     fn occluded(&self, ray: &Ray, mut instance_hit: impl FnMut(u32) -> bool) -> bool {
         let Some(bvh) = self.level.bvh.as_ref() else {
             return false;
@@ -480,8 +479,11 @@ impl Geometry {
         self.top.bvh.is_some()
     }
 
-    /// Closest hit along the ray, if any.
-    #[inline]
+    /// Closest hit along the ray, if any. (Not inlined into callers; the
+    /// traversal is inlined here, so that nothing is passed through memory
+    /// on the way in: a struct written just before a call and read back
+    /// with wider loads stalls store forwarding.)
+    #[inline(never)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.shapes().intersect(ray, |i, t_max| {
             let inst = &self.instances[i as usize];
@@ -495,7 +497,7 @@ impl Geometry {
     }
 
     /// True if anything blocks the ray before `t_max`.
-    #[inline]
+    #[inline(never)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.shapes().occluded(ray, |i| {
             let inst = &self.instances[i as usize];
