@@ -535,4 +535,87 @@ mod tests {
             );
         }
     }
+
+    /// The four-lane test against the scalar one, lane by lane, with rays
+    /// through vertices and along edges (edge values exactly zero, decided
+    /// in f64) as well as ordinary ones, for every largest-axis case.
+    #[test]
+    fn four_lanes_match_the_scalar_test() {
+        let tris = [
+            [
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+            [
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+            [
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(0.0, 1.0, 2.0),
+                Vec3::new(1.0, 0.0, 0.5),
+            ],
+            [
+                Vec3::new(-1.0, 0.5, 0.0),
+                Vec3::new(0.5, -1.0, 1.0),
+                Vec3::new(0.25, 0.25, -1.0),
+            ],
+        ];
+        let pack = pack_triangles(&tris);
+        let mut checked = 0;
+        let mut hits = 0;
+        for axis in 0..3 {
+            for i in 0..=8 {
+                for j in 0..=8 {
+                    // Lattice points on the triangles' edges and corners.
+                    let (a, b) = (i as f32 / 4.0 - 0.5, j as f32 / 4.0 - 0.5);
+                    let (o, d) = match axis {
+                        0 => (Vec3::new(a, b, 5.0), Vec3::new(0.01, -0.02, -1.0)),
+                        1 => (Vec3::new(-5.0, a, b), Vec3::new(1.0, 0.0, 0.0)),
+                        _ => (Vec3::new(a, 5.0, b), Vec3::new(-0.0, -1.0, 0.0)),
+                    };
+                    let d = if i % 3 == 0 {
+                        Vec3::new(0.0, 0.0, -1.0)
+                    } else {
+                        d
+                    };
+                    let r4 = TriangleRay4::new(o, d);
+                    for lanes in [0b1111u32, 0b0101, 0b0010] {
+                        for t_max in [f32::INFINITY, 5.0] {
+                            let got = match r4.kz() {
+                                0 => r4.intersect4::<0>(&pack, t_max, lanes),
+                                1 => r4.intersect4::<1>(&pack, t_max, lanes),
+                                _ => r4.intersect4::<2>(&pack, t_max, lanes),
+                            };
+                            let mut want: Option<(u32, f32, [f32; 3])> = None;
+                            for (l, t) in tris.iter().enumerate() {
+                                if lanes & (1 << l) == 0 {
+                                    continue;
+                                }
+                                if let Some((th, b)) =
+                                    intersect_triangle(o, d, t_max, t[0], t[1], t[2])
+                                {
+                                    if want.is_none_or(|(_, bt, _)| th < bt) {
+                                        want = Some((l as u32, th, b));
+                                    }
+                                }
+                            }
+                            assert_eq!(got, want, "o {o:?} d {d:?} lanes {lanes:b} t_max {t_max}");
+                            let any = match r4.kz() {
+                                0 => r4.any4::<0>(&pack, t_max, lanes),
+                                1 => r4.any4::<1>(&pack, t_max, lanes),
+                                _ => r4.any4::<2>(&pack, t_max, lanes),
+                            };
+                            assert_eq!(any, want.is_some());
+                            checked += 1;
+                            hits += want.is_some() as u32;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 1000 && hits > 100, "{checked} cases, {hits} hits");
+    }
 }
