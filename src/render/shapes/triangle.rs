@@ -618,4 +618,46 @@ mod tests {
         }
         assert!(checked > 1000 && hits > 100, "{checked} cases, {hits} hits");
     }
+
+    /// Rays aimed at random points of shared edges: some edge values round
+    /// to exactly zero in f32 and are decided in f64; the four-lane test must
+    /// decide them as the scalar test does.
+    #[test]
+    fn four_lanes_match_the_scalar_test_on_shared_edges() {
+        use crate::render::sampling::rng::Pcg32;
+        let (a, b) = (Vec3::new(0.1, 0.2, 0.05), Vec3::new(0.7, 0.9, 0.3));
+        let tris = [
+            [a, b, Vec3::new(0.9, 0.1, 0.2)],
+            [b, a, Vec3::new(0.0, 0.8, 0.1)],
+            [a, Vec3::new(0.3, -0.4, 0.0), Vec3::new(0.9, 0.1, 0.2)],
+            [Vec3::new(0.0, 0.8, 0.1), Vec3::new(-0.5, 0.5, 0.2), a],
+        ];
+        let pack = pack_triangles(&tris);
+        let mut rng = Pcg32::with_sequence(5);
+        for _ in 0..200_000 {
+            let s = rng.uniform_f32();
+            let p = a + s * (b - a);
+            let d = Vec3::new(
+                (rng.uniform_f32() - 0.5) * 0.2,
+                (rng.uniform_f32() - 0.5) * 0.2,
+                -1.0,
+            );
+            let o = p - 2.0 * d;
+            let r4 = TriangleRay4::new(o, d);
+            let got = match r4.kz() {
+                0 => r4.intersect4::<0>(&pack, f32::INFINITY, 0b1111),
+                1 => r4.intersect4::<1>(&pack, f32::INFINITY, 0b1111),
+                _ => r4.intersect4::<2>(&pack, f32::INFINITY, 0b1111),
+            };
+            let mut want: Option<(u32, f32, [f32; 3])> = None;
+            for (l, t) in tris.iter().enumerate() {
+                if let Some((th, bc)) = intersect_triangle(o, d, f32::INFINITY, t[0], t[1], t[2]) {
+                    if want.is_none_or(|(_, bt, _)| th < bt) {
+                        want = Some((l as u32, th, bc));
+                    }
+                }
+            }
+            assert_eq!(got, want, "o {o:?} d {d:?}");
+        }
+    }
 }
