@@ -40,13 +40,14 @@ const SMALL_STACK: usize = 64;
 const LARGE_STACK: usize = 512;
 
 /// Four children's boxes, lane `i` for child `i`: `b[axis]` is the minimum
-/// and `b[3 + axis]` the maximum along `axis`. An unused slot has an empty
-/// box (+∞, −∞) that no ray hits.
+/// and `b[3 + axis]` the maximum along `axis`. `valid` is true in the lanes of
+/// used slots (an unused one has an empty box, +∞ to −∞).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {
     b: [Vec4; 6],
     child: [u32; 4],
+    valid: BVec4A,
 }
 
 /// Up to four primitives at BVH positions `first .. first + count`;
@@ -83,9 +84,6 @@ pub(super) struct Bvh4 {
 struct BoxRay {
     o: [Vec4; 3],
     inv: [Vec4; 3],
-    /// Index into `Node::b` of the near and the far plane per axis.
-    near: [usize; 3],
-    far: [usize; 3],
 }
 
 impl BoxRay {
@@ -99,14 +97,6 @@ impl BoxRay {
             Vec3A::splat(1e30),
         );
         let r = Vec3A::select(tiny, big, d.recip());
-        let neg = r.cmplt(Vec3A::ZERO).bitmask();
-        let mut near = [0; 3];
-        let mut far = [0; 3];
-        for a in 0..3 {
-            let n = ((neg >> a) & 1) as usize;
-            near[a] = a + 3 * n;
-            far[a] = a + 3 * (1 - n);
-        }
         BoxRay {
             o: [
                 Vec4::splat(ray.o.x),
@@ -114,8 +104,6 @@ impl BoxRay {
                 Vec4::splat(ray.o.z),
             ],
             inv: [Vec4::splat(r.x), Vec4::splat(r.y), Vec4::splat(r.z)],
-            near,
-            far,
         }
     }
 
@@ -123,16 +111,19 @@ impl BoxRay {
     /// within `[0, t_max]`.
     #[inline(always)]
     fn test(&self, n: &Node, t_max: f32) -> (Vec4, BVec4A) {
-        let tx0 = (n.b[self.near[0]] - self.o[0]) * self.inv[0];
-        let ty0 = (n.b[self.near[1]] - self.o[1]) * self.inv[1];
-        let tz0 = (n.b[self.near[2]] - self.o[2]) * self.inv[2];
-        let tx1 = (n.b[self.far[0]] - self.o[0]) * self.inv[0];
-        let ty1 = (n.b[self.far[1]] - self.o[1]) * self.inv[1];
-        let tz1 = (n.b[self.far[2]] - self.o[2]) * self.inv[2];
-        let t0 = tx0.max(ty0).max(tz0.max(Vec4::ZERO));
-        let t1 =
-            (tx1.min(ty1).min(tz1) * Vec4::splat(1.0 + 2.0 * gamma(3))).min(Vec4::splat(t_max));
-        (t0, t0.cmple(t1))
+        // Slab distances of both planes; the near one is the smaller (the
+        // same values as picking planes by the direction's sign).
+        let xa = (n.b[0] - self.o[0]) * self.inv[0];
+        let ya = (n.b[1] - self.o[1]) * self.inv[1];
+        let za = (n.b[2] - self.o[2]) * self.inv[2];
+        let xb = (n.b[3] - self.o[0]) * self.inv[0];
+        let yb = (n.b[4] - self.o[1]) * self.inv[1];
+        let zb = (n.b[5] - self.o[2]) * self.inv[2];
+        let t0 = xa.min(xb).max(ya.min(yb)).max(za.min(zb).max(Vec4::ZERO));
+        let t1 = (xa.max(xb).min(ya.max(yb)).min(za.max(zb)) * Vec4::splat(1.0 + 2.0 * gamma(3)))
+            .min(Vec4::splat(t_max));
+        // Unused slots (empty boxes) would pass: only `valid` lanes count.
+        (t0, t0.cmple(t1) & n.valid)
     }
 }
 
@@ -234,6 +225,7 @@ impl Bvh4 {
                 kids.push(f + 1);
             }
             let mut node = empty_node();
+            node.valid = BVec4A::new(true, kids.len() > 1, kids.len() > 2, kids.len() > 3);
             for (slot, &k) in kids.iter().enumerate() {
                 let a = nodes2[k].aabb;
                 for axis in 0..3 {
@@ -497,6 +489,7 @@ fn empty_node() -> Node {
     Node {
         b,
         child: [u32::MAX; 4],
+        valid: BVec4A::FALSE,
     }
 }
 

@@ -384,14 +384,16 @@ impl TriangleRay4 {
         let e1 = p2x * p0y - p2y * p0x;
         let e2 = p0x * p1y - p0y * p1x;
         let zero = Vec4::ZERO;
-        if (e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero)).bitmask() & lanes != 0 {
-            return None;
-        }
         let neg = e0.cmplt(zero) | e1.cmplt(zero) | e2.cmplt(zero);
         let pos = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
         let inside = !(neg & pos);
-        if inside.bitmask() & lanes == 0 {
-            // Most packs a ray reaches miss in every lane.
+        let inside_lanes = inside.bitmask() & lanes;
+        if inside_lanes == 0 {
+            // Most packs a ray reaches miss in every lane. An edge value of
+            // exactly zero does not matter here: a nonzero f32 edge value
+            // has the sign of the exact one (rounding is monotonic, so the
+            // two products keep their order), so a lane with edge values of
+            // both signs is outside whatever f64 makes of its zeros.
             return Some(Lanes {
                 mask: 0,
                 t: zero,
@@ -400,6 +402,9 @@ impl TriangleRay4 {
                 e2,
                 inv_det: zero,
             });
+        }
+        if (e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero)).bitmask() & inside_lanes != 0 {
+            return None;
         }
         let det = e0 + e1 + e2;
         let finite = det.abs().cmplt(Vec4::INFINITY);
