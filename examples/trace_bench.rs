@@ -11,6 +11,7 @@ use glam::Vec3;
 use pbrs::build::load_scene;
 use pbrs::render::accel::{Geometry, Hit};
 use pbrs::render::geometry::{spawn_ray, spawn_ray_to_point, Ray};
+use pbrs::render::sampling::rng::Pcg32;
 use pbrs::render::scene::RenderScene;
 use std::path::Path;
 use std::time::Instant;
@@ -34,13 +35,8 @@ fn main() {
     let rs = RenderScene::new(&loaded.scene);
     let g = &rs.geometry;
     let b = g.bounds;
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut rnd = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = Pcg32::with_sequence(1);
+    let mut rnd = || rng.uniform_f32();
     let dir = |rnd: &mut dyn FnMut() -> f32| {
         let z = 2.0 * rnd() - 1.0;
         let r = (1.0 - z * z).max(0.0).sqrt();

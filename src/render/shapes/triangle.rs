@@ -273,7 +273,6 @@ pub struct TriangleRay4 {
     o: [Vec4; 3],
     /// (Sx, Sy, Sz).
     s: [Vec4; 3],
-    kz: u8,
     scalar: TriangleRay,
 }
 
@@ -283,7 +282,7 @@ impl TriangleRay4 {
     /// test is mispredicted whenever ray directions are random).
     #[inline(always)]
     pub fn kz(&self) -> u8 {
-        self.kz
+        self.scalar.kz
     }
 
     #[inline(always)]
@@ -297,7 +296,6 @@ impl TriangleRay4 {
                 Vec4::splat(scalar.shear.y),
                 Vec4::splat(scalar.shear.z),
             ],
-            kz: scalar.kz,
             scalar,
         }
     }
@@ -314,7 +312,7 @@ impl TriangleRay4 {
         t_max: f32,
         lanes: u32,
     ) -> Option<(u32, f32, [f32; 3])> {
-        debug_assert_eq!(KZ, self.kz);
+        debug_assert_eq!(KZ, self.scalar.kz);
         let Some(r) = self.lanes_k::<KZ>(v, t_max, lanes) else {
             return self.scalar.intersect4_scalar(v, t_max, lanes);
         };
@@ -348,7 +346,7 @@ impl TriangleRay4 {
     /// `0 < t <= t_max`.
     #[inline(always)]
     pub fn any4<const KZ: u8>(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> bool {
-        debug_assert_eq!(KZ, self.kz);
+        debug_assert_eq!(KZ, self.scalar.kz);
         match self.lanes_k::<KZ>(v, t_max, lanes) {
             Some(r) => r.mask != 0,
             None => self.scalar.intersect4_scalar(v, t_max, lanes).is_some(),
