@@ -33,6 +33,8 @@ pub struct LightSampler {
 struct SpatialGrid {
     bounds: Bounds3,
     n: [i32; 3],
+    /// Bricks along x and y (see `slot`).
+    bricks: [usize; 2],
     voxels: VoxelStore,
 }
 
@@ -40,9 +42,14 @@ struct SpatialGrid {
 /// first use by whichever thread gets there first. Their contents are a
 /// function of the voxel alone, so who builds them never shows in the image.
 enum VoxelStore {
-    /// All voxels in one table, a voxel's state word followed by its CDF (as
-    /// f32 bits): one memory access per lookup. Used while the table stays
-    /// small (few lights).
+    /// All voxels in one table: the CDF's inner values (`active - 1` words of
+    /// f32 bits; the first is 0 and the last 1 anyway), the first word
+    /// doubling as the state (`EMPTY` or `BUILDING`, NaN patterns no CDF
+    /// value has). One memory access per lookup, used while the table stays
+    /// small (few lights). Voxels are stored in bricks of 4×2×2, so that the
+    /// voxels along any wall share cache lines: shading points lie on
+    /// surfaces, and with x-rows a wall facing x would touch a cache line
+    /// per voxel (for two lights, a brick is one 64-byte line).
     Flat {
         words: Vec<AtomicU32>,
         stride: usize,
@@ -53,9 +60,10 @@ enum VoxelStore {
 
 /// Largest flat voxel table, in bytes.
 const FLAT_BUDGET: usize = 16 << 20;
-const EMPTY: u32 = 0;
-const BUILDING: u32 = 1;
-const READY: u32 = 2;
+const EMPTY: u32 = u32::MAX;
+const BUILDING: u32 = u32::MAX - 1;
+/// Voxels per brick (4×2×2) of the flat table.
+const BRICK: usize = 16;
 
 /// A voxel's light choice: the CDF over the active lights.
 #[derive(Clone, Copy)]
@@ -73,7 +81,16 @@ impl VoxelCdf<'_> {
     #[inline(always)]
     fn at(&self, i: usize) -> f32 {
         match self.cdf {
-            CdfRef::Words(w) => f32::from_bits(w[i].load(Ordering::Relaxed)),
+            // Inner values only: cdf[0] = 0 and cdf[n] = 1 always.
+            CdfRef::Words(w) => {
+                if i == 0 {
+                    0.0
+                } else if i > w.len() {
+                    1.0
+                } else {
+                    f32::from_bits(w[i - 1].load(Ordering::Relaxed))
+                }
+            }
             CdfRef::Floats(f) => f[i],
         }
     }
@@ -81,7 +98,7 @@ impl VoxelCdf<'_> {
     #[inline(always)]
     fn len(&self) -> usize {
         match self.cdf {
-            CdfRef::Words(w) => w.len(),
+            CdfRef::Words(w) => w.len() + 2,
             CdfRef::Floats(f) => f.len(),
         }
     }
@@ -169,8 +186,14 @@ impl LightSampler {
                     *ni = ((diag[i] / max_extent * MAX_VOXELS).round() as i32).max(1);
                 }
             }
-            let count = (n[0] * n[1] * n[2]) as usize;
-            let stride = active.len() + 2;
+            let bricks = [
+                (n[0] as usize).div_ceil(4),
+                (n[1] as usize).div_ceil(2),
+                (n[2] as usize).div_ceil(2),
+            ];
+            let count = bricks[0] * bricks[1] * bricks[2] * BRICK;
+            // Spatial sampling has at least two lights (one is uniform).
+            let stride = active.len() - 1;
             let voxels = if count.saturating_mul(stride).saturating_mul(4) <= FLAT_BUDGET {
                 VoxelStore::Flat {
                     words: (0..count * stride).map(|_| AtomicU32::new(EMPTY)).collect(),
@@ -179,7 +202,12 @@ impl LightSampler {
             } else {
                 VoxelStore::Boxed((0..count).map(|_| OnceLock::new()).collect())
             };
-            SpatialGrid { bounds, n, voxels }
+            SpatialGrid {
+                bounds,
+                n,
+                bricks: [bricks[0], bricks[1]],
+                voxels,
+            }
         });
         LightSampler {
             kind,
@@ -203,7 +231,7 @@ impl LightSampler {
         self.spatial.as_ref().map_or(0, |s| match &s.voxels {
             VoxelStore::Flat { words, stride } => words
                 .chunks(*stride)
-                .filter(|v| v[0].load(Ordering::Acquire) == READY)
+                .filter(|v| v[0].load(Ordering::Acquire) < BUILDING)
                 .count(),
             VoxelStore::Boxed(v) => v.iter().filter(|v| v.get().is_some()).count(),
         })
@@ -276,36 +304,47 @@ impl SpatialGrid {
             let x = (o[i] * self.n[i] as f32) as i32; // NaN → 0
             v[i] = x.clamp(0, self.n[i] - 1);
         }
-        let idx = ((v[2] * self.n[1] + v[1]) * self.n[0] + v[0]) as usize;
         match &self.voxels {
             VoxelStore::Flat { words, stride } => {
+                let idx = self.slot(v);
                 let slot = &words[idx * stride..(idx + 1) * stride];
-                if slot[0].load(Ordering::Acquire) != READY {
+                if slot[0].load(Ordering::Acquire) >= BUILDING {
                     *local = self.compute(v, active, lights, geom);
                     if slot[0]
                         .compare_exchange(EMPTY, BUILDING, Ordering::Acquire, Ordering::Relaxed)
                         .is_ok()
                     {
-                        for (w, c) in slot[1..].iter().zip(local.iter()) {
+                        // The inner values; the first one last, publishing.
+                        let inner = &local[1..local.len() - 1];
+                        for (w, c) in slot[1..].iter().zip(&inner[1..]) {
                             w.store(c.to_bits(), Ordering::Relaxed);
                         }
-                        slot[0].store(READY, Ordering::Release);
+                        slot[0].store(inner[0].to_bits(), Ordering::Release);
                     }
                     return VoxelCdf {
                         cdf: CdfRef::Floats(local),
                     };
                 }
                 VoxelCdf {
-                    cdf: CdfRef::Words(&slot[1..]),
+                    cdf: CdfRef::Words(slot),
                 }
             }
             VoxelStore::Boxed(voxels) => VoxelCdf {
                 cdf: CdfRef::Floats(
-                    voxels[idx]
+                    voxels[((v[2] * self.n[1] + v[1]) * self.n[0] + v[0]) as usize]
                         .get_or_init(|| self.compute(v, active, lights, geom).into_boxed_slice()),
                 ),
             },
         }
+    }
+
+    /// Position of voxel `v` in the flat table: its 4×2×2 brick, then its
+    /// place in the brick.
+    #[inline(always)]
+    fn slot(&self, v: [i32; 3]) -> usize {
+        let [x, y, z] = v.map(|c| c as usize);
+        let brick = ((z >> 1) * self.bricks[1] + (y >> 1)) * self.bricks[0] + (x >> 2);
+        brick * BRICK + ((z & 1) << 3 | (y & 1) << 2 | (x & 3))
     }
 
     /// pbrt-v3's SpatialLightDistribution::ComputeDistribution: estimate each
