@@ -21,7 +21,7 @@ pub struct TriangleMesh {
 }
 
 impl TriangleMesh {
-    #[inline]
+    #[inline(always)]
     pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
         let i = 3 * tri as usize;
         [
@@ -55,7 +55,7 @@ impl TriangleMesh {
     }
 
     /// Oriented normals at barycentrics (b0, b1, b2), as pbrt-v3's triangle.cpp.
-    #[inline]
+    #[inline(always)]
     fn normals_at(&self, tri: u32, b: [f32; 3], geometric: Vec3) -> (Vec3, Vec3) {
         let mut n = geometric;
         if self.flip_normal {
