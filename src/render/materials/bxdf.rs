@@ -182,13 +182,7 @@ impl Bsdf {
     /// specular lobes are zero for any given pair).
     #[inline]
     pub fn f(&self, wo_w: Vec3, wi_w: Vec3) -> Vec3 {
-        let wo = self.frame.to_local(wo_w);
-        if wo.z == 0.0 {
-            return Vec3::ZERO;
-        }
-        let wi = self.frame.to_local(wi_w);
-        let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
-        self.lobes.f_local(wo, wi, reflect)
+        self.f_pdf(wo_w, wi_w).0
     }
 
     /// `(f(wo_w, wi_w), pdf(wo_w, wi_w))` in one pass (the local directions
