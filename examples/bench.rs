@@ -117,6 +117,7 @@ fn child(o: &Opts) -> Result<(), String> {
         &RenderOptions {
             threads: o.threads,
             seed: 0,
+            ..Default::default()
         },
         &|_, _| {},
     )?;

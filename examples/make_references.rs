@@ -40,6 +40,7 @@ fn main() {
             &RenderOptions {
                 threads: None,
                 seed: 12345,
+                ..Default::default()
             },
             &|_, _| {},
         )

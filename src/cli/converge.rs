@@ -113,6 +113,7 @@ pub fn run(args: &ConvergeArgs) -> i32 {
             &RenderOptions {
                 threads: args.threads,
                 seed: args.seed,
+                ..Default::default()
             },
         ) {
             Ok(r) => r,

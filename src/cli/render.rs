@@ -75,6 +75,7 @@ pub fn run(args: &Args) -> i32 {
     let opts = RenderOptions {
         threads: args.threads,
         seed: args.seed,
+        ..Default::default()
     };
     let progress = |done: usize, total: usize| {
         bar.set_length(total as u64);

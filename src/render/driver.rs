@@ -19,6 +19,9 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Seed for the sampler's scrambling and random dimensions.
     pub seed: u64,
+    /// Scalar code only: no four-lane fast paths (they give the same image
+    /// bit for bit; tests compare the two).
+    pub scalar: bool,
 }
 
 /// What a render did.
@@ -72,7 +75,7 @@ impl Renderer {
         let t0 = Instant::now();
         check_film_memory(desc)?;
         let scene = RenderScene::new(desc);
-        let mut integrator = Integrator::new(&desc.integrator, &scene);
+        let mut integrator = Integrator::new(&desc.integrator, &scene, !opts.scalar);
         let film = Film::new(&desc.film, &desc.filter);
         let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
         integrator.prepare_sampler(&scene, &mut sampler);
@@ -139,6 +142,7 @@ impl Renderer {
     pub fn stats(&self) -> RenderStats {
         let mut stats = self.stats.clone();
         stats.notes = self.scene.notes.clone();
+        stats.notes.extend(self.integrator.notes());
         if let Some(ls) = self.integrator.light_sampler() {
             stats.notes.push(format!(
                 "light selection: {:?} over {} lights that emit{}",

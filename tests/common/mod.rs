@@ -33,7 +33,15 @@ pub fn render_at(
     desc.film.xresolution = res;
     desc.film.yresolution = res;
     desc.sampler.pixel_samples = spp;
-    render(&desc, &RenderOptions { threads, seed: 0 }, &|_, _| {}).expect("render failed")
+    render(
+        &desc,
+        &RenderOptions {
+            threads,
+            ..Default::default()
+        },
+        &|_, _| {},
+    )
+    .expect("render failed")
 }
 
 /// A converged pbrt-v3 reference from `scenes/references/`.
@@ -146,6 +154,7 @@ pub fn render_seeded(
         &RenderOptions {
             threads: None,
             seed,
+            ..Default::default()
         },
         &|_, _| {},
     )

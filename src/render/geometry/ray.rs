@@ -32,10 +32,14 @@ impl Ray {
 #[inline]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
-    let mut offset = d * n;
-    if w.dot(n) < 0.0 {
-        offset = -offset;
-    }
+    // Negated when w·n < 0, by the sign bit rather than a branch (which
+    // side a ray leaves by is as good as random to the predictor).
+    let flip = ((w.dot(n) < 0.0) as u32) << 31;
+    let offset = Vec3::from_array(
+        (d * n)
+            .to_array()
+            .map(|c| f32::from_bits(c.to_bits() ^ flip)),
+    );
     let po = p + offset;
     Vec3::new(
         step_away(po.x, offset.x),

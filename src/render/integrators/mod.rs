@@ -4,14 +4,18 @@
 
 use crate::render::accel::SurfaceHit;
 use crate::render::geometry::{spawn_ray, Ray};
-use crate::render::lights::{LightSampler, LightSamplerKind};
-use crate::render::materials::{Bsdf, LobeFilter};
+use crate::render::lights::{
+    pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
+};
+use crate::render::materials::{Bsdf, LobeFilter, Lobes};
 use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
 use crate::render::shapes::SurfacePoint;
 use crate::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
 use glam::{Vec2, Vec3};
+
+mod all_lights;
 
 /// Rays traced, counted per tile and summed at the end (no shared counters).
 #[derive(Clone, Copy, Debug, Default)]
@@ -70,6 +74,9 @@ pub enum Integrator {
         strategy: DirectStrategy,
         lights: LightSampler,
         n_light_samples: Vec<u32>,
+        /// The lights four to a pack, for strategy "all" when every light is
+        /// a triangle of constant normal with one sample (else empty).
+        packs: Vec<TriangleLightPack>,
     },
     Whitted {
         max_depth: u32,
@@ -77,8 +84,9 @@ pub enum Integrator {
 }
 
 impl Integrator {
-    /// Builds the integrator and only the light distribution it uses.
-    pub fn new(desc: &IntegratorDesc, scene: &RenderScene) -> Integrator {
+    /// Builds the integrator and only the light distribution it uses;
+    /// `simd` allows the four-lane paths (which give the same image).
+    pub fn new(desc: &IntegratorDesc, scene: &RenderScene, simd: bool) -> Integrator {
         match *desc {
             IntegratorDesc::Path {
                 max_depth,
@@ -109,6 +117,12 @@ impl Integrator {
                     &scene.geometry,
                 ),
                 n_light_samples: Vec::new(),
+                packs: match strategy {
+                    DirectStrategy::All if simd => {
+                        pack_triangle_lights(&scene.lights).unwrap_or_default()
+                    }
+                    _ => Vec::new(),
+                },
             },
             IntegratorDesc::Whitted { max_depth } => Integrator::Whitted { max_depth },
         }
@@ -120,6 +134,7 @@ impl Integrator {
             max_depth,
             strategy: DirectStrategy::All,
             n_light_samples,
+            packs,
             ..
         } = self
         {
@@ -128,12 +143,27 @@ impl Integrator {
                 .iter()
                 .map(|l| sampler.round_count(l.n_samples()))
                 .collect();
+            if n_light_samples.iter().any(|&n| n != 1) {
+                packs.clear();
+            }
             for _ in 0..*max_depth {
                 for &n in n_light_samples.iter() {
                     sampler.request_2d_array(n);
                     sampler.request_2d_array(n);
                 }
             }
+        }
+    }
+
+    /// What the integrator built beyond the light distribution.
+    pub fn notes(&self) -> Vec<String> {
+        match self {
+            Integrator::Direct { packs, .. } if !packs.is_empty() => vec![format!(
+                "directlighting \"all\": {} triangle lights in {} four-lane packs (Lambertian vertices sample four lights at once)",
+                packs.iter().map(|p| p.count).sum::<usize>(),
+                packs.len()
+            )],
+            _ => Vec::new(),
         }
     }
 
@@ -224,10 +254,16 @@ impl Integrator {
                     strategy,
                     ref lights,
                     ref n_light_samples,
+                    ref packs,
                 } => {
                     if !scene.lights.is_empty() {
-                        local += match strategy {
-                            DirectStrategy::All => sample_all_lights(
+                        local += match (strategy, bsdf.lobes) {
+                            (DirectStrategy::All, Lobes::Lambertian { r }) if !packs.is_empty() => {
+                                all_lights::sample_all_lights_packed(
+                                    scene, &s, &bsdf, r, wo, sampler, scratch, packs,
+                                )
+                            }
+                            (DirectStrategy::All, _) => sample_all_lights(
                                 scene,
                                 &s,
                                 &bsdf,
@@ -236,7 +272,7 @@ impl Integrator {
                                 scratch,
                                 n_light_samples,
                             ),
-                            DirectStrategy::One => {
+                            (DirectStrategy::One, _) => {
                                 sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights)
                             }
                         };

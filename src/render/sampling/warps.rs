@@ -71,6 +71,23 @@ pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
     (s, c)
 }
 
+/// `sin_cos_quarter` in four lanes, operation for operation.
+#[inline(always)]
+pub fn sin_cos_quarter4(x: glam::Vec4) -> (glam::Vec4, glam::Vec4) {
+    use glam::Vec4;
+    let k = Vec4::splat;
+    let x2 = x * x;
+    let s = x + x
+        * x2
+        * (k(-1.0 / 6.0)
+            + x2 * (k(1.0 / 120.0) + x2 * (k(-1.0 / 5040.0) + x2 * k(1.0 / 362_880.0))));
+    let c = Vec4::ONE
+        + x2 * (k(-0.5)
+            + x2 * (k(1.0 / 24.0)
+                + x2 * (k(-1.0 / 720.0) + x2 * (k(1.0 / 40_320.0) - x2 * k(1.0 / 3_628_800.0)))));
+    (s, c)
+}
+
 /// Polar map from the square to the unit disk (density 1/π).
 #[inline]
 pub fn uniform_sample_disk(u: Vec2) -> Vec2 {
