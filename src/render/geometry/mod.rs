@@ -12,7 +12,8 @@ mod ray;
 pub use bounds::{Bounds2i, Bounds3};
 pub use frame::Frame;
 pub use ray::{
-    offset_ray_origin, spawn_ray, spawn_ray_to, spawn_ray_to_point, Ray, SHADOW_EPSILON,
+    offset_ray_origin, spawn_ray, spawn_ray_from_to, spawn_ray_to, spawn_ray_to_point, Ray,
+    SHADOW_EPSILON,
 };
 
 use glam::Vec3;

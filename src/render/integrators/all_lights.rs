@@ -14,11 +14,11 @@
 
 use super::Scratch;
 use crate::render::accel::SurfaceHit;
-use crate::render::geometry::{offset_ray_origin, spawn_ray_to, Ray};
+use crate::render::geometry::{offset_ray_origin, spawn_ray_from_to, Ray};
 use crate::render::lights::{dot3, lane3, splat3, TriangleLightPack, Vec3x4};
 use crate::render::materials::Bsdf;
 use crate::render::samplers::Sampler;
-use crate::render::sampling::{power_heuristic, sin_cos_quarter4};
+use crate::render::sampling::{power_heuristic, sin_cos_quarter};
 use crate::render::scene::RenderScene;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
@@ -98,6 +98,8 @@ pub(super) fn sample_all_lights_packed(
         let abs_cos_l = cos_l.abs();
         // f · |cos| is zero where the BSDF is (not reflecting) or cos is.
         let try_l = active & ls.lit & reflect_l & abs_cos_l.cmpne(Vec4::ZERO);
+        // The shadow rays' near ends: spawn_ray_to's offset towards q.
+        let down_l = dot3(&ls.d, &n3).cmplt(Vec4::ZERO).bitmask();
 
         // BSDF strategy (Bsdf::sample of the Lambertian lobe).
         let u = x4(&us);
@@ -144,10 +146,13 @@ pub(super) fn sample_all_lights_packed(
                 let f = f_lambert * abs_cos_l[lane];
                 if f != Vec3::ZERO {
                     scratch.counts.shadow += 1;
-                    let shadow = spawn_ray_to(
-                        sp.p,
-                        sp.p_error,
-                        sp.n,
+                    let pf = if down_l & (1 << lane) != 0 {
+                        o_down
+                    } else {
+                        o_up
+                    };
+                    let shadow = spawn_ray_from_to(
+                        pf,
                         lane3(&ls.q, lane),
                         lane3(&ls.q_error, lane),
                         lane3(&pack.n, lane),
@@ -198,7 +203,7 @@ fn concentric_sample_disk4(u: [Vec4; 2]) -> [Vec4; 2] {
     let x_major = ox.abs().cmpgt(oy.abs());
     let num = Vec4::select(x_major, oy, ox);
     let den = Vec4::select(x_major, ox, oy);
-    let (s, c) = sin_cos_quarter4(Vec4::splat(FRAC_PI_4) * (num / den));
+    let (s, c) = sin_cos_quarter(Vec4::splat(FRAC_PI_4) * (num / den));
     let zero = ox.cmpeq(Vec4::ZERO) & oy.cmpeq(Vec4::ZERO);
     [
         Vec4::select(zero, Vec4::ZERO, den * Vec4::select(x_major, c, s)),

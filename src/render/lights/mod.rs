@@ -50,12 +50,18 @@ impl TriangleCache {
             [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|b| m.oriented_normal(tri, b));
         let constant =
             corners[0] == corners[1] && corners[1] == corners[2] && corners[0].is_finite();
+        Self::from_vertices(p, if constant { corners[0] } else { Vec3::ZERO })
+    }
+
+    /// The cache of a triangle with vertices `p` and constant normal `n`
+    /// (zero if it is not constant).
+    pub fn from_vertices(p: [Vec3; 3], n: Vec3) -> TriangleCache {
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
         let plane = e1.cross(e2);
         let inv = 1.0 / plane.length_squared();
         TriangleCache {
             p,
-            n: if constant { corners[0] } else { Vec3::ZERO },
+            n,
             plane,
             // b1 = (q × e2)·(e1 × e2)/|e1 × e2|² = q·(e2 × (e1 × e2))/|…|², and
             // b2 = q·((e1 × e2) × e1)/|…|² for q in the plane.
@@ -439,15 +445,7 @@ mod tests {
     use crate::render::shapes::intersect_triangle;
 
     fn cache(p: [Vec3; 3]) -> TriangleCache {
-        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-        let plane = e1.cross(e2);
-        let inv = 1.0 / plane.length_squared();
-        TriangleCache {
-            p,
-            n: plane.normalize(),
-            plane,
-            bary: [e2.cross(plane) * inv, plane.cross(e1) * inv],
-        }
+        TriangleCache::from_vertices(p, (p[1] - p[0]).cross(p[2] - p[0]).normalize())
     }
 
     /// `hit_pdf` against pbrt-v3's watertight test: every ray the watertight

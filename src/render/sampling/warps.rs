@@ -4,6 +4,7 @@
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
+use std::ops::{Add, Mul, Sub};
 
 const INV_2PI: f32 = 0.5 * FRAC_1_PI;
 const INV_4PI: f32 = 0.25 * FRAC_1_PI;
@@ -57,9 +58,14 @@ pub fn concentric_sample_disk(u: Vec2) -> Vec2 {
 /// `(sin x, cos x)` for `|x| <= π/4` by their Taylor polynomials (to x⁹ and
 /// x¹⁰: truncation error below 3e-9 there), evaluated in `f32`; within
 /// 2 ulp of the correctly rounded values, without libm's range reduction
-/// and call.
+/// and call. Generic so that one polynomial serves `f32` and four-lane
+/// `Vec4` (the same operations in each lane).
 #[inline(always)]
-pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
+pub fn sin_cos_quarter<T>(x: T) -> (T, T)
+where
+    T: Copy + Add<Output = T> + Mul<Output = T> + Mul<f32, Output = T>,
+    f32: Add<T, Output = T> + Sub<T, Output = T>,
+{
     let x2 = x * x;
     let s = x + x
         * x2
@@ -68,23 +74,6 @@ pub fn sin_cos_quarter(x: f32) -> (f32, f32) {
         + x2 * (-0.5
             + x2 * (1.0 / 24.0
                 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40_320.0 - x2 * (1.0 / 3_628_800.0)))));
-    (s, c)
-}
-
-/// `sin_cos_quarter` in four lanes, operation for operation.
-#[inline(always)]
-pub fn sin_cos_quarter4(x: glam::Vec4) -> (glam::Vec4, glam::Vec4) {
-    use glam::Vec4;
-    let k = Vec4::splat;
-    let x2 = x * x;
-    let s = x + x
-        * x2
-        * (k(-1.0 / 6.0)
-            + x2 * (k(1.0 / 120.0) + x2 * (k(-1.0 / 5040.0) + x2 * k(1.0 / 362_880.0))));
-    let c = Vec4::ONE
-        + x2 * (k(-0.5)
-            + x2 * (k(1.0 / 24.0)
-                + x2 * (k(-1.0 / 720.0) + x2 * (k(1.0 / 40_320.0) - x2 * k(1.0 / 3_628_800.0)))));
     (s, c)
 }
 
