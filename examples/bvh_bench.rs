@@ -40,6 +40,7 @@ fn grid(n: u32) -> TriangleMesh {
         uv: None,
         indices,
         flip_normal: false,
+        reverse_orientation: false,
         material: 0,
         first_light: None,
     }

@@ -7,10 +7,13 @@
 
 use glam::{Vec2, Vec3};
 use pbrs::render::geometry::Frame;
-use pbrs::render::materials::{Bsdf, LobeFilter, Lobes, Material};
+mod common;
+
+use common::material_bsdf;
+use pbrs::render::bxdf::{Bxdf, FresnelSpecular};
+use pbrs::render::materials::{Bsdf, BxdfFlags};
 use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::render::sampling::Pcg32;
-use pbrs::scene::MaterialDesc;
 
 /// Incident directions: polar angles (degrees) of wo, above the surface,
 /// plus one from below (both-sided matte surfaces shade either side).
@@ -27,16 +30,17 @@ fn wo_at(deg: f32) -> Vec3 {
 }
 
 fn matte(kd: Vec3, sigma: f32) -> Bsdf {
-    Material::new(&MaterialDesc::Matte { kd, sigma }).bsdf(Vec3::Z, Vec3::Z, false)
+    material_bsdf(
+        &format!(
+            "\"matte\" \"rgb Kd\" [{} {} {}] \"float sigma\" {sigma}",
+            kd.x, kd.y, kd.z
+        ),
+        false,
+    )
 }
 
-fn lobes_bsdf(lobes: Lobes, eta: f32) -> Bsdf {
-    Bsdf {
-        frame: Frame::from_normal(Vec3::Z),
-        ng: Vec3::Z,
-        lobes,
-        eta,
-    }
+fn is_oren_nayar(b: &Bsdf) -> bool {
+    matches!(b.lobes(), [l] if matches!(l.bxdf, Bxdf::OrenNayar(_)))
 }
 
 fn chi2_bsdf(name: &str, bsdf: &Bsdf, wo: Vec3, seed: u64) {
@@ -48,8 +52,8 @@ fn chi2_bsdf(name: &str, bsdf: &Bsdf, wo: Vec3, seed: u64) {
         ..Default::default()
     };
     let r = chi2_sphere(
-        |u| bsdf.sample(wo, u, LobeFilter::NonSpecular).map(|s| s.wi),
-        |wi| bsdf.pdf(wo, wi),
+        |u| bsdf.sample(wo, u, BxdfFlags::NON_SPECULAR).map(|s| s.wi),
+        |wi| bsdf.pdf(wo, wi, BxdfFlags::ALL),
         &cfg,
     );
     println!("{name}: {r}");
@@ -68,22 +72,22 @@ fn check_f_agrees(name: &str, bsdf: &Bsdf, wo: Vec3) {
     for _ in 0..20_000 {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
         let s = bsdf
-            .sample(wo, u, LobeFilter::NonSpecular)
+            .sample(wo, u, BxdfFlags::NON_SPECULAR)
             .unwrap_or_else(|| panic!("{name}: no sample"));
-        assert!(!s.specular && !s.transmission, "{name}");
+        assert!(!s.is_specular() && !s.is_transmission(), "{name}");
         assert!(
             s.wi.z * wo.z > 0.0,
             "{name}: wi on the wrong side: {:?}",
             s.wi
         );
-        let f = bsdf.f(wo, s.wi);
+        let f = bsdf.f(wo, s.wi, BxdfFlags::ALL);
         assert!(
             (f - s.f).abs().max_element() <= 1e-6 * f.max_element().max(1.0),
             "{name}: sampled f {:?} vs f {:?}",
             s.f,
             f
         );
-        let pdf = bsdf.pdf(wo, s.wi);
+        let pdf = bsdf.pdf(wo, s.wi, BxdfFlags::ALL);
         assert!(
             (pdf - s.pdf).abs() <= 1e-5 * pdf,
             "{name}: {pdf} vs {}",
@@ -91,8 +95,8 @@ fn check_f_agrees(name: &str, bsdf: &Bsdf, wo: Vec3) {
         );
         // Specular filters never return a sample from a matte surface.
         for filter in [
-            LobeFilter::SpecularReflection,
-            LobeFilter::SpecularTransmission,
+            BxdfFlags::SPECULAR_REFLECTION,
+            BxdfFlags::SPECULAR_TRANSMISSION,
         ] {
             assert!(bsdf.sample(wo, u, filter).is_none(), "{name}");
         }
@@ -103,13 +107,13 @@ fn check_f_agrees(name: &str, bsdf: &Bsdf, wo: Vec3) {
 fn lambertian_chi2_and_f() {
     let kd = Vec3::new(0.5, 0.25, 0.8);
     let b = matte(kd, 0.0);
-    assert!(matches!(b.lobes, Lobes::Lambertian { .. }));
+    assert!(b.single_lambertian().is_some());
     for (i, &deg) in ANGLES.iter().enumerate() {
         let wo = wo_at(deg);
         chi2_bsdf(&format!("lambertian θo={deg}"), &b, wo, i as u64);
         check_f_agrees(&format!("lambertian θo={deg}"), &b, wo);
         // f·cos/pdf = Kd exactly for every cosine-weighted sample.
-        let s = b.sample(wo, Vec2::new(0.3, 0.6), LobeFilter::All).unwrap();
+        let s = b.sample(wo, Vec2::new(0.3, 0.6), BxdfFlags::ALL).unwrap();
         let w = s.f * s.wi.z.abs() / s.pdf;
         assert!((w - kd).abs().max_element() < 1e-5, "{w:?}");
     }
@@ -142,7 +146,7 @@ fn oren_nayar_chi2_and_f() {
     let kd = 0.6;
     for (k, &sigma) in SIGMAS.iter().enumerate() {
         let b = matte(Vec3::splat(kd), sigma);
-        assert!(matches!(b.lobes, Lobes::OrenNayar { .. }));
+        assert!(is_oren_nayar(&b));
         for (i, &deg) in ANGLES.iter().enumerate() {
             let name = format!("oren-nayar σ={sigma} θo={deg}");
             let wo = wo_at(deg);
@@ -152,7 +156,7 @@ fn oren_nayar_chi2_and_f() {
             let mut rng = Pcg32::with_sequence(k as u64);
             for _ in 0..2000 {
                 let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-                let s = b.sample(wo, u, LobeFilter::NonSpecular).unwrap();
+                let s = b.sample(wo, u, BxdfFlags::NON_SPECULAR).unwrap();
                 let want = oren_nayar_reference(kd as f64, sigma as f64, wo, s.wi);
                 assert!(
                     (s.f.x as f64 - want).abs() < 2e-4 * want.max(1.0),
@@ -160,7 +164,7 @@ fn oren_nayar_chi2_and_f() {
                     s.f.x,
                     s.wi
                 );
-                let back = b.f(s.wi, wo);
+                let back = b.f(s.wi, wo, BxdfFlags::ALL);
                 assert!(
                     (back - s.f).abs().max_element() < 1e-5,
                     "{name}: reciprocity"
@@ -203,7 +207,7 @@ fn oren_nayar_albedo_matches_quadrature() {
             let (mut sum, mut sum2) = (0.0f64, 0.0f64);
             for _ in 0..n {
                 let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-                let s = b.sample(wo, u, LobeFilter::NonSpecular).unwrap();
+                let s = b.sample(wo, u, BxdfFlags::NON_SPECULAR).unwrap();
                 let w = (s.f.x * s.wi.z.abs() / s.pdf) as f64;
                 sum += w;
                 sum2 += w * w;
@@ -219,10 +223,7 @@ fn oren_nayar_albedo_matches_quadrature() {
         }
     }
     // sigma 0 is Lambertian (pbrt-v3's MatteMaterial).
-    assert!(matches!(
-        matte(Vec3::ONE, 0.0).lobes,
-        Lobes::Lambertian { .. }
-    ));
+    assert!(matte(Vec3::ONE, 0.0).single_lambertian().is_some());
 }
 
 #[test]
@@ -231,7 +232,7 @@ fn wrong_pdf_is_rejected() {
     let b = matte(Vec3::ONE, 0.0);
     let wo = wo_at(30.0);
     let r = chi2_sphere(
-        |u| b.sample(wo, u, LobeFilter::NonSpecular).map(|s| s.wi),
+        |u| b.sample(wo, u, BxdfFlags::NON_SPECULAR).map(|s| s.wi),
         |wi| {
             if wi.z > 0.0 {
                 0.5 / std::f32::consts::PI
@@ -287,7 +288,13 @@ fn check_transmitted(name: &str, wo: Vec3, wi: Vec3, n1: f64, n2: f64) {
 fn fresnel_specular_picks_reflection_with_the_fresnel_probability() {
     let eta = 1.5f32;
     let (r, t) = (Vec3::new(0.9, 0.8, 0.7), Vec3::new(0.6, 0.7, 0.8));
-    let b = lobes_bsdf(Lobes::FresnelSpecular { r, t, eta }, eta);
+    let mut b = Bsdf::new(Frame::from_normal(Vec3::Z), Vec3::Z, eta);
+    b.add(FresnelSpecular {
+        r,
+        t,
+        eta_a: 1.0,
+        eta_b: eta,
+    });
     // 4% at normal incidence for index 1.5.
     assert!((fresnel(1.0, 1.0, 1.5) - 0.04).abs() < 1e-12);
     for &deg in &GLASS_ANGLES {
@@ -301,12 +308,12 @@ fn fresnel_specular_picks_reflection_with_the_fresnel_probability() {
             // Stratified u.x: the reflected fraction is F to within 1/n.
             let u = Vec2::new((k as f32 + 0.5) / n as f32, 0.5);
             let s = b
-                .sample(wo, u, LobeFilter::All)
+                .sample(wo, u, BxdfFlags::ALL)
                 .unwrap_or_else(|| panic!("{name}: no sample"));
-            assert!(s.specular, "{name}");
+            assert!(s.is_specular(), "{name}");
             let w = s.f * s.wi.z.abs() / s.pdf;
             mean += w.as_dvec3() / n as f64;
-            if s.transmission {
+            if s.is_transmission() {
                 check_transmitted(&name, wo, s.wi, n1, n2);
                 assert!((s.pdf as f64 - (1.0 - fr)).abs() < 1e-5, "{name}: pdf");
                 // Radiance scaled by (η_i/η_t)².
@@ -336,9 +343,12 @@ fn fresnel_specular_picks_reflection_with_the_fresnel_probability() {
         );
         // No non-specular part: NonSpecular sampling and pdf give nothing.
         assert!(b
-            .sample(wo, Vec2::splat(0.3), LobeFilter::NonSpecular)
+            .sample(wo, Vec2::splat(0.3), BxdfFlags::NON_SPECULAR)
             .is_none());
-        assert_eq!(b.f(wo, Vec3::new(-wo.x, -wo.y, wo.z)), Vec3::ZERO);
+        assert_eq!(
+            b.f(wo, Vec3::new(-wo.x, -wo.y, wo.z), BxdfFlags::ALL),
+            Vec3::ZERO
+        );
     }
     // Beyond the critical angle from inside every sample reflects.
     let wo = wo_at(135.0);
@@ -346,9 +356,9 @@ fn fresnel_specular_picks_reflection_with_the_fresnel_probability() {
     assert_eq!(fresnel(cos1, n1, n2), 1.0);
     for k in 0..1000 {
         let s = b
-            .sample(wo, Vec2::new(k as f32 / 1000.0, 0.5), LobeFilter::All)
+            .sample(wo, Vec2::new(k as f32 / 1000.0, 0.5), BxdfFlags::ALL)
             .unwrap();
-        assert!(!s.transmission && s.pdf == 1.0);
+        assert!(!s.is_transmission() && s.pdf == 1.0);
     }
 }
 
@@ -357,29 +367,41 @@ fn split_glass_and_mirror_throughputs_are_fresnel_weighted_colours() {
     let eta = 1.5f32;
     let (r, t) = (Vec3::new(0.9, 0.8, 0.7), Vec3::new(0.6, 0.7, 0.8));
     // What directlighting and whitted use for smooth glass.
-    let b = Material::new(&MaterialDesc::Glass { kr: r, kt: t, eta }).bsdf(Vec3::Z, Vec3::Z, false);
-    assert!(matches!(b.lobes, Lobes::SplitGlass { .. }));
+    let b = material_bsdf(
+        &format!(
+            "\"glass\" \"rgb Kr\" [{} {} {}] \"rgb Kt\" [{} {} {}] \"float index\" {eta}",
+            r.x, r.y, r.z, t.x, t.y, t.z
+        ),
+        false,
+    );
+    assert_eq!(b.lobes().len(), 2);
     let u = Vec2::new(0.3, 0.7);
     for &deg in &GLASS_ANGLES {
         let wo = wo_at(deg);
         let name = format!("split glass θo={deg}");
         let (cos1, n1, n2) = side(wo, eta as f64);
         let fr = fresnel(cos1, n1, n2);
-        let s = b.sample(wo, u, LobeFilter::SpecularReflection).unwrap();
-        assert!(s.specular && !s.transmission && s.pdf == 1.0, "{name}");
+        let s = b.sample(wo, u, BxdfFlags::SPECULAR_REFLECTION).unwrap();
+        assert!(
+            s.is_specular() && !s.is_transmission() && s.pdf == 1.0,
+            "{name}"
+        );
         assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
         let w = (s.f * s.wi.z.abs() / s.pdf).as_dvec3();
         assert!(
             (w - r.as_dvec3() * fr).abs().max_element() < 1e-5,
             "{name}: {w:?}"
         );
-        match b.sample(wo, u, LobeFilter::SpecularTransmission) {
+        match b.sample(wo, u, BxdfFlags::SPECULAR_TRANSMISSION) {
             Some(s) => {
                 assert!(
                     fr < 1.0,
                     "{name}: transmitted under total internal reflection"
                 );
-                assert!(s.specular && s.transmission && s.pdf == 1.0, "{name}");
+                assert!(
+                    s.is_specular() && s.is_transmission() && s.pdf == 1.0,
+                    "{name}"
+                );
                 check_transmitted(&name, wo, s.wi, n1, n2);
                 let w = (s.f * s.wi.z.abs() / s.pdf).as_dvec3();
                 let want = t.as_dvec3() * (1.0 - fr) * (n1 * n1) / (n2 * n2);
@@ -391,18 +413,21 @@ fn split_glass_and_mirror_throughputs_are_fresnel_weighted_colours() {
             None => assert_eq!(fr, 1.0, "{name}: no transmission without TIR"),
         }
         // Both lobes under `All`: one is chosen, with probability 1/2.
-        let s = b.sample(wo, u, LobeFilter::All).unwrap();
+        let s = b.sample(wo, u, BxdfFlags::ALL).unwrap();
         assert_eq!(s.pdf, 0.5, "{name}");
-        assert!(b.sample(wo, u, LobeFilter::NonSpecular).is_none());
+        assert!(b.sample(wo, u, BxdfFlags::NON_SPECULAR).is_none());
     }
     // Mirror: no Fresnel term, throughput Kr at every angle.
     let kr = Vec3::new(0.8, 0.5, 0.3);
-    let m = Material::new(&MaterialDesc::Mirror { kr }).bsdf(Vec3::Z, Vec3::Z, false);
+    let m = material_bsdf(
+        &format!("\"mirror\" \"rgb Kr\" [{} {} {}]", kr.x, kr.y, kr.z),
+        false,
+    );
     for &deg in &ANGLES {
         let wo = wo_at(deg);
-        let s = m.sample(wo, u, LobeFilter::SpecularReflection).unwrap();
+        let s = m.sample(wo, u, BxdfFlags::SPECULAR_REFLECTION).unwrap();
         assert!((s.f * s.wi.z.abs() / s.pdf - kr).abs().max_element() < 1e-5);
-        assert!(m.sample(wo, u, LobeFilter::SpecularTransmission).is_none());
-        assert!(m.sample(wo, u, LobeFilter::NonSpecular).is_none());
+        assert!(m.sample(wo, u, BxdfFlags::SPECULAR_TRANSMISSION).is_none());
+        assert!(m.sample(wo, u, BxdfFlags::NON_SPECULAR).is_none());
     }
 }

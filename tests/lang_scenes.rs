@@ -205,13 +205,10 @@ fn cornell_path_details() {
     let a = light.area_light.unwrap();
     assert_eq!(a.l, glam::Vec3::new(17.0, 12.0, 4.0));
     assert!(!a.two_sided);
-    assert_eq!(
-        s.materials[light.material.0 as usize],
-        MaterialDesc::Matte {
-            kd: glam::Vec3::ZERO,
-            sigma: 0.0
-        }
-    );
+    let m = &s.materials[light.material.0 as usize];
+    assert_eq!(m.kind, "matte");
+    assert_eq!(m.constant_spectrum("Kd"), Some(glam::Vec3::ZERO));
+    assert_eq!(m.constant_float("sigma"), Some(0.0));
     // The boxes: unitcube.inc under Translate·Rotate·Scale.
     let boxes: Vec<_> = s
         .shapes

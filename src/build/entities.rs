@@ -21,7 +21,11 @@ pub const MAX_SAMPLES: i64 = 1 << 24;
 
 // ---------------------------------------------------------------- lookups
 
-fn one<'a>(p: &'a ParamList, name: &str, ty: impl Fn(ParamType) -> bool) -> Option<&'a Param> {
+pub(super) fn one<'a>(
+    p: &'a ParamList,
+    name: &str,
+    ty: impl Fn(ParamType) -> bool,
+) -> Option<&'a Param> {
     p.items
         .iter()
         .find(|q| q.name == name && ty(q.ty) && q.count() == 1)
@@ -34,7 +38,7 @@ pub fn float(p: &ParamList, name: &str, def: f64) -> f64 {
         .unwrap_or(def)
 }
 
-fn float_opt(p: &ParamList, name: &str) -> Option<(f64, Loc)> {
+pub(super) fn float_opt(p: &ParamList, name: &str) -> Option<(f64, Loc)> {
     one(p, name, |t| t == ParamType::Float).map(|q| (q.nums()[0], q.values_loc))
 }
 
@@ -61,7 +65,7 @@ fn point3(p: &ParamList, name: &str, def: DVec3) -> DVec3 {
 }
 
 /// A spectrum-typed parameter as linear RGB (`None` for spectrum file names, with a warning).
-fn spectrum_value(ctx: &mut Ctx, q: &Param) -> Option<Vec3> {
+pub(super) fn spectrum_value(ctx: &mut Ctx, q: &Param) -> Option<Vec3> {
     let v = q.nums();
     match q.ty {
         ParamType::Rgb => Some(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)),
@@ -76,7 +80,7 @@ fn spectrum_value(ctx: &mut Ctx, q: &Param) -> Option<Vec3> {
     }
 }
 
-fn find_spectrum<'a>(p: &'a ParamList, name: &str) -> Option<&'a Param> {
+pub(super) fn find_spectrum<'a>(p: &'a ParamList, name: &str) -> Option<&'a Param> {
     let q = p
         .items
         .iter()
@@ -197,207 +201,6 @@ pub fn texture(
             loc: name.loc,
         },
     ))
-}
-
-// ---------------------------------------------------------------- materials
-
-/// A material as declared (built lazily when a shape uses it).
-#[derive(Debug)]
-pub struct MaterialSpec {
-    pub ty: String,
-    /// The `Material`/`MakeNamedMaterial` statement; `None` for the initial matte.
-    pub stmt: Option<usize>,
-    pub loc: Loc,
-    pub textures: Rc<Textures>,
-    pub name: Option<String>,
-}
-
-impl MaterialSpec {
-    pub fn new(
-        ty: String,
-        stmt: Option<usize>,
-        loc: Loc,
-        textures: Rc<Textures>,
-        name: Option<String>,
-    ) -> Self {
-        MaterialSpec {
-            ty,
-            stmt,
-            loc,
-            textures,
-            name,
-        }
-    }
-    pub fn default_matte() -> Self {
-        MaterialSpec {
-            ty: "matte".into(),
-            stmt: None,
-            loc: Loc::default(),
-            textures: Rc::new(Textures::default()),
-            name: None,
-        }
-    }
-}
-
-/// Material parameter lookup: shape parameters first (if they override), then the material's.
-pub struct Lookup<'a> {
-    pub first: Option<&'a ParamList>,
-    pub second: &'a ParamList,
-    pub textures: &'a Textures,
-}
-
-impl Lookup<'_> {
-    fn lists(&self) -> impl Iterator<Item = &ParamList> {
-        self.first.into_iter().chain(std::iter::once(self.second))
-    }
-
-    fn texture_ref(&self, name: &str, l: &ParamList) -> Option<(String, Loc)> {
-        one(l, name, |t| t == ParamType::Texture).map(|q| (q.strs()[0].clone(), q.values_loc))
-    }
-
-    /// pbrt-v3 `GetSpectrumTexture` reduced to a constant.
-    fn spectrum(&self, ctx: &mut Ctx, name: &str, def: Vec3) -> Vec3 {
-        for l in self.lists() {
-            if let Some((tex, loc)) = self.texture_ref(name, l) {
-                return match self.textures.spectrum.get(&tex).map(|t| t.value.clone()) {
-                    Some(TexValue::Spectrum(v)) => v,
-                    Some(TexValue::Unsupported(class)) => {
-                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which pbrs does not evaluate: the default {def} is used"), "unsupported texture");
-                        def
-                    }
-                    _ => {
-                        ctx.warn(loc, format!("unknown spectrum texture \"{tex}\" for \"{name}\": the default {def} is used (as pbrt-v3)"), "no such \"color\" texture");
-                        def
-                    }
-                };
-            }
-            if let Some(q) = find_spectrum(l, name) {
-                return spectrum_value(ctx, q).unwrap_or(def);
-            }
-        }
-        def
-    }
-
-    /// pbrt-v3 `GetFloatTexture` reduced to a constant; `None` if absent.
-    fn float_opt(&self, ctx: &mut Ctx, name: &str) -> Option<f64> {
-        for l in self.lists() {
-            if let Some((tex, loc)) = self.texture_ref(name, l) {
-                return match self.textures.float.get(&tex).map(|t| t.value.clone()) {
-                    Some(TexValue::Float(v)) => Some(v),
-                    Some(TexValue::Unsupported(class)) => {
-                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which pbrs does not evaluate: the default is used"), "unsupported texture");
-                        None
-                    }
-                    _ => {
-                        ctx.warn(loc, format!("unknown float texture \"{tex}\" for \"{name}\": the default is used (as pbrt-v3)"), "no such \"float\" texture");
-                        None
-                    }
-                };
-            }
-            if let Some((v, _)) = float_opt(l, name) {
-                return Some(v);
-            }
-        }
-        None
-    }
-
-    fn float(&self, ctx: &mut Ctx, name: &str, def: f64) -> f64 {
-        self.float_opt(ctx, name).unwrap_or(def)
-    }
-
-    fn bumpmap(&self, ctx: &mut Ctx) {
-        for l in self.lists() {
-            if let Some((_, loc)) = self.texture_ref("bumpmap", l) {
-                ctx.warn(
-                    loc,
-                    "bump mapping is not supported by pbrs: \"bumpmap\" ignored",
-                    "ignored",
-                );
-            }
-        }
-    }
-
-    /// Marks the material's own parameters (not the shape's) used.
-    fn mark_all(&self) {
-        self.second.mark_all_used();
-    }
-}
-
-const OTHER_MATERIALS: &[&str] = &[
-    "plastic",
-    "translucent",
-    "hair",
-    "disney",
-    "mix",
-    "metal",
-    "substrate",
-    "uber",
-    "subsurface",
-    "kdsubsurface",
-    "fourier",
-];
-
-/// Builds a material: the description and its kind name for the summary.
-pub fn material(ctx: &mut Ctx, spec: &MaterialSpec, l: &Lookup) -> (MaterialDesc, &'static str) {
-    let what = match &spec.name {
-        Some(n) => format!("named material \"{n}\""),
-        None => format!("Material \"{}\"", spec.ty),
-    };
-    match spec.ty.as_str() {
-        "matte" => {
-            let kd = l.spectrum(ctx, "Kd", Vec3::splat(0.5));
-            let sigma = l.float(ctx, "sigma", 0.0).clamp(0.0, 90.0) as f32;
-            l.bumpmap(ctx);
-            (MaterialDesc::Matte { kd, sigma }, "matte")
-        }
-        "glass" => {
-            let kr = l.spectrum(ctx, "Kr", Vec3::ONE);
-            let kt = l.spectrum(ctx, "Kt", Vec3::ONE);
-            let eta = match l.float_opt(ctx, "eta") {
-                Some(e) => e,
-                None => l.float(ctx, "index", 1.5),
-            };
-            let ur = l.float(ctx, "uroughness", 0.0);
-            let vr = l.float(ctx, "vroughness", 0.0);
-            for p in l.lists() {
-                one(p, "remaproughness", |t| t == ParamType::Bool);
-            }
-            if ur > 0.0 || vr > 0.0 {
-                ctx.warn(spec.loc, format!("{what}: rough glass (uroughness {ur}, vroughness {vr}) is not supported: treated as smooth glass"), "rough glass");
-            }
-            l.bumpmap(ctx);
-            (
-                MaterialDesc::Glass {
-                    kr,
-                    kt,
-                    eta: eta as f32,
-                },
-                "glass",
-            )
-        }
-        "mirror" => {
-            let kr = l.spectrum(ctx, "Kr", Vec3::splat(0.9));
-            l.bumpmap(ctx);
-            (MaterialDesc::Mirror { kr }, "mirror")
-        }
-        "" | "none" => (MaterialDesc::None, "none"),
-        other => {
-            let kd = l.spectrum(ctx, "Kd", Vec3::splat(0.5));
-            let kept = l.lists().any(|p| p.get("Kd").is_some_and(|q| q.used.get()));
-            l.mark_all();
-            let keep = if kept {
-                format!("its Kd {kd}")
-            } else {
-                "the default Kd 0.5".to_string()
-            };
-            if OTHER_MATERIALS.contains(&other) {
-                ctx.warn(spec.loc, format!("{what}: material type \"{other}\" is not supported by pbrs: substituted by a matte with {keep}"), "substituted by matte");
-            } else {
-                ctx.warn(spec.loc, format!("{what}: unknown material type \"{other}\": using \"matte\" with {keep} (as pbrt-v3)"), "unknown material type");
-            }
-            (MaterialDesc::Matte { kd, sigma: 0.0 }, "matte")
-        }
-    }
 }
 
 /// pbrt-v3 `shapeMaySetMaterialParameters` (api.cpp): whether a shape's parameters

@@ -8,6 +8,7 @@
 
 pub mod color;
 pub mod entities;
+pub mod material;
 pub mod meshfile;
 pub mod ply;
 pub mod state;

@@ -2,7 +2,8 @@
 //! and transform stacks, current and named materials, textures, area light,
 //! ReverseOrientation, object definitions, and the option directives.
 
-use super::entities::{self, Lookup, MaterialSpec, Textures};
+use super::entities::{self, Textures};
+use super::material::{self, Lookup, MaterialSpec};
 use super::Ctx;
 use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
 use crate::lang::Loc;
@@ -397,7 +398,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             K::ReverseOrientation => self.graphics.reverse = !self.graphics.reverse,
             K::Material => {
                 let Directive::Entity { name, .. } = &s.dir else { return };
-                self.graphics.material = Rc::new(MaterialSpec::new(name.value.clone(), Some(i), name.loc, self.graphics.textures.clone(), None));
+                self.graphics.material = Rc::new(MaterialSpec::new(name.value.clone(), Some(i), name.loc, self.graphics.textures.clone(), None, self.graphics.named.clone()));
             }
             K::MakeNamedMaterial => {
                 let Directive::Entity { name, params } = &s.dir else { return };
@@ -410,7 +411,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                     let at = self.ctx.sources.position(old.loc);
                     self.ctx.warn(name.loc, format!("named material \"{}\" redefined (first defined at {at})", name.value), "redefinition");
                 }
-                let spec = Rc::new(MaterialSpec::new(ty, Some(i), name.loc, self.graphics.textures.clone(), Some(name.value.clone())));
+                let spec = Rc::new(MaterialSpec::new(ty, Some(i), name.loc, self.graphics.textures.clone(), Some(name.value.clone()), self.graphics.named.clone()));
                 self.named_material_defs.push((name.value.clone(), spec.clone()));
                 Rc::make_mut(&mut self.graphics.named).insert(name.value.clone(), spec);
             }
@@ -688,7 +689,35 @@ impl<'s, 'c> Builder<'s, 'c> {
             second: mat_params.unwrap_or(&empty),
             textures: if overrides { textures } else { &spec.textures },
         };
-        let (desc, kind) = entities::material(self.ctx, spec, &lookup);
+        let (mut desc, kind, refs) = material::material(self.ctx, spec, &lookup);
+        for r in refs {
+            let id = match spec.named.get(&r.name) {
+                Some(named) => {
+                    let named = named.clone();
+                    let empty = crate::lang::params::ParamList::default();
+                    self.material_for_shape(&named, &empty, &named.textures.clone())
+                }
+                None => {
+                    let what = if r.name.is_empty() {
+                        format!("\"{}\" is not given", r.param)
+                    } else {
+                        format!(
+                            "named material \"{}\" (\"{}\") is not defined before this material",
+                            r.name, r.param
+                        )
+                    };
+                    self.ctx.warn(
+                        if r.name.is_empty() { spec.loc } else { r.loc },
+                        format!("{what}: using a matte (as pbrt-v3)"),
+                        "undefined named material",
+                    );
+                    let matte = Rc::new(MaterialSpec::default_matte());
+                    let empty = crate::lang::params::ParamList::default();
+                    self.material_for_shape(&matte, &empty, &matte.textures.clone())
+                }
+            };
+            desc.params.set(r.param, ParamValue::Material(id));
+        }
         if self.reported_materials.insert(spec.stmt) {
             if let Some(p) = mat_params {
                 if overrides {

@@ -2,6 +2,7 @@
 //! samplers, integrators and film. It consumes a [`crate::scene::SceneDescription`].
 
 pub mod accel;
+pub mod bxdf;
 pub mod camera;
 pub mod driver;
 pub mod film;
@@ -13,3 +14,4 @@ pub mod samplers;
 pub mod sampling;
 pub mod scene;
 pub mod shapes;
+pub mod textures;

@@ -289,6 +289,7 @@ fn world_mesh(m: &scene::MeshData, to_world: DMat4, reverse: bool, material: u32
         uv: m.uvs.clone(),
         indices: m.indices.clone(),
         flip_normal: reverse ^ (lin.determinant() < 0.0),
+        reverse_orientation: reverse,
         material,
         first_light: None,
     }

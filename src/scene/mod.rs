@@ -6,6 +6,14 @@
 //! Transforms are `f64` so that long chains of scene-file transforms do not lose
 //! precision before the render core converts geometry to `f32` world space.
 
+mod params;
+mod textures;
+
+pub use params::{
+    FourierTable, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
+};
+pub use textures::{FloatTex, SpectrumTex};
+
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -152,25 +160,25 @@ pub enum IntegratorDesc {
     },
 }
 
-/// Materials as linear RGB constants (textures are reduced to constants or
-/// substituted with a warning by scene building).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MaterialDesc {
-    /// `sigma` in degrees; 0 means Lambertian.
-    Matte {
-        kd: Vec3,
-        sigma: f32,
-    },
-    Glass {
-        kr: Vec3,
-        kt: Vec3,
-        eta: f32,
-    },
-    Mirror {
-        kr: Vec3,
-    },
-    /// `Material ""` / `"none"`: no BSDF, the surface only delimits media.
-    None,
+/// A material: its kind (a name in `render::materials::MATERIALS`) and the
+/// values of the parameters that kind declares, defaults applied.
+/// `Material "none"` / `""` is the kind "none" (no BSDF: the surface only
+/// delimits media).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDesc {
+    pub kind: &'static str,
+    pub params: ParamValues,
+}
+
+impl MaterialDesc {
+    /// A spectrum parameter's value if it is a constant.
+    pub fn constant_spectrum(&self, name: &str) -> Option<Vec3> {
+        self.params.spectrum_tex(name)?.as_constant()
+    }
+    /// A float-texture parameter's value if it is a constant.
+    pub fn constant_float(&self, name: &str) -> Option<f32> {
+        self.params.float_tex(name)?.as_constant()
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -169,3 +169,59 @@ pub fn average(images: &[Image]) -> Image {
     }
     out
 }
+
+/// The materials of `Material {decl}` (and of named materials it refers
+/// to), loaded through the real scene loader; the first is the statement's.
+pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
+    let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n");
+    let l = pbrs::build::load_scene_str(&text, &repo().join("mem.pbrt"))
+        .unwrap_or_else(|f| panic!("{decl}: {:?}", f.errors));
+    let first = l.scene.shapes[0].material.0 as usize;
+    let mut m: Vec<_> = l
+        .scene
+        .materials
+        .iter()
+        .map(pbrs::render::materials::Material::new)
+        .collect();
+    m.swap(0, first);
+    m
+}
+
+/// The BSDF of `Material {decl}` at a point with normals +z and, when the
+/// material needs them, dp/du = +x and dp/dv = +y.
+pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::materials::Bsdf {
+    use glam::{Vec2, Vec3};
+    use pbrs::render::accel::SurfaceHit;
+    use pbrs::render::materials::{BsdfContext, ShadingContext};
+    use pbrs::render::shapes::{DiffGeom, SurfacePoint};
+    let materials = materials_of(decl);
+    let hit = SurfaceHit {
+        point: SurfacePoint {
+            p: Vec3::ZERO,
+            p_error: Vec3::ZERO,
+            n: Vec3::Z,
+            ns: Vec3::Z,
+        },
+        material: 0,
+        light: None,
+    };
+    let geom = DiffGeom {
+        uv: Vec2::new(0.5, 0.5),
+        dpdu: Vec3::X,
+        dpdv: Vec3::Y,
+        shading_dpdu: Vec3::X,
+        shading_dpdv: Vec3::Y,
+        ..DiffGeom::ZERO
+    };
+    let ctx = BsdfContext {
+        materials: &materials,
+        multiple_lobes,
+    };
+    materials[0].bsdf(
+        &ShadingContext {
+            hit: &hit,
+            geom: &geom,
+        },
+        &ctx,
+    )
+}

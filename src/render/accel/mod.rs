@@ -16,7 +16,7 @@
 mod bvh4;
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
-use crate::render::shapes::{Sphere, SurfacePoint, TriangleMesh};
+use crate::render::shapes::{DiffGeom, Sphere, SurfacePoint, TriangleMesh};
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
@@ -141,6 +141,8 @@ pub struct Instance {
     abs_translation: Vec3,
     /// Inverse transpose of the linear part: maps normals.
     normal_matrix: Mat3,
+    /// The linear part: maps tangent vectors.
+    linear: Mat3,
 }
 
 impl Instance {
@@ -163,6 +165,7 @@ impl Instance {
             abs_linear: Mat3::from_cols(l.x_axis.abs(), l.y_axis.abs(), l.z_axis.abs()),
             abs_translation: object_to_world.w_axis.truncate().as_vec3().abs(),
             normal_matrix: lin.inverse().transpose().as_mat3(),
+            linear: l,
         })
     }
 
@@ -245,6 +248,24 @@ impl Instance {
             n = crate::render::geometry::face_forward(n, ns);
         }
         SurfacePoint { p, p_error, n, ns }
+    }
+
+    /// Object-space differential geometry in world space: tangents by the
+    /// linear part, normal derivatives by the inverse transpose.
+    #[inline]
+    fn geom_to_world(&self, g: DiffGeom) -> DiffGeom {
+        let (l, n) = (self.linear, self.normal_matrix);
+        DiffGeom {
+            uv: g.uv,
+            dpdu: l * g.dpdu,
+            dpdv: l * g.dpdv,
+            dndu: n * g.dndu,
+            dndv: n * g.dndv,
+            shading_dpdu: l * g.shading_dpdu,
+            shading_dpdv: l * g.shading_dpdv,
+            shading_dndu: n * g.shading_dndu,
+            shading_dndv: n * g.shading_dndv,
+        }
     }
 }
 
@@ -373,7 +394,16 @@ impl Shapes<'_> {
         })
     }
 
+    /// The differential geometry of a hit whose shading normal is `ns`.
     #[inline]
+    fn diff_geom(&self, prim: PrimRef, local: HitLocal, ns: Vec3) -> DiffGeom {
+        match local {
+            HitLocal::Bary(b) => self.meshes[prim.mesh as usize].diff_geom(prim.index, b, ns),
+            HitLocal::SpherePoint(p) => self.spheres[prim.index as usize].diff_geom(p),
+        }
+    }
+
+    #[inline(always)]
     fn surface(&self, prim: PrimRef, local: HitLocal) -> (SurfaceHit, bool) {
         match local {
             HitLocal::Bary(b) => {
@@ -505,6 +535,19 @@ impl Geometry {
                 .shapes()
                 .occluded(&inst.object_ray(ray), |_| false)
         })
+    }
+
+    /// The differential geometry of a hit (uv, dp/du, …), for materials
+    /// that need more than the normals: computed on demand, since most hits
+    /// (isotropic constant materials, light and shadow tests) never use it.
+    pub fn diff_geom(&self, hit: &Hit, s: &SurfaceHit) -> DiffGeom {
+        if hit.instance == NO_INSTANCE {
+            return self.shapes().diff_geom(hit.prim, hit.local, s.point.ns);
+        }
+        let inst = &self.instances[hit.instance as usize];
+        let shapes = inst.object.shapes();
+        let (local, _) = shapes.surface(hit.prim, hit.local);
+        inst.geom_to_world(shapes.diff_geom(hit.prim, hit.local, local.point.ns))
     }
 
     /// Shading data of a hit.

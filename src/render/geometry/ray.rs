@@ -29,7 +29,7 @@ impl Ray {
 
 /// pbrt-v3's OffsetRayOrigin: push `p` past its error box along `n`, on the
 /// side `w` points to, then round away from the surface.
-#[inline]
+#[inline(always)]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
     // Negated when w·n < 0, by the sign bit rather than a branch (which

@@ -2,16 +2,16 @@
 //! power-heuristic MIS, Russian roulette), `directlighting` (strategy all or
 //! one, specular lobes followed recursively) and `whitted`.
 
-use crate::render::accel::SurfaceHit;
+use crate::render::accel::{Hit, SurfaceHit};
 use crate::render::geometry::{spawn_ray, Ray};
 use crate::render::lights::{
     pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
 };
-use crate::render::materials::{Bsdf, LobeFilter, Lobes};
+use crate::render::materials::{Bsdf, BsdfContext, BxdfFlags, Material, ShadingContext};
 use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
-use crate::render::shapes::SurfacePoint;
+use crate::render::shapes::{DiffGeom, SurfacePoint};
 use crate::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
 use glam::{Vec2, Vec3};
 
@@ -226,6 +226,7 @@ impl Integrator {
             pass: 0,
         });
         let mut l = Vec3::ZERO;
+        let mut bsdf = Bsdf::empty();
         while let Some(w) = stack.pop() {
             scratch.counts.closest += 1;
             let Some(hit) = scene.geometry.intersect(&w.ray) else {
@@ -246,7 +247,7 @@ impl Integrator {
                 continue;
             }
             let wo = -w.ray.d;
-            let bsdf = material.bsdf(s.point.ns, s.point.n, false);
+            shade(scene, &hit, &s, material, false, &mut bsdf);
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
                 Integrator::Direct {
@@ -257,8 +258,8 @@ impl Integrator {
                     ref packs,
                 } => {
                     if !scene.lights.is_empty() {
-                        local += match (strategy, bsdf.lobes) {
-                            (DirectStrategy::All, Lobes::Lambertian { r }) if !packs.is_empty() => {
+                        local += match (strategy, bsdf.single_lambertian()) {
+                            (DirectStrategy::All, Some(r)) if !packs.is_empty() => {
                                 all_lights::sample_all_lights_packed(
                                     scene, &s, &bsdf, r, wo, sampler, scratch, packs,
                                 )
@@ -288,7 +289,7 @@ impl Integrator {
                         if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
                             continue;
                         }
-                        let f = bsdf.f(wo, ls.wi);
+                        let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
                         if f != Vec3::ZERO {
                             scratch.counts.shadow += 1;
                             if !scene.geometry.occluded(&ls.shadow) {
@@ -304,8 +305,8 @@ impl Integrator {
             if w.depth + 1 < max_depth {
                 let mut children = [None, None];
                 for (i, filter) in [
-                    LobeFilter::SpecularReflection,
-                    LobeFilter::SpecularTransmission,
+                    BxdfFlags::SPECULAR_REFLECTION,
+                    BxdfFlags::SPECULAR_TRANSMISSION,
                 ]
                 .into_iter()
                 .enumerate()
@@ -336,6 +337,40 @@ impl Integrator {
         }
         scratch.work = stack;
         l
+    }
+}
+
+/// The BSDF of `material` at a hit, built into `bsdf`, with the hit's
+/// differential geometry computed only if the material uses it.
+#[inline]
+fn shade(
+    scene: &RenderScene,
+    hit: &Hit,
+    s: &SurfaceHit,
+    material: &Material,
+    multiple_lobes: bool,
+    bsdf: &mut Bsdf,
+) {
+    let ctx = BsdfContext {
+        materials: &scene.materials,
+        multiple_lobes,
+    };
+    if material.needs_geom() {
+        let geom = scene.geometry.diff_geom(hit, s);
+        material.bsdf_into(
+            &ShadingContext {
+                hit: s,
+                geom: &geom,
+            },
+            &ctx,
+            bsdf,
+        );
+    } else {
+        let sc = ShadingContext {
+            hit: s,
+            geom: &DiffGeom::ZERO,
+        };
+        material.bsdf_into(&sc, &ctx, bsdf);
     }
 }
 
@@ -382,6 +417,7 @@ fn path_li(
     lights: &LightSampler,
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
+    let mut bsdf = Bsdf::empty();
     let mut beta = Vec3::ONE;
     let mut specular_bounce = false;
     let mut eta_scale = 1.0f32;
@@ -435,22 +471,22 @@ fn path_li(
             ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
             continue;
         }
-        let bsdf = material.bsdf(s.point.ns, s.point.n, true);
+        shade(scene, &hit, &s, material, true, &mut bsdf);
         if bsdf.has_non_specular() {
             l += beta * sample_light_mis(scene, &s, &bsdf, wo, sampler, scratch, lights);
         }
         let u = sampler.get_2d();
-        let Some(bs) = bsdf.sample(wo, u, LobeFilter::All) else {
+        let Some(bs) = bsdf.sample(wo, u, BxdfFlags::ALL) else {
             break;
         };
         if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
             break;
         }
         beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
-        specular_bounce = bs.specular;
+        specular_bounce = bs.is_specular();
         bsdf_pdf = bs.pdf;
         prev = Some(s.point);
-        if bs.specular && bs.transmission {
+        if bs.is_specular() && bs.is_transmission() {
             let eta2 = bsdf.eta * bsdf.eta;
             eta_scale *= if wo.dot(s.point.n) > 0.0 {
                 eta2
@@ -515,14 +551,27 @@ fn sample_light_mis(
     else {
         return Vec3::ZERO;
     };
-    light_strategy(scene, s, bsdf, wo, light_index, u_light, pmf, scratch)
+    light_strategy(
+        scene,
+        s,
+        bsdf,
+        wo,
+        light_index,
+        u_light,
+        pmf,
+        BxdfFlags::ALL,
+        scratch,
+    )
 }
 
 /// The light-sampling strategy of MIS: sample light `light_index`, trace the
 /// shadow ray, and weight the sample by the power heuristic against the BSDF
 /// density. `pmf` is the light's selection probability as the weights should
 /// see it: the path tracer's weights include it; pbrt-v3's EstimateDirect
-/// passes 1 and divides by the selection probability afterwards.
+/// passes 1 and divides by the selection probability afterwards. `flags`:
+/// the lobes of the BSDF strategy it is weighted against (all of them for
+/// the path tracer, whose continuation is that strategy; the non-specular
+/// ones for EstimateDirect, as pbrt-v3).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn light_strategy(
@@ -533,6 +582,7 @@ fn light_strategy(
     light_index: u32,
     u_light: Vec2,
     pmf: f32,
+    flags: BxdfFlags,
     scratch: &mut Scratch,
 ) -> Vec3 {
     let light = &scene.lights[light_index as usize];
@@ -542,7 +592,7 @@ fn light_strategy(
     if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let (f, scattering_pdf) = bsdf.f_pdf(wo, ls.wi);
+    let (f, scattering_pdf) = bsdf.f_pdf(wo, ls.wi, flags);
     let f = f * ls.wi.dot(s.point.ns).abs();
     if f == Vec3::ZERO {
         return Vec3::ZERO;
@@ -634,9 +684,19 @@ fn estimate_direct(
     let light = &scene.lights[light_index as usize];
     let geom = &scene.geometry;
     let ns = s.point.ns;
-    let mut ld = light_strategy(scene, s, bsdf, wo, light_index, u_light, 1.0, scratch);
+    let mut ld = light_strategy(
+        scene,
+        s,
+        bsdf,
+        wo,
+        light_index,
+        u_light,
+        1.0,
+        BxdfFlags::NON_SPECULAR,
+        scratch,
+    );
     if !light.is_delta() {
-        if let Some(bs) = bsdf.sample(wo, u_scatter, LobeFilter::NonSpecular) {
+        if let Some(bs) = bsdf.sample(wo, u_scatter, BxdfFlags::NON_SPECULAR) {
             let f = bs.f * bs.wi.dot(ns).abs();
             if f != Vec3::ZERO && bs.pdf > 0.0 {
                 let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);

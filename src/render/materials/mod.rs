@@ -1,57 +1,122 @@
-//! Materials and their BSDFs. A closed set, so an enum: matte (Lambertian or
-//! Oren–Nayar), mirror, glass (one FresnelSpecular lobe, or separate specular
-//! reflection and transmission lobes when the integrator asks for them, as
-//! pbrt-v3's `allowMultipleLobes`), and "none" (no BSDF).
+//! Materials: one file per pbrt-v3 material type, each with its parameters
+//! (names, types, pbrt-v3's defaults) declared at its top, and one table,
+//! [`MATERIALS`], that the loader (parsing and "did you mean"), `--check`,
+//! `grammar/REFERENCE.md` and the tests all read.
+//!
+//! A material turns the shading context of a hit into a [`Bsdf`] (pbrt-v3's
+//! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
+//! delegates to the files.
 
-mod bxdf;
+mod glass;
+mod matte;
+mod mirror;
 
-pub use bxdf::{fr_dielectric, refract, Bsdf, BsdfSample, LobeFilter, Lobes};
+pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use glass::Glass;
+pub use matte::Matte;
+pub use mirror::Mirror;
 
+use crate::render::accel::SurfaceHit;
 use crate::render::geometry::Frame;
-use crate::scene::MaterialDesc;
-use glam::Vec3;
+use crate::render::shapes::DiffGeom;
+use crate::scene::{MaterialDesc, ParamSpec, ParamValues};
+
+/// Whether pbrs renders a material kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Support {
+    Supported,
+    /// Known to pbrt-v3, not rendered by pbrs: the loader substitutes a
+    /// matte with the material's `Kd` and warns, giving the reason.
+    Unsupported(&'static str),
+}
+
+/// One material kind: its pbrt-v3 name, its parameters, and its builder.
+pub struct MaterialKind {
+    pub name: &'static str,
+    pub support: Support,
+    pub params: &'static [ParamSpec],
+    /// What it is, for `grammar/REFERENCE.md`.
+    pub doc: &'static str,
+    pub build: fn(&ParamValues) -> Material,
+}
+
+/// Every material type pbrt-v3 knows, in the order of pbrt-v3's
+/// `MakeMaterial`.
+pub static MATERIALS: &[MaterialKind] = &[
+    matte::KIND,
+    mirror::KIND,
+    glass::KIND,
+    NONE_KIND,
+    unsupported(
+        "subsurface",
+        "subsurface scattering comes with participating media",
+    ),
+    unsupported(
+        "kdsubsurface",
+        "subsurface scattering comes with participating media",
+    ),
+    unsupported("hair", "the hair BSDF comes after curves"),
+];
+
+const NONE_KIND: MaterialKind = MaterialKind {
+    name: "none",
+    support: Support::Supported,
+    params: &[],
+    doc: "no surface: rays pass through (it only delimits media)",
+    build: |_| Material::None,
+};
+
+const fn unsupported(name: &'static str, why: &'static str) -> MaterialKind {
+    MaterialKind {
+        name,
+        support: Support::Unsupported(why),
+        params: &[],
+        doc: why,
+        build: |_| Material::None,
+    }
+}
+
+/// The table entry of a material type (`""` is `"none"`, as in pbrt-v3).
+pub fn kind(name: &str) -> Option<&'static MaterialKind> {
+    let name = if name.is_empty() { "none" } else { name };
+    MATERIALS.iter().find(|k| k.name == name)
+}
+
+/// What materials and textures see of a hit: the point with its normals,
+/// and its differential geometry (uv, dp/du, …) when the material asked for
+/// it ([`Material::needs_geom`]; otherwise all zero).
+#[derive(Clone, Copy)]
+pub struct ShadingContext<'a> {
+    pub hit: &'a SurfaceHit,
+    pub geom: &'a DiffGeom,
+}
+
+/// What a material needs besides the hit: the other materials (for `mix`),
+/// and whether glass may be one FresnelSpecular lobe (pbrt-v3's
+/// `allowMultipleLobes`, which the path tracer sets).
+#[derive(Clone, Copy)]
+pub struct BsdfContext<'a> {
+    pub materials: &'a [Material],
+    pub multiple_lobes: bool,
+}
 
 /// A material ready to build BSDFs at hit points.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Material {
-    Matte {
-        kd: Vec3,
-        a: f32,
-        b: f32,
-        oren_nayar: bool,
-    },
-    Mirror {
-        kr: Vec3,
-    },
-    Glass {
-        kr: Vec3,
-        kt: Vec3,
-        eta: f32,
-    },
+    Matte(Matte),
+    Mirror(Mirror),
+    Glass(Glass),
+    /// `Material "none"`: no BSDF.
     None,
 }
 
 impl Material {
+    /// Builds the material from its description (the kind must be in
+    /// [`MATERIALS`]; the loader guarantees it).
     pub fn new(desc: &MaterialDesc) -> Material {
-        let clamp = |c: Vec3| c.max(Vec3::ZERO);
-        match *desc {
-            MaterialDesc::Matte { kd, sigma } => {
-                let s = sigma.clamp(0.0, 90.0).to_radians();
-                let s2 = s * s;
-                Material::Matte {
-                    kd: clamp(kd),
-                    a: 1.0 - s2 / (2.0 * (s2 + 0.33)),
-                    b: 0.45 * s2 / (s2 + 0.09),
-                    oren_nayar: sigma != 0.0,
-                }
-            }
-            MaterialDesc::Mirror { kr } => Material::Mirror { kr: clamp(kr) },
-            MaterialDesc::Glass { kr, kt, eta } => Material::Glass {
-                kr: clamp(kr),
-                kt: clamp(kt),
-                eta,
-            },
-            MaterialDesc::None => Material::None,
+        match kind(desc.kind) {
+            Some(k) => (k.build)(&desc.params),
+            None => panic!("material kind \"{}\" is not in the table", desc.kind),
         }
     }
 
@@ -60,53 +125,66 @@ impl Material {
         matches!(self, Material::None)
     }
 
-    /// The BSDF at a point with shading normal `ns` and geometric normal `ng`.
-    /// `multiple_lobes`: glass becomes one FresnelSpecular lobe (path) rather
-    /// than separate reflection and transmission (directlighting, whitted).
-    #[inline]
-    pub fn bsdf(&self, ns: Vec3, ng: Vec3, multiple_lobes: bool) -> Bsdf {
-        let lobes = match *self {
-            Material::Matte {
-                kd,
-                a,
-                b,
-                oren_nayar,
-            } => {
-                if kd == Vec3::ZERO {
-                    Lobes::Empty
-                } else if oren_nayar {
-                    Lobes::OrenNayar { r: kd, a, b }
-                } else {
-                    Lobes::Lambertian { r: kd }
-                }
-            }
-            Material::Mirror { kr } => {
-                if kr == Vec3::ZERO {
-                    Lobes::Empty
-                } else {
-                    Lobes::Mirror { r: kr }
-                }
-            }
-            Material::Glass { kr, kt, eta } => {
-                if kr == Vec3::ZERO && kt == Vec3::ZERO {
-                    Lobes::Empty
-                } else if multiple_lobes {
-                    Lobes::FresnelSpecular { r: kr, t: kt, eta }
-                } else {
-                    Lobes::SplitGlass { r: kr, t: kt, eta }
-                }
-            }
-            Material::None => Lobes::Empty,
-        };
-        let eta = match *self {
-            Material::Glass { eta, .. } => eta,
-            _ => 1.0,
-        };
-        Bsdf {
-            frame: Frame::from_normal(ns),
-            ng,
-            lobes,
-            eta,
+    /// True if the BSDF depends on more than the normals (textures read
+    /// uv, anisotropic lobes align with dp/du): then the integrator computes
+    /// the hit's differential geometry for it.
+    pub fn needs_geom(&self) -> bool {
+        match self {
+            Material::Matte(m) => m.needs_geom(),
+            Material::Mirror(m) => m.needs_geom(),
+            Material::Glass(m) => m.needs_geom(),
+            Material::None => false,
         }
     }
+
+    /// True if a lobe is anisotropic: then the shading frame's x axis
+    /// follows the shading dp/du (else any frame around the normal does).
+    pub fn anisotropic(&self) -> bool {
+        match self {
+            Material::Matte(_) | Material::Mirror(_) | Material::Glass(_) | Material::None => false,
+        }
+    }
+
+    /// The BSDF at a hit (pbrt-v3's `ComputeScatteringFunctions`).
+    pub fn bsdf(&self, sc: &ShadingContext, ctx: &BsdfContext) -> Bsdf {
+        let mut b = Bsdf::new(shading_frame(sc, false), sc.hit.point.n, 1.0);
+        self.bsdf_into(sc, ctx, &mut b);
+        b
+    }
+
+    /// [`Material::bsdf`] written into `out` (reset first), so that the
+    /// integrators build BSDFs in place.
+    #[inline]
+    pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+        out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
+        match self {
+            Material::Matte(m) => m.scatter(sc, out),
+            Material::Mirror(m) => m.scatter(sc, out),
+            Material::Glass(m) => m.scatter(sc, ctx, out),
+            Material::None => {}
+        }
+    }
+}
+
+/// The shading frame of a hit: z is the shading normal; x is the shading
+/// dp/du (made perpendicular to the normal) when `anisotropic`, as pbrt-v3's
+/// BSDF. Isotropic lobes do not depend on the rotation about the normal, so
+/// they take any frame around it (no differential geometry needed).
+#[inline]
+pub fn shading_frame(sc: &ShadingContext, anisotropic: bool) -> Frame {
+    let ns = sc.hit.point.ns;
+    if anisotropic {
+        let d = sc.geom.shading_dpdu;
+        let s = d - ns * ns.dot(d);
+        let l2 = s.length_squared();
+        if l2 > 0.0 && l2.is_finite() {
+            let s = s / l2.sqrt();
+            return Frame {
+                s,
+                t: ns.cross(s),
+                n: ns,
+            };
+        }
+    }
+    Frame::from_normal(ns)
 }

@@ -1,4 +1,4 @@
-use super::{ShapeSample, SurfacePoint};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, offset_ray_origin, Bounds3, Frame};
 use crate::render::sampling::uniform_cone_pdf;
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
@@ -21,6 +21,9 @@ pub struct Sphere {
     /// |det| of the linear part of the transform.
     det_abs: f64,
     pub flip_normal: bool,
+    /// pbrt-v3's θ range of the zone: θ(z_min) and θ(z_max), radians.
+    theta_min: f64,
+    theta_max: f64,
     pub material: u32,
     pub light: Option<u32>,
     /// Some((world centre, world radius)) when the transform is a similarity
@@ -80,6 +83,8 @@ impl Sphere {
             normal_matrix,
             det_abs: det.abs(),
             flip_normal: reverse ^ (det < 0.0),
+            theta_min: (zmin / r).clamp(-1.0, 1.0).acos(),
+            theta_max: (zmax / r).clamp(-1.0, 1.0).acos(),
             material,
             light: None,
             cone,
@@ -204,6 +209,62 @@ impl Sphere {
             p_error,
             n,
             ns: n,
+        }
+    }
+
+    /// The differential geometry at an object-space hit point (pbrt-v3's
+    /// `Sphere::Intersect`): u = φ/φmax, v from θ over the zone, dp/du,
+    /// dp/dv and the Weingarten equations' dn/du, dn/dv, in world space.
+    pub fn diff_geom(&self, p_obj: DVec3) -> DiffGeom {
+        let r = self.radius;
+        let mut p = p_obj;
+        if p.x == 0.0 && p.y == 0.0 {
+            p.x = 1e-5 * r;
+        }
+        let mut phi = p.y.atan2(p.x);
+        if phi < 0.0 {
+            phi += std::f64::consts::TAU;
+        }
+        let u = phi / self.phi_max;
+        let cos_theta = (p.z / r).clamp(-1.0, 1.0);
+        let theta = cos_theta.acos();
+        let dtheta = self.theta_max - self.theta_min;
+        let v = (theta - self.theta_min) / dtheta;
+        let z_radius = (p.x * p.x + p.y * p.y).sqrt();
+        let (cos_phi, sin_phi) = (p.x / z_radius, p.y / z_radius);
+        let dpdu = DVec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0);
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let dpdv = dtheta * DVec3::new(p.z * cos_phi, p.z * sin_phi, -r * sin_theta);
+        let d2pduu = -self.phi_max * self.phi_max * DVec3::new(p.x, p.y, 0.0);
+        let d2pduv = dtheta * p.z * self.phi_max * DVec3::new(-sin_phi, cos_phi, 0.0);
+        let d2pdvv = -dtheta * dtheta * p;
+        let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
+        let n = dpdu.cross(dpdv).normalize();
+        let (e, f, g) = (n.dot(d2pduu), n.dot(d2pduv), n.dot(d2pdvv));
+        let inv = 1.0 / (e1 * g1 - f1 * f1);
+        let dndu = (f * f1 - e * g1) * inv * dpdu + (e * f1 - f * e1) * inv * dpdv;
+        let dndv = (g * f1 - f * g1) * inv * dpdu + (f * f1 - g * e1) * inv * dpdv;
+        let lin = DMat3::from_mat4(self.object_to_world);
+        let (dpdu, dpdv) = ((lin * dpdu).as_vec3(), (lin * dpdv).as_vec3());
+        let fin = |v: DVec3| {
+            let v = (self.normal_matrix * v).as_vec3();
+            if v.is_finite() {
+                v
+            } else {
+                Vec3::ZERO
+            }
+        };
+        let (dndu, dndv) = (fin(dndu), fin(dndv));
+        DiffGeom {
+            uv: Vec2::new(u as f32, v as f32),
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            shading_dndu: dndu,
+            shading_dndv: dndv,
         }
     }
 

@@ -1,4 +1,4 @@
-use super::{ShapeSample, SurfacePoint};
+use super::{coordinate_system, DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{face_forward, gamma, Bounds3};
 use crate::render::sampling::uniform_sample_triangle;
 use glam::{Vec2, Vec3, Vec4};
@@ -14,6 +14,9 @@ pub struct TriangleMesh {
     pub indices: Vec<u32>,
     /// ReverseOrientation XOR the transform swaps handedness.
     pub flip_normal: bool,
+    /// ReverseOrientation alone: pbrt-v3 flips interpolated shading normals
+    /// by it (not by the handedness), and the geometric normal follows them.
+    pub reverse_orientation: bool,
     pub material: u32,
     /// Index of the area light of this mesh's first triangle; triangle `i`
     /// has light `first_light + i` (one light per triangle, as pbrt-v3).
@@ -69,6 +72,7 @@ impl TriangleMesh {
             let l2 = ns.length_squared();
             if l2 > 0.0 && l2.is_finite() {
                 let ns = ns / l2.sqrt();
+                let ns = if self.reverse_orientation { -ns } else { ns };
                 // Per-vertex normals are authoritative for orientation.
                 return (face_forward(geometric, ns), ns);
             }
@@ -94,6 +98,83 @@ impl TriangleMesh {
         let geometric = (p0 - p2).cross(p1 - p2).normalize();
         let (n, ns) = self.normals_at(tri, b, geometric);
         SurfacePoint { p, p_error, n, ns }
+    }
+
+    /// The differential geometry at barycentrics `b` (pbrt-v3's
+    /// `Triangle::Intersect`): uv (default (0,0), (1,0), (1,1)), dp/du and
+    /// dp/dv from the uv parameterisation (any frame of the plane if it is
+    /// degenerate), and with per-vertex normals the shading tangents (dp/du
+    /// made perpendicular to the shading normal `ns`) and dn/du, dn/dv.
+    #[inline]
+    pub fn diff_geom(&self, tri: u32, b: [f32; 3], ns: Vec3) -> DiffGeom {
+        let [p0, p1, p2] = self.vertices(tri);
+        let i = 3 * tri as usize;
+        let v = [
+            self.indices[i] as usize,
+            self.indices[i + 1] as usize,
+            self.indices[i + 2] as usize,
+        ];
+        let uv = match &self.uv {
+            Some(uv) => [uv[v[0]], uv[v[1]], uv[v[2]]],
+            None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
+        };
+        let duv02 = uv[0] - uv[2];
+        let duv12 = uv[1] - uv[2];
+        let dp02 = p0 - p2;
+        let dp12 = p1 - p2;
+        let det = duv02.x * duv12.y - duv02.y * duv12.x;
+        let degenerate_uv = det.abs() < 1e-8;
+        let (mut dpdu, mut dpdv) = (Vec3::ZERO, Vec3::ZERO);
+        if !degenerate_uv {
+            let inv = 1.0 / det;
+            dpdu = (duv12.y * dp02 - duv02.y * dp12) * inv;
+            dpdv = (duv02.x * dp12 - duv12.x * dp02) * inv;
+        }
+        if degenerate_uv || dpdu.cross(dpdv).length_squared() == 0.0 {
+            let ng = (p2 - p0).cross(p1 - p0);
+            (dpdu, dpdv) = coordinate_system(ng.normalize());
+        }
+        let uv_hit = b[0] * uv[0] + b[1] * uv[1] + b[2] * uv[2];
+        let mut g = DiffGeom {
+            uv: uv_hit,
+            dpdu,
+            dpdv,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            ..DiffGeom::default()
+        };
+        if let Some(normals) = &self.n {
+            let mut ss = dpdu.normalize();
+            let mut ts = ss.cross(ns);
+            if ts.length_squared() > 0.0 {
+                ts = ts.normalize();
+                ss = ts.cross(ns);
+            } else {
+                (ss, ts) = coordinate_system(ns);
+            }
+            let [n0, n1, n2] = [normals[v[0]], normals[v[1]], normals[v[2]]];
+            let (dndu, dndv) = if degenerate_uv {
+                let dn = (n2 - n0).cross(n1 - n0);
+                if dn.length_squared() == 0.0 {
+                    (Vec3::ZERO, Vec3::ZERO)
+                } else {
+                    coordinate_system(dn.normalize())
+                }
+            } else {
+                let inv = 1.0 / det;
+                let dn1 = n0 - n2;
+                let dn2 = n1 - n2;
+                (
+                    (duv12.y * dn1 - duv02.y * dn2) * inv,
+                    (duv02.x * dn2 - duv12.x * dn1) * inv,
+                )
+            };
+            g.shading_dpdu = ss;
+            g.shading_dpdv = ts;
+            g.shading_dndu = dndu;
+            g.shading_dndv = dndv;
+        }
+        g
     }
 
     /// Uniform sample by area (pbrt-v3 Triangle::Sample).

@@ -1,0 +1,330 @@
+//! Materials as declared, and their parameters read through the kind's
+//! `ParamSpec` list from `render::materials::MATERIALS`, with pbrt-v3's
+//! lookup rules (`TextureParams`): the shape's parameters first when it may
+//! override its material's, a texture reference before a value in each list.
+
+use super::color::sampled_to_rgb;
+use super::entities::{find_spectrum, float_opt, one, spectrum_value, TexValue, Textures};
+use super::state::closest_name;
+use super::Ctx;
+use crate::lang::params::{ParamList, ParamType};
+use crate::lang::Loc;
+use crate::render::materials::{self, MaterialKind, Support, MATERIALS};
+use crate::scene::{
+    FloatTex, MaterialDesc, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
+    SpectrumTex,
+};
+use glam::Vec3;
+use std::collections::HashMap;
+use std::rc::Rc;
+
+/// A material as declared (built lazily when a shape uses it).
+#[derive(Debug)]
+pub struct MaterialSpec {
+    pub ty: String,
+    /// The `Material`/`MakeNamedMaterial` statement; `None` for the initial matte.
+    pub stmt: Option<usize>,
+    pub loc: Loc,
+    pub textures: Rc<Textures>,
+    pub name: Option<String>,
+    /// The named materials visible at the statement (what `mix` refers to).
+    pub named: Rc<HashMap<String, Rc<MaterialSpec>>>,
+}
+
+impl MaterialSpec {
+    pub fn new(
+        ty: String,
+        stmt: Option<usize>,
+        loc: Loc,
+        textures: Rc<Textures>,
+        name: Option<String>,
+        named: Rc<HashMap<String, Rc<MaterialSpec>>>,
+    ) -> Self {
+        MaterialSpec {
+            ty,
+            stmt,
+            loc,
+            textures,
+            name,
+            named,
+        }
+    }
+    pub fn default_matte() -> Self {
+        MaterialSpec {
+            ty: "matte".into(),
+            stmt: None,
+            loc: Loc::default(),
+            textures: Rc::new(Textures::default()),
+            name: None,
+            named: Rc::new(HashMap::new()),
+        }
+    }
+}
+
+/// Material parameter lookup: shape parameters first (if they override), then the material's.
+pub struct Lookup<'a> {
+    pub first: Option<&'a ParamList>,
+    pub second: &'a ParamList,
+    pub textures: &'a Textures,
+}
+
+impl Lookup<'_> {
+    pub fn lists(&self) -> impl Iterator<Item = &ParamList> {
+        self.first.into_iter().chain(std::iter::once(self.second))
+    }
+
+    fn texture_ref(&self, name: &str, l: &ParamList) -> Option<(String, Loc)> {
+        one(l, name, |t| t == ParamType::Texture).map(|q| (q.strs()[0].clone(), q.values_loc))
+    }
+
+    /// pbrt-v3 `GetSpectrumTextureOrNull`, with the value's location.
+    pub fn spectrum(&self, ctx: &mut Ctx, name: &str) -> Option<(SpectrumTex, Loc)> {
+        for l in self.lists() {
+            if let Some((tex, loc)) = self.texture_ref(name, l) {
+                return match self.textures.spectrum.get(&tex).map(|t| t.value.clone()) {
+                    Some(TexValue::Spectrum(v)) => Some((SpectrumTex::Constant(v), loc)),
+                    Some(TexValue::Unsupported(class)) => {
+                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which is not supported by pbrs: the default is used"), "unsupported texture");
+                        None
+                    }
+                    _ => {
+                        ctx.warn(loc, format!("unknown spectrum texture \"{tex}\" for \"{name}\": the default is used (as pbrt-v3)"), "no such \"color\" texture");
+                        None
+                    }
+                };
+            }
+            if let Some(q) = find_spectrum(l, name) {
+                return spectrum_value(ctx, q).map(|v| (SpectrumTex::Constant(v), q.values_loc));
+            }
+        }
+        None
+    }
+
+    /// pbrt-v3 `GetFloatTextureOrNull`, with the value's location.
+    pub fn float(&self, ctx: &mut Ctx, name: &str) -> Option<(FloatTex, Loc)> {
+        for l in self.lists() {
+            if let Some((tex, loc)) = self.texture_ref(name, l) {
+                return match self.textures.float.get(&tex).map(|t| t.value.clone()) {
+                    Some(TexValue::Float(v)) => Some((FloatTex::Constant(v as f32), loc)),
+                    Some(TexValue::Unsupported(class)) => {
+                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which is not supported by pbrs: the default is used"), "unsupported texture");
+                        None
+                    }
+                    _ => {
+                        ctx.warn(loc, format!("unknown float texture \"{tex}\" for \"{name}\": the default is used (as pbrt-v3)"), "no such \"float\" texture");
+                        None
+                    }
+                };
+            }
+            if let Some((v, loc)) = float_opt(l, name) {
+                return Some((FloatTex::Constant(v as f32), loc));
+            }
+        }
+        None
+    }
+
+    /// A plain parameter of one type, shape list first (pbrt-v3's
+    /// `TextureParams::FindFloat`/`FindBool`/`FindString`).
+    fn plain(&self, name: &str, ty: ParamType) -> Option<&crate::lang::params::Param> {
+        self.lists().find_map(|l| one(l, name, |t| t == ty))
+    }
+
+    /// Marks the material's own parameters (not the shape's) used.
+    pub fn mark_all(&self) {
+        self.second.mark_all_used();
+    }
+}
+
+/// A `mix` reference to a named material, resolved by the caller.
+#[derive(Debug)]
+pub struct NamedRef {
+    pub param: &'static str,
+    pub name: String,
+    pub loc: Loc,
+}
+
+/// Builds a material: its description, the kind's name for the summary,
+/// and the named materials it refers to (for the caller to resolve).
+pub fn material(
+    ctx: &mut Ctx,
+    spec: &MaterialSpec,
+    l: &Lookup,
+) -> (MaterialDesc, &'static str, Vec<NamedRef>) {
+    let what = match &spec.name {
+        Some(n) => format!("named material \"{n}\""),
+        None => format!("Material \"{}\"", spec.ty),
+    };
+    let matte = materials::kind("matte").expect("matte is in the table");
+    let kind: &'static MaterialKind = match materials::kind(&spec.ty) {
+        Some(k) => match k.support {
+            Support::Supported => k,
+            Support::Unsupported(why) => {
+                let kd = l
+                    .spectrum(ctx, "Kd")
+                    .and_then(|(t, _)| t.as_constant())
+                    .unwrap_or(Vec3::splat(0.5));
+                let kept = l.lists().any(|p| p.get("Kd").is_some_and(|q| q.used.get()));
+                l.mark_all();
+                let keep = if kept {
+                    format!("its Kd {kd}")
+                } else {
+                    "the default Kd 0.5".to_string()
+                };
+                ctx.warn(spec.loc, format!("{what}: material type \"{}\" is not supported by pbrs ({why}): substituted by a matte with {keep}", spec.ty), "substituted by matte");
+                let mut params = defaults(ctx, matte.params);
+                params.set("Kd", ParamValue::SpectrumTexture(SpectrumTex::Constant(kd)));
+                return (
+                    MaterialDesc {
+                        kind: "matte",
+                        params,
+                    },
+                    "matte",
+                    Vec::new(),
+                );
+            }
+        },
+        None => {
+            let names: Vec<&str> = MATERIALS
+                .iter()
+                .filter(|k| !k.name.is_empty())
+                .map(|k| k.name)
+                .collect();
+            let hint = match closest_name(&spec.ty, &names) {
+                Some(c) => format!(" (did you mean \"{c}\"?)"),
+                None => String::new(),
+            };
+            ctx.warn(spec.loc, format!("{what}: unknown material type \"{}\"{hint}: using \"matte\" with its parameters (as pbrt-v3)", spec.ty), "unknown material type");
+            matte
+        }
+    };
+    let (params, refs) = read_params(ctx, kind.params, l);
+    // Rough glass comes with the microfacet lobes; until then, say so.
+    if kind.name == "glass" {
+        let ur = params.float_tex("uroughness").and_then(|t| t.as_constant());
+        let vr = params.float_tex("vroughness").and_then(|t| t.as_constant());
+        if ur.unwrap_or(0.0) != 0.0 || vr.unwrap_or(0.0) != 0.0 {
+            ctx.warn(spec.loc, format!("{what}: rough glass (uroughness {ur:?}, vroughness {vr:?}) is not supported by pbrs yet: treated as smooth glass"), "rough glass");
+        }
+    }
+    (
+        MaterialDesc {
+            kind: kind.name,
+            params,
+        },
+        kind.name,
+        refs,
+    )
+}
+
+/// The default values of a kind's parameters (no statement).
+pub fn defaults(ctx: &mut Ctx, specs: &'static [ParamSpec]) -> ParamValues {
+    let empty = ParamList::default();
+    let textures = Textures::default();
+    let l = Lookup {
+        first: None,
+        second: &empty,
+        textures: &textures,
+    };
+    read_params(ctx, specs, &l).0
+}
+
+fn spectrum_default(d: SpectrumDefault) -> Vec3 {
+    match d {
+        SpectrumDefault::Rgb(c) => Vec3::from_array(c),
+        SpectrumDefault::Sampled { lambda, values } => {
+            let pairs: Vec<f64> = lambda
+                .iter()
+                .zip(values)
+                .flat_map(|(&l, &v)| [l as f64, v as f64])
+                .collect();
+            sampled_to_rgb(&pairs)
+        }
+    }
+}
+
+/// Reads every parameter of `specs` through the lookup, applying defaults
+/// and range checks; named-material references are returned to resolve.
+pub fn read_params(
+    ctx: &mut Ctx,
+    specs: &'static [ParamSpec],
+    l: &Lookup,
+) -> (ParamValues, Vec<NamedRef>) {
+    let mut out = ParamValues::default();
+    let mut refs = Vec::new();
+    for s in specs {
+        let value = match s.kind {
+            ParamKind::FloatTexture(def) => match l.float(ctx, s.name) {
+                Some((FloatTex::Constant(v), loc)) => {
+                    Some(FloatTex::Constant(check_range(ctx, s, v, loc)))
+                }
+                None => def.map(FloatTex::Constant),
+            }
+            .map(ParamValue::FloatTexture),
+            ParamKind::SpectrumTexture(def) => match l.spectrum(ctx, s.name) {
+                Some((t, _)) => Some(t),
+                None => def.map(|d| SpectrumTex::Constant(spectrum_default(d))),
+            }
+            .map(ParamValue::SpectrumTexture),
+            ParamKind::Float(def) => Some(ParamValue::Float(
+                l.plain(s.name, ParamType::Float)
+                    .map(|q| check_range(ctx, s, q.nums()[0] as f32, q.values_loc))
+                    .unwrap_or(def),
+            )),
+            ParamKind::Bool(def) => Some(ParamValue::Bool(
+                l.plain(s.name, ParamType::Bool)
+                    .map(|q| q.bools()[0])
+                    .unwrap_or(def),
+            )),
+            ParamKind::String(def) => Some(ParamValue::String(
+                l.plain(s.name, ParamType::String)
+                    .map(|q| q.strs()[0].clone())
+                    .unwrap_or_else(|| def.to_string()),
+            )),
+            ParamKind::NamedMaterial => {
+                let (name, loc) = match l.plain(s.name, ParamType::String) {
+                    Some(q) => (q.strs()[0].clone(), q.values_loc),
+                    None => (String::new(), Loc::default()),
+                };
+                refs.push(NamedRef {
+                    param: s.name,
+                    name,
+                    loc,
+                });
+                None
+            }
+            ParamKind::FourierFile => {
+                if let Some(q) = l.plain(s.name, ParamType::String) {
+                    ctx.warn(q.values_loc, format!("\"{}\": tabulated Fourier BSDF files are not supported by pbrs yet: ignored", s.name), "not read");
+                }
+                None
+            }
+            ParamKind::Unsupported(why) => {
+                for list in l.lists() {
+                    if let Some(q) = list.get(s.name) {
+                        q.used.set(true);
+                        ctx.warn(q.values_loc, why.to_string(), "ignored");
+                    }
+                }
+                None
+            }
+        };
+        if let Some(v) = value {
+            out.set(s.name, v);
+        }
+    }
+    (out, refs)
+}
+
+fn check_range(ctx: &mut Ctx, s: &ParamSpec, v: f32, loc: Loc) -> f32 {
+    match s.range {
+        Range::NonNegative if v < 0.0 || v.is_nan() => {
+            ctx.warn(
+                loc,
+                format!("\"{}\" is {v}: it must not be negative; 0 is used", s.name),
+                "negative",
+            );
+            0.0
+        }
+        _ => v,
+    }
+}

@@ -1,0 +1,282 @@
+//! Entity parameters as data: what an entity kind declares it reads
+//! ([`ParamSpec`], in the kind's own file), and the values the loader found
+//! for them ([`ParamValues`]), with pbrt-v3's defaults already applied.
+//!
+//! The loader reads a statement's parameters through the kind's
+//! `ParamSpec` list (pbrt-v3's lookup rules: shape parameters may override
+//! the material's, texture references before values); `--check`, "did you
+//! mean", `grammar/REFERENCE.md` and the tests read the same lists.
+
+use super::textures::{FloatTex, SpectrumTex};
+use super::MaterialId;
+use std::sync::Arc;
+
+/// A spectrum default: RGB, or a sampled spectrum the loader converts to RGB
+/// as pbrt-v3's `FromSampled` does (e.g. the metals' measured copper).
+#[derive(Clone, Copy, Debug)]
+pub enum SpectrumDefault {
+    Rgb([f32; 3]),
+    Sampled {
+        lambda: &'static [f32],
+        values: &'static [f32],
+    },
+}
+
+/// What a parameter is and its default.
+#[derive(Clone, Copy, Debug)]
+pub enum ParamKind {
+    /// A float texture (a `float` value or a `texture` name); `None`: no
+    /// default, the entity decides when it is absent.
+    FloatTexture(Option<f32>),
+    /// A spectrum texture (`rgb`/`color`, `xyz`, `blackbody`, `spectrum`, or
+    /// a `texture` name).
+    SpectrumTexture(Option<SpectrumDefault>),
+    Float(f32),
+    Bool(bool),
+    String(&'static str),
+    /// The name of a material made by `MakeNamedMaterial` (`mix`).
+    NamedMaterial,
+    /// A tabulated Fourier BSDF file (`.bsdf`, pbrt-v3's format).
+    FourierFile,
+    /// Known to pbrt-v3 but not evaluated by pbrs yet: the loader warns
+    /// when it is given, naming the reason.
+    Unsupported(&'static str),
+}
+
+/// A constraint the loader checks on constant values (with a located
+/// warning, clamping the value).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Range {
+    Any,
+    NonNegative,
+}
+
+/// One parameter an entity kind reads.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub kind: ParamKind,
+    pub range: Range,
+    /// What it means, for `grammar/REFERENCE.md`.
+    pub doc: &'static str,
+}
+
+impl ParamSpec {
+    pub const fn float_tex(name: &'static str, default: f32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FloatTexture(Some(default)),
+            range: Range::Any,
+            doc,
+        }
+    }
+    /// A float texture that must not be negative (roughness, σ, …).
+    pub const fn nonneg_tex(name: &'static str, default: f32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FloatTexture(Some(default)),
+            range: Range::NonNegative,
+            doc,
+        }
+    }
+    pub const fn float_tex_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FloatTexture(None),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn nonneg_tex_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FloatTexture(None),
+            range: Range::NonNegative,
+            doc,
+        }
+    }
+    pub const fn spectrum(name: &'static str, default: f32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::SpectrumTexture(Some(SpectrumDefault::Rgb([default; 3]))),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn spectrum_with(
+        name: &'static str,
+        default: SpectrumDefault,
+        doc: &'static str,
+    ) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::SpectrumTexture(Some(default)),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn spectrum_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::SpectrumTexture(None),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn boolean(name: &'static str, default: bool, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Bool(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn float(name: &'static str, default: f32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Float(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn string(name: &'static str, default: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::String(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn named_material(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::NamedMaterial,
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn fourier_file(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FourierFile,
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn unsupported(name: &'static str, why: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Unsupported(why),
+            range: Range::Any,
+            doc: why,
+        }
+    }
+    /// pbrt-v3's `bumpmap` float texture (not evaluated yet).
+    pub const BUMPMAP: ParamSpec = ParamSpec::unsupported(
+        "bumpmap",
+        "bump mapping is not supported by pbrs yet: \"bumpmap\" ignored",
+    );
+}
+
+/// A value the loader found (or the default it applied).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamValue {
+    FloatTexture(FloatTex),
+    SpectrumTexture(SpectrumTex),
+    Float(f32),
+    Bool(bool),
+    String(String),
+    Material(MaterialId),
+    Fourier(Arc<FourierTable>),
+}
+
+/// The values of one entity's parameters, by name (absent: no value and no
+/// default). Entities read them with the typed getters, which panic on a
+/// name the entity's `ParamSpec` list does not declare (a bug caught by the
+/// tests that build every kind with its defaults).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ParamValues {
+    pub values: Vec<(&'static str, ParamValue)>,
+}
+
+impl ParamValues {
+    pub fn get(&self, name: &str) -> Option<&ParamValue> {
+        self.values.iter().find(|(n, _)| *n == name).map(|(_, v)| v)
+    }
+    pub fn set(&mut self, name: &'static str, v: ParamValue) {
+        match self.values.iter_mut().find(|(n, _)| *n == name) {
+            Some(slot) => slot.1 = v,
+            None => self.values.push((name, v)),
+        }
+    }
+    pub fn float_tex(&self, name: &str) -> Option<FloatTex> {
+        match self.get(name) {
+            Some(ParamValue::FloatTexture(t)) => Some(t.clone()),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a float texture"),
+        }
+    }
+    pub fn spectrum_tex(&self, name: &str) -> Option<SpectrumTex> {
+        match self.get(name) {
+            Some(ParamValue::SpectrumTexture(t)) => Some(t.clone()),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a spectrum texture"),
+        }
+    }
+    pub fn float(&self, name: &str) -> f32 {
+        match self.get(name) {
+            Some(ParamValue::Float(f)) => *f,
+            v => panic!("parameter \"{name}\" is {v:?}, not a float"),
+        }
+    }
+    pub fn boolean(&self, name: &str) -> bool {
+        match self.get(name) {
+            Some(ParamValue::Bool(b)) => *b,
+            v => panic!("parameter \"{name}\" is {v:?}, not a bool"),
+        }
+    }
+    pub fn string(&self, name: &str) -> &str {
+        match self.get(name) {
+            Some(ParamValue::String(s)) => s,
+            v => panic!("parameter \"{name}\" is {v:?}, not a string"),
+        }
+    }
+    pub fn material(&self, name: &str) -> Option<MaterialId> {
+        match self.get(name) {
+            Some(ParamValue::Material(m)) => Some(*m),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a material"),
+        }
+    }
+    pub fn fourier(&self, name: &str) -> Option<Arc<FourierTable>> {
+        match self.get(name) {
+            Some(ParamValue::Fourier(t)) => Some(t.clone()),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a Fourier table"),
+        }
+    }
+}
+
+/// A tabulated BSDF in pbrt-v3's Fourier representation (the data of a
+/// `.bsdf` file; layout as pbrt-v3's `FourierBSDFTable`).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct FourierTable {
+    /// Relative index of refraction of the layer stack (1: reflection only).
+    pub eta: f32,
+    /// Maximum Fourier order over all (μi, μo) pairs.
+    pub m_max: usize,
+    /// Colour channels: 1 (luminance) or 3 (Y, R, B as pbrt-v3 stores them).
+    pub n_channels: usize,
+    /// The discretised zenith cosines μ, increasing.
+    pub mu: Vec<f32>,
+    /// Per (μo, μi) pair: offset into `a` and order.
+    pub a_offset: Vec<u32>,
+    pub m: Vec<u32>,
+    /// Fourier coefficients (channel-major within each pair, as the file).
+    pub a: Vec<f32>,
+    /// a0 coefficients per pair (for sampling) and their CDF over μi.
+    pub a0: Vec<f32>,
+    pub cdf: Vec<f32>,
+    /// ∫ weights over μ for the recurrence (pbrt-v3's `recip`: 1/i).
+    pub recip: Vec<f32>,
+}
