@@ -13,7 +13,7 @@
 //! table gains its wall time and the ratio: on a shared, noisy machine the
 //! ratio of two runs made side by side means more than either time alone.
 
-use pbrs::build::load_scene;
+use pbrs::loader::load_scene;
 use pbrs::render::driver::{peak_memory_bytes, render, RenderOptions};
 use pbrs::render::film::compare::compare;
 use pbrs::render::film::io::read_image;

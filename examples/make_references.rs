@@ -9,7 +9,7 @@
 mod golden;
 
 use golden::{manifest, Check, PBRS_REFERENCE_RES, PBRS_REFERENCE_SPP};
-use pbrs::build::load_scene;
+use pbrs::loader::load_scene;
 use pbrs::render::driver::{render, RenderOptions};
 use pbrs::render::film::io::write_image;
 use std::path::Path;

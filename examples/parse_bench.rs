@@ -5,9 +5,9 @@
 //!
 //! Run: `cargo run --release --example parse_bench`
 
-use pbrs::build::load_scene;
 use pbrs::lang::parse_text;
 use pbrs::lang::parser::DiskLoader;
+use pbrs::loader::load_scene;
 use std::fmt::Write;
 use std::time::Instant;
 

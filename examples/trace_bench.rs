@@ -8,7 +8,7 @@
 //! single-threaded. Compare two builds by running both in turn.
 
 use glam::Vec3;
-use pbrs::build::load_scene;
+use pbrs::loader::load_scene;
 use pbrs::render::accel::{Geometry, Hit};
 use pbrs::render::geometry::{spawn_ray, spawn_ray_to_point, Ray};
 use pbrs::render::sampling::rng::Pcg32;

@@ -2,12 +2,12 @@
 //!
 //! Data flows one way:
 //! scene text → [`lang`] (tokens, directives, diagnostics)
-//! → [`build`] (graphics state → [`scene::SceneDescription`])
+//! → [`loader`] (graphics state → [`scene::SceneDescription`])
 //! → [`render`] (render-ready scene, integrators, film) → image.
 //! The command line ([`cli`]) sits on top.
 
-pub mod build;
 pub mod cli;
 pub mod lang;
+pub mod loader;
 pub mod render;
 pub mod scene;

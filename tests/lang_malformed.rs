@@ -110,7 +110,7 @@ fn library_rejects_every_malformed_file() {
     std::env::set_current_dir(env!("CARGO_MANIFEST_DIR")).unwrap();
     let mut failures = Vec::new();
     for c in cases() {
-        match pbrs::build::load_scene(&c.path) {
+        match pbrs::loader::load_scene(&c.path) {
             Ok(_) => failures.push(format!("{}: loaded", c.path.display())),
             Err(f) => {
                 assert!(!f.errors.is_empty());

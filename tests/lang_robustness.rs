@@ -2,8 +2,8 @@
 //! versions of every scene and malformed file must load or fail with located
 //! errors, never panic. Runs on stable as part of `cargo test`.
 
-use pbrs::build::{load_scene_with, ply::read_ply};
 use pbrs::lang::FileLoader;
+use pbrs::loader::{load_scene_with, ply::read_ply};
 use std::path::{Path, PathBuf};
 
 struct Served(Vec<u8>);

@@ -1,7 +1,7 @@
 //! Every `.pbrt` file under `scenes/` passes `pbrs --check` (exit 0) with the
 //! expected summary, through the binary and through the library.
 
-use pbrs::build::load_scene;
+use pbrs::loader::load_scene;
 use pbrs::scene::*;
 use std::path::Path;
 use std::process::Command;

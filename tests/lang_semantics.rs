@@ -1,7 +1,7 @@
 //! Scene building semantics, as pbrt-v3 defines them (see grammar/REFERENCE.md).
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
-use pbrs::build::{load_scene, load_scene_str, LoadedScene};
+use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
 use pbrs::scene::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

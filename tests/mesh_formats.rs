@@ -6,8 +6,8 @@
 
 mod common;
 use common::*;
-use pbrs::build::load_scene_str;
-use pbrs::build::ply::read_ply;
+use pbrs::loader::load_scene_str;
+use pbrs::loader::ply::read_ply;
 use pbrs::render::film::Image;
 use pbrs::scene::MeshData;
 use std::fmt::Write as _;

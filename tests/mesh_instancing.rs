@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use pbrs::build::load_scene_str;
+use pbrs::loader::load_scene_str;
 use pbrs::render::film::compare::mean_rgb;
 use std::process::Command;
 

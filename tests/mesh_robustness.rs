@@ -3,8 +3,8 @@
 //! give a mesh or an error, never a panic and never a huge allocation (a
 //! count that does not fit the file is an error before anything is reserved).
 
-use pbrs::build::meshfile::{read_gltf, read_obj};
-use pbrs::build::ply::read_ply;
+use pbrs::loader::meshfile::{read_gltf, read_obj};
+use pbrs::loader::ply::read_ply;
 use std::path::Path;
 
 fn ply(format: &str, be: bool) -> Vec<u8> {

@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use pbrs::build::load_scene_str;
+use pbrs::loader::load_scene_str;
 use pbrs::render::film::compare::relative_mse;
 use std::process::Command;
 

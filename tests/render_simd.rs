@@ -4,7 +4,7 @@
 
 mod common;
 
-use pbrs::build::load_scene_str;
+use pbrs::loader::load_scene_str;
 use pbrs::render::driver::{render, RenderOptions};
 use pbrs::scene::SceneDescription;
 

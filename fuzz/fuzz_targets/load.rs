@@ -8,8 +8,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use pbrs::build::meshfile::{read_gltf, read_obj};
-use pbrs::build::{load_scene_with, ply::read_ply};
+use pbrs::loader::meshfile::{read_gltf, read_obj};
+use pbrs::loader::{load_scene_with, ply::read_ply};
 use pbrs::lang::FileLoader;
 use std::path::Path;
 

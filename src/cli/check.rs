@@ -1,7 +1,7 @@
 //! `pbrs --check`: parse and build, print warnings and a summary.
 
 use super::Args;
-use crate::build::{load_scene, print_diagnostics};
+use crate::loader::{load_scene, print_diagnostics};
 
 /// Parses and builds `args.scene` without rendering. Prints the warnings, then the
 /// summary and what was left out (exit 0), or the errors (exit 1).

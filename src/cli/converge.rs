@@ -4,7 +4,7 @@
 //! log-log plot (SVG) with fitted slopes, and a table of efficiencies
 //! 1/(MSE × time), the figure of merit of the seed text.
 
-use crate::build::{load_scene, print_diagnostics};
+use crate::loader::{load_scene, print_diagnostics};
 use crate::render::driver::{RenderOptions, Renderer};
 use crate::render::film::compare::compare;
 use crate::render::film::io::{read_image, write_atomic};

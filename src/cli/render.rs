@@ -2,7 +2,7 @@
 //! progress bar, write the image atomically, print a summary.
 
 use super::Args;
-use crate::build::{load_scene, print_diagnostics};
+use crate::loader::{load_scene, print_diagnostics};
 use crate::render::driver::{peak_memory_bytes, render, RenderOptions};
 use crate::render::film::io::{check_output_path, write_image};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

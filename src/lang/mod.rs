@@ -5,7 +5,7 @@
 //! - [`parser`]: tokens to [`parser::Stmt`]s; the directive table; Include splicing.
 //! - [`source`]: loaded files, locations, Include chains, located miette diagnostics.
 //!
-//! This part knows nothing about rendering; [`crate::build`] gives the statements meaning.
+//! This part knows nothing about rendering; [`crate::loader`] gives the statements meaning.
 
 pub mod lexer;
 pub mod params;

@@ -2,7 +2,7 @@
 //! compare with noise-aware metrics, and leave images to look at on failure.
 #![allow(dead_code)]
 
-use pbrs::build::load_scene;
+use pbrs::loader::load_scene;
 use pbrs::render::driver::{render, RenderOptions, RenderStats};
 use pbrs::render::film::compare::{compare, false_colour_difference, Comparison};
 use pbrs::render::film::io::{read_image, write_image};
@@ -174,7 +174,7 @@ pub fn average(images: &[Image]) -> Image {
 /// to), loaded through the real scene loader; the first is the statement's.
 pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
     let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n");
-    let l = pbrs::build::load_scene_str(&text, &repo().join("mem.pbrt"))
+    let l = pbrs::loader::load_scene_str(&text, &repo().join("mem.pbrt"))
         .unwrap_or_else(|f| panic!("{decl}: {:?}", f.errors));
     let first = l.scene.shapes[0].material.0 as usize;
     let mut m: Vec<_> = l
