@@ -44,14 +44,34 @@ pub fn render_at(
     .expect("render failed")
 }
 
+/// The file of a converged pbrt-v3 reference: `STEM-128-SPP.pfm` in
+/// `scenes/references/` with the highest SPP (the Cornell boxes have 16384,
+/// the feature scenes 2048; "128" names the resolution set, and a few
+/// scenes of it are not square).
+pub fn reference_path(stem: &str) -> PathBuf {
+    let dir = repo().join("scenes/references");
+    let prefix = format!("{stem}-128-");
+    let best = std::fs::read_dir(&dir)
+        .expect("scenes/references")
+        .filter_map(|e| {
+            let name = e.ok()?.file_name().into_string().ok()?;
+            let spp: u32 = name
+                .strip_prefix(&prefix)?
+                .strip_suffix(".pfm")?
+                .parse()
+                .ok()?;
+            (spp > 64).then_some((spp, name))
+        })
+        .max();
+    match best {
+        Some((_, name)) => dir.join(name),
+        None => panic!("no converged reference {prefix}*.pfm"),
+    }
+}
+
 /// A converged pbrt-v3 reference from `scenes/references/`.
 pub fn reference(stem: &str) -> Image {
-    read_image(
-        &repo()
-            .join("scenes/references")
-            .join(format!("{stem}-128-16384.pfm")),
-    )
-    .expect("reference")
+    read_image(&reference_path(stem)).expect("reference")
 }
 
 /// pbrt-v3's own render at 64 spp (the noise to expect).
@@ -141,13 +161,24 @@ pub fn exists(p: &Path) -> bool {
 
 /// Renders with an explicit seed (independent scrambling per seed).
 pub fn render_seeded(
-    mut desc: SceneDescription,
+    desc: SceneDescription,
     res: u32,
     spp: u32,
     seed: u64,
 ) -> (Image, RenderStats) {
-    desc.film.xresolution = res;
-    desc.film.yresolution = res;
+    render_seeded_wh(desc, res, res, spp, seed)
+}
+
+/// [`render_seeded`] at `width`×`height`.
+pub fn render_seeded_wh(
+    mut desc: SceneDescription,
+    width: u32,
+    height: u32,
+    spp: u32,
+    seed: u64,
+) -> (Image, RenderStats) {
+    desc.film.xresolution = width;
+    desc.film.yresolution = height;
     desc.sampler.pixel_samples = spp;
     render(
         &desc,
