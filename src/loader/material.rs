@@ -6,7 +6,7 @@
 use super::color::sampled_to_rgb;
 use super::entities::{find_spectrum, float_opt, one, spectrum_value, TexValue, Textures};
 use super::state::closest_name;
-use super::Ctx;
+use super::{Ctx, DeclaredKind};
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::Loc;
 use crate::render::materials::{self, MaterialKind, Support, MATERIALS};
@@ -143,18 +143,19 @@ pub struct NamedRef {
     pub loc: Loc,
 }
 
-/// Builds a material: its description, the kind's name for the summary,
+/// Builds a material: its description, its declared kind for the summary,
 /// and the named materials it refers to (for the caller to resolve).
 pub fn material(
     ctx: &mut Ctx,
     spec: &MaterialSpec,
     l: &Lookup,
-) -> (MaterialDesc, &'static str, Vec<NamedRef>) {
+) -> (MaterialDesc, DeclaredKind, Vec<NamedRef>) {
     let what = match &spec.name {
         Some(n) => format!("named material \"{n}\""),
         None => format!("Material \"{}\"", spec.ty),
     };
     let matte = materials::kind("matte").expect("matte is in the table");
+    let mut declared = None;
     let kind: &'static MaterialKind = match materials::kind(&spec.ty) {
         Some(k) => match k.support {
             Support::Supported => k,
@@ -178,7 +179,7 @@ pub fn material(
                         kind: "matte",
                         params,
                     },
-                    "matte",
+                    DeclaredKind::Table(k.name),
                     Vec::new(),
                 );
             }
@@ -194,6 +195,7 @@ pub fn material(
                 None => String::new(),
             };
             ctx.warn(spec.loc, format!("{what}: unknown material type \"{}\"{hint}: using \"matte\" with its parameters (as pbrt-v3)", spec.ty), "unknown material type");
+            declared = Some(DeclaredKind::Unknown(spec.ty.clone()));
             matte
         }
     };
@@ -211,7 +213,7 @@ pub fn material(
             kind: kind.name,
             params,
         },
-        kind.name,
+        declared.unwrap_or(DeclaredKind::Table(kind.name)),
         refs,
     )
 }

@@ -99,7 +99,7 @@ pub struct Builder<'s, 'c> {
     world_seen: bool,
     world_ended: bool,
     pub scene_materials: Vec<MaterialDesc>,
-    pub material_kinds: Vec<&'static str>,
+    pub material_kinds: Vec<super::DeclaredKind>,
     pub shapes: Vec<ShapeDesc>,
     pub lights: Vec<LightDesc>,
     pub scene_objects: Vec<ObjectDesc>,
@@ -728,11 +728,20 @@ impl<'s, 'c> Builder<'s, 'c> {
                         }
                     }
                 }
-                self.ctx
-                    .report_unused_except(p, &format!("Material \"{}\"", spec.ty), &["type"]);
+                // Hints only for a known kind: an unknown one is read as a
+                // matte, whose names would mislead.
+                let specs = crate::render::materials::kind(&spec.ty).map_or(&[][..], |k| k.params);
+                self.ctx.report_unused_with_specs(
+                    p,
+                    &format!("Material \"{}\"", spec.ty),
+                    &["type"],
+                    specs,
+                );
             }
         }
-        let key = format!("{desc:?}");
+        // The declared kind is part of the key: a substituted material stays
+        // apart from a matte of the same Kd, so that the summary counts it.
+        let key = format!("{kind:?}{desc:?}");
         let id = match self.material_keys.get(&key) {
             Some(&id) => id,
             None => {
