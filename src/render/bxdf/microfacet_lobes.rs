@@ -16,6 +16,12 @@
 //!   `pdf(wh)·η²|wi·wh| / (wo·wh + η wi·wh)²`.
 //!
 //! `f` and `pdf` share the half vector, D and Λ(wo) in `f_pdf`.
+//!
+//! As in pbrt-v3, the transmission's `f` and `pdf` are also non-zero for
+//! pairs whose half vector has wo or wi behind the facet (no facet refracts
+//! one into the other; the sampler never produces them, pbrt-v4 drops them).
+//! Their share of the density is small (a few 1e-4 at α = 0.05) but makes
+//! it integrate to slightly more than the sampler's success probability.
 
 use super::{
     cos_theta, fr_dielectric, reflect, refract, same_hemisphere, BxdfFlags, BxdfModel, BxdfSample,
