@@ -364,8 +364,11 @@ fn materials_and_substitutes() {
         glass_of(&m("\"glass\" \"float eta\" 2 \"float index\" 1.2").0),
         (Vec3::ONE, Vec3::ONE, 2.0)
     );
+    // Rough glass is rendered as rough glass: no warning.
     let (g, w) = m("\"glass\" \"float uroughness\" 0.1");
-    assert!(g.kind == "glass" && w.contains("treated as smooth"), "{w}");
+    assert!(g.kind == "glass" && w.is_empty(), "{w}");
+    assert_eq!(g.constant_float("uroughness"), Some(0.1));
+    assert_eq!(g.constant_float("vroughness"), Some(0.0));
     assert_eq!(
         m("\"mirror\"").0.constant_spectrum("Kr"),
         Some(Vec3::splat(0.9))

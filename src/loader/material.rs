@@ -200,14 +200,6 @@ pub fn material(
         }
     };
     let (params, refs) = read_params(ctx, kind.params, l);
-    // Rough glass comes with the microfacet lobes; until then, say so.
-    if kind.name == "glass" {
-        let ur = params.float_tex("uroughness").and_then(|t| t.as_constant());
-        let vr = params.float_tex("vroughness").and_then(|t| t.as_constant());
-        if ur.unwrap_or(0.0) != 0.0 || vr.unwrap_or(0.0) != 0.0 {
-            ctx.warn(spec.loc, format!("{what}: rough glass (uroughness {ur:?}, vroughness {vr:?}) is not supported by pbrs yet: treated as smooth glass"), "rough glass");
-        }
-    }
     (
         MaterialDesc {
             kind: kind.name,

@@ -11,13 +11,21 @@
 
 mod bsdf;
 mod fresnel;
+mod fresnel_blend;
 mod lambertian;
+mod microfacet;
+mod microfacet_lobes;
 mod oren_nayar;
 mod specular;
 
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
+pub use fresnel_blend::FresnelBlend;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
+pub use microfacet::{
+    roughness_to_alpha, Beckmann, MicrofacetDistribution, MicrofacetModel, TrowbridgeReitz,
+};
+pub use microfacet_lobes::{MicrofacetReflection, MicrofacetTransmission};
 pub use oren_nayar::OrenNayar;
 pub use specular::{refract, FresnelSpecular, SpecularReflection, SpecularTransmission};
 
@@ -168,6 +176,9 @@ bxdfs! {
     SpecularReflection(SpecularReflection),
     SpecularTransmission(SpecularTransmission),
     FresnelSpecular(FresnelSpecular),
+    MicrofacetReflection(MicrofacetReflection),
+    MicrofacetTransmission(MicrofacetTransmission),
+    FresnelBlend(FresnelBlend),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry
