@@ -82,12 +82,13 @@ const N_CHI2: usize = 8 * (4 + 4 + 5 + 4) + 3;
 
 fn chi2_cfg(seed: u64) -> Chi2Config {
     Chi2Config {
-        theta_res: 16,
-        phi_res: 32,
-        sample_count: 200_000,
+        theta_res: 12,
+        phi_res: 24,
+        sample_count: 100_000,
         seed,
-        // Expected counts to ~1e-7·n = 0.02 samples: far below the noise.
-        cell_tolerance: Some(1e-7),
+        // Expected counts to ~1e-6·n = 0.2 samples: far below the noise
+        // of any cell that is not pooled (≥ 5 expected).
+        cell_tolerance: Some(1e-6),
         ..Default::default()
     }
 }
@@ -143,7 +144,7 @@ fn chi2_lobe(name: &str, b: &Bxdf, wo: Vec3, seed: u64) -> f64 {
 fn check_sampled_f(name: &str, b: &Bxdf, wo: Vec3) {
     let mut rng = Pcg32::with_sequence(11);
     let mut n = 0;
-    for _ in 0..20_000 {
+    for _ in 0..5_000 {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
         let Some(s) = b.sample_f(wo, u) else { continue };
         if s.pdf == 0.0 {
@@ -173,7 +174,7 @@ fn check_sampled_f(name: &str, b: &Bxdf, wo: Vec3) {
         );
         assert!(f.min_element() >= 0.0 && f.is_finite(), "{name}: f {f}");
     }
-    assert!(n > 2_000, "{name}: only {n} samples");
+    assert!(n > 500, "{name}: only {n} samples");
 }
 
 fn reflection(d: Dist, fresnel: Fresnel) -> Bxdf {
@@ -209,7 +210,7 @@ fn blend(d: Dist) -> Bxdf {
 /// ∫ g(wh) dωh over the upper hemisphere, in tan θ = α·s/(1 − s) (which puts
 /// the points where D lives for any α) and φ, by the midpoint rule (f64).
 fn hemisphere_integral(alpha: f64, g: impl Fn(DVec3) -> f64) -> f64 {
-    let (ns, np) = (3000, 720);
+    let (ns, np) = (1500, 360);
     let mut sum = 0.0;
     for i in 0..ns {
         let s = (i as f64 + 0.5) / ns as f64;
@@ -641,7 +642,7 @@ fn white_furnace_of_the_rough_conductor() {
     // weighs G(wo, wi)/G1(wo) ≤ 1. Single scattering loses the light that
     // would bounce again between facets, so the albedo falls below 1 as
     // the roughness grows.
-    let n = 200_000;
+    let n = 100_000;
     for beckmann in [false, true] {
         for alpha in [0.01f32, 0.05, 0.3, 0.7, 1.0] {
             let d = Dist {
