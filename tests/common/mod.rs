@@ -204,8 +204,15 @@ pub fn average(images: &[Image]) -> Image {
 /// The materials of `Material {decl}` (after the named materials it refers
 /// to, in the scene's order, linked as the renderer links them) and the
 /// index of the statement's own, loaded through the real scene loader.
+///
+/// `decl` may start with other statements (`MakeNamedMaterial` lines): then
+/// its last line is a whole `Material` statement.
 pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usize) {
-    let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n");
+    let text = if decl.contains('\n') {
+        format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd\n")
+    } else {
+        format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n")
+    };
     let l = pbrs::loader::load_scene_str(&text, &repo().join("mem.pbrt"))
         .unwrap_or_else(|f| panic!("{decl}: {:?}", f.errors));
     let first = l.scene.shapes[0].material.0 as usize;
