@@ -10,12 +10,17 @@
 //! `BSDF` with `Add` and no allocation per hit.
 
 mod bsdf;
+mod disney;
 mod fresnel;
 mod lambertian;
 mod oren_nayar;
 mod specular;
 
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
+pub use disney::{
+    fr_schlick, gtr1, schlick_r0_from_eta, schlick_weight, DisneyClearcoat, DisneyDiffuse,
+    DisneyFakeSS, DisneyFresnel, DisneyRetro, DisneySheen,
+};
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use lambertian::{LambertianReflection, LambertianTransmission};
 pub use oren_nayar::OrenNayar;
@@ -168,6 +173,11 @@ bxdfs! {
     SpecularReflection(SpecularReflection),
     SpecularTransmission(SpecularTransmission),
     FresnelSpecular(FresnelSpecular),
+    DisneyDiffuse(DisneyDiffuse),
+    DisneyFakeSS(DisneyFakeSS),
+    DisneyRetro(DisneyRetro),
+    DisneySheen(DisneySheen),
+    DisneyClearcoat(DisneyClearcoat),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry
