@@ -12,7 +12,10 @@
 mod bsdf;
 mod disney;
 mod fresnel;
+mod fresnel_blend;
 mod lambertian;
+mod microfacet;
+mod microfacet_lobes;
 mod oren_nayar;
 mod specular;
 
@@ -22,7 +25,12 @@ pub use disney::{
     DisneyFakeSS, DisneyFresnel, DisneyRetro, DisneySheen,
 };
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
+pub use fresnel_blend::FresnelBlend;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
+pub use microfacet::{
+    roughness_to_alpha, Beckmann, MicrofacetDistribution, MicrofacetModel, TrowbridgeReitz,
+};
+pub use microfacet_lobes::{MicrofacetReflection, MicrofacetTransmission};
 pub use oren_nayar::OrenNayar;
 pub use specular::{refract, FresnelSpecular, SpecularReflection, SpecularTransmission};
 
@@ -173,6 +181,9 @@ bxdfs! {
     SpecularReflection(SpecularReflection),
     SpecularTransmission(SpecularTransmission),
     FresnelSpecular(FresnelSpecular),
+    MicrofacetReflection(MicrofacetReflection),
+    MicrofacetTransmission(MicrofacetTransmission),
+    FresnelBlend(FresnelBlend),
     DisneyDiffuse(DisneyDiffuse),
     DisneyFakeSS(DisneyFakeSS),
     DisneyRetro(DisneyRetro),
