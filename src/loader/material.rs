@@ -206,6 +206,11 @@ pub fn material(
             ctx.warn(spec.loc, format!("{what}: rough glass (uroughness {ur:?}, vroughness {vr:?}) is not supported by pbrs yet: treated as smooth glass"), "rough glass");
         }
     }
+    if kind.name == "disney" {
+        for msg in materials::Disney::load_warnings(&params) {
+            ctx.warn(spec.loc, format!("{what}: {msg}"), "disney");
+        }
+    }
     (
         MaterialDesc {
             kind: kind.name,

@@ -22,6 +22,10 @@
 //!   It samples wh from D·cos θh exactly; density D·|cos θh|/(4 wo·wh).
 //! - [`DisneyFresnel`]: the specular lobe's Fresnel term, lerp(metallic,
 //!   dielectric Fresnel for η, Schlick Fresnel from R0).
+//! - [`DisneyMicrofacet`]: the specular distribution, Trowbridge–Reitz with
+//!   separable masking G = G1(wo)·G1(wi) (pbrt-v3's
+//!   `DisneyMicrofacetDistribution`); D, Λ, sampling and density are
+//!   Trowbridge–Reitz's.
 //!
 //! The diffuse-type lobes (all but the clearcoat) are cosine-sampled on
 //! wo's side. None of their `f` tests the hemisphere: the BSDF decides
@@ -29,6 +33,7 @@
 
 use super::{
     abs_cos_theta, fr_dielectric, reflect, same_hemisphere, BxdfFlags, BxdfModel, BxdfSample,
+    MicrofacetModel, TrowbridgeReitz,
 };
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -262,5 +267,45 @@ impl DisneyFresnel {
         let dielectric = fr_dielectric(cos_theta_i, 1.0, self.eta);
         let schlick = fr_schlick(self.r0, cos_theta_i);
         (1.0 - self.metallic) * Vec3::splat(dielectric) + self.metallic * schlick
+    }
+}
+
+/// Trowbridge–Reitz with Burley's separable Smith masking in place of the
+/// height-correlated one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisneyMicrofacet {
+    pub tr: TrowbridgeReitz,
+}
+
+impl DisneyMicrofacet {
+    /// α along dp/du and dp/dv (clamped to ≥ 0.001), visible-normal sampling.
+    #[inline]
+    pub fn new(alpha_x: f32, alpha_y: f32) -> DisneyMicrofacet {
+        DisneyMicrofacet {
+            tr: TrowbridgeReitz::new(alpha_x, alpha_y),
+        }
+    }
+}
+
+impl MicrofacetModel for DisneyMicrofacet {
+    #[inline]
+    fn d(&self, wh: Vec3) -> f32 {
+        self.tr.d(wh)
+    }
+    #[inline]
+    fn lambda(&self, w: Vec3) -> f32 {
+        self.tr.lambda(w)
+    }
+    #[inline]
+    fn sample_wh(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        self.tr.sample_wh(wo, u)
+    }
+    #[inline]
+    fn sample_visible(&self) -> bool {
+        self.tr.sample_visible()
+    }
+    #[inline]
+    fn g_from_lambdas(&self, lambda_o: f32, lambda_i: f32) -> f32 {
+        1.0 / ((1.0 + lambda_o) * (1.0 + lambda_i))
     }
 }

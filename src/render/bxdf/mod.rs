@@ -22,7 +22,7 @@ mod specular;
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
 pub use disney::{
     fr_schlick, gtr1, schlick_r0_from_eta, schlick_weight, DisneyClearcoat, DisneyDiffuse,
-    DisneyFakeSS, DisneyFresnel, DisneyRetro, DisneySheen,
+    DisneyFakeSS, DisneyFresnel, DisneyMicrofacet, DisneyRetro, DisneySheen,
 };
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use fresnel_blend::FresnelBlend;

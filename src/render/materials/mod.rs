@@ -7,11 +7,13 @@
 //! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
 //! delegates to the files.
 
+mod disney;
 mod glass;
 mod matte;
 mod mirror;
 
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use disney::Disney;
 pub use glass::Glass;
 pub use matte::Matte;
 pub use mirror::Mirror;
@@ -46,6 +48,7 @@ pub static MATERIALS: &[MaterialKind] = &[
     matte::KIND,
     mirror::KIND,
     glass::KIND,
+    disney::KIND,
     NONE_KIND,
     unsupported(
         "subsurface",
@@ -106,6 +109,7 @@ pub enum Material {
     Matte(Matte),
     Mirror(Mirror),
     Glass(Glass),
+    Disney(Disney),
     /// `Material "none"`: no BSDF.
     None,
 }
@@ -133,6 +137,7 @@ impl Material {
             Material::Matte(m) => m.needs_geom(),
             Material::Mirror(m) => m.needs_geom(),
             Material::Glass(m) => m.needs_geom(),
+            Material::Disney(m) => m.needs_geom(),
             Material::None => false,
         }
     }
@@ -141,6 +146,7 @@ impl Material {
     /// follows the shading dp/du (else any frame around the normal does).
     pub fn anisotropic(&self) -> bool {
         match self {
+            Material::Disney(m) => m.anisotropic(),
             Material::Matte(_) | Material::Mirror(_) | Material::Glass(_) | Material::None => false,
         }
     }
@@ -161,6 +167,7 @@ impl Material {
             Material::Matte(m) => m.scatter(sc, out),
             Material::Mirror(m) => m.scatter(sc, out),
             Material::Glass(m) => m.scatter(sc, ctx, out),
+            Material::Disney(m) => m.scatter(sc, out),
             Material::None => {}
         }
     }
