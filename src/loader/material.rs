@@ -200,6 +200,11 @@ pub fn material(
         }
     };
     let (params, refs) = read_params(ctx, kind.params, l);
+    if kind.name == "disney" {
+        for msg in materials::Disney::load_warnings(&params) {
+            ctx.warn(spec.loc, format!("{what}: {msg}"), "disney");
+        }
+    }
     (
         MaterialDesc {
             kind: kind.name,

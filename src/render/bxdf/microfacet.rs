@@ -28,6 +28,7 @@
 
 use super::{
     abs_cos_theta, cos2_phi, cos2_theta, cos_phi, sin2_phi, sin2_theta, sin_phi, tan2_theta,
+    DisneyMicrofacet,
 };
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_PI_2, PI};
@@ -450,12 +451,21 @@ impl MicrofacetModel for Beckmann {
 pub enum MicrofacetDistribution {
     TrowbridgeReitz(TrowbridgeReitz),
     Beckmann(Beckmann),
+    /// The Disney material's Trowbridge–Reitz with separable masking.
+    Disney(DisneyMicrofacet),
 }
 
 impl From<TrowbridgeReitz> for MicrofacetDistribution {
     #[inline]
     fn from(d: TrowbridgeReitz) -> Self {
         MicrofacetDistribution::TrowbridgeReitz(d)
+    }
+}
+
+impl From<DisneyMicrofacet> for MicrofacetDistribution {
+    #[inline]
+    fn from(d: DisneyMicrofacet) -> Self {
+        MicrofacetDistribution::Disney(d)
     }
 }
 
@@ -471,6 +481,7 @@ macro_rules! delegate {
         match $self {
             MicrofacetDistribution::TrowbridgeReitz($d) => $e,
             MicrofacetDistribution::Beckmann($d) => $e,
+            MicrofacetDistribution::Disney($d) => $e,
         }
     };
 }

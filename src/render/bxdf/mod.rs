@@ -10,6 +10,7 @@
 //! `BSDF` with `Add` and no allocation per hit.
 
 mod bsdf;
+mod disney;
 mod fresnel;
 mod fresnel_blend;
 mod lambertian;
@@ -19,6 +20,10 @@ mod oren_nayar;
 mod specular;
 
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
+pub use disney::{
+    fr_schlick, gtr1, schlick_r0_from_eta, schlick_weight, DisneyClearcoat, DisneyDiffuse,
+    DisneyFakeSS, DisneyFresnel, DisneyMicrofacet, DisneyRetro, DisneySheen,
+};
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use fresnel_blend::FresnelBlend;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
@@ -179,6 +184,11 @@ bxdfs! {
     MicrofacetReflection(MicrofacetReflection),
     MicrofacetTransmission(MicrofacetTransmission),
     FresnelBlend(FresnelBlend),
+    DisneyDiffuse(DisneyDiffuse),
+    DisneyFakeSS(DisneyFakeSS),
+    DisneyRetro(DisneyRetro),
+    DisneySheen(DisneySheen),
+    DisneyClearcoat(DisneyClearcoat),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry

@@ -7,6 +7,7 @@
 //! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
 //! delegates to the files.
 
+mod disney;
 mod glass;
 mod matte;
 mod metal;
@@ -18,6 +19,7 @@ mod translucent;
 mod uber;
 
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use disney::Disney;
 pub use glass::Glass;
 pub use matte::Matte;
 pub use metal::Metal;
@@ -65,6 +67,7 @@ pub static MATERIALS: &[MaterialKind] = &[
     metal::KIND,
     substrate::KIND,
     uber::KIND,
+    disney::KIND,
     NONE_KIND,
     unsupported(
         "subsurface",
@@ -131,6 +134,7 @@ pub enum Material {
     Metal(Metal),
     Substrate(Substrate),
     Uber(Uber),
+    Disney(Disney),
     /// `Material "none"`: no BSDF.
     None,
 }
@@ -165,6 +169,7 @@ impl Material {
             Material::Metal(m) => m.needs_geom(),
             Material::Substrate(m) => m.needs_geom(),
             Material::Uber(m) => m.needs_geom(),
+            Material::Disney(m) => m.needs_geom(),
             Material::None => false,
         }
     }
@@ -178,6 +183,7 @@ impl Material {
             Material::Metal(m) => m.anisotropic(),
             Material::Substrate(m) => m.anisotropic(),
             Material::Uber(m) => m.anisotropic(),
+            Material::Disney(m) => m.anisotropic(),
             Material::Matte(_)
             | Material::Plastic(_)
             | Material::Translucent(_)
@@ -200,6 +206,7 @@ impl Material {
             Material::Metal(m) => m.max_lobes(),
             Material::Substrate(m) => m.max_lobes(),
             Material::Uber(m) => m.max_lobes(),
+            Material::Disney(m) => m.max_lobes(),
             Material::None => 0,
         }
     }
@@ -233,6 +240,7 @@ impl Material {
             Material::Metal(m) => m.scatter(sc, bsdf),
             Material::Substrate(m) => m.scatter(sc, bsdf),
             Material::Uber(m) => m.scatter(sc, bsdf),
+            Material::Disney(m) => m.scatter(sc, bsdf),
             Material::None => {}
         }
     }
