@@ -118,6 +118,24 @@ const CASES: &[Case] = &[
         "\"rgb Kd\" [1 1 1] \"rgb Ks\" [0 0 0] \"rgb reflect\" [0.5 0.5 0.5] \"rgb transmit\" [0.5 0.5 0.5]",
         (1.0, 1.0),
     ),
+    // Disney: diffuse + retro + specular by default; a metal; sheen and
+    // clearcoat; thin with diffuse and glossy transmission.
+    case("disney", "", (0.2, 1.0)),
+    case(
+        "disney",
+        "\"rgb color\" [0.9 0.6 0.3] \"float metallic\" 1 \"float roughness\" 0.3 \"float anisotropic\" 0.5",
+        (0.2, 1.0),
+    ),
+    case(
+        "disney",
+        "\"float sheen\" 1 \"float clearcoat\" 1 \"float clearcoatgloss\" 0.5 \"float roughness\" 0.7",
+        (0.2, 1.2),
+    ),
+    nonreciprocal(
+        "disney",
+        "\"bool thin\" \"true\" \"float spectrans\" 0.5 \"float difftrans\" 1 \"float flatness\" 0.5",
+        (0.1, 1.1),
+    ),
     // pbrt-v3's mix: amount × material 1 + (1 − amount) × material 2.
     case(
         "mix",
