@@ -13,6 +13,7 @@ pub mod meshfile;
 pub mod ply;
 pub mod state;
 pub mod summary;
+pub mod texture;
 
 use crate::lang::params::ParamList;
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};

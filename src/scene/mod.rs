@@ -12,7 +12,7 @@ mod textures;
 pub use params::{
     FourierTable, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
 };
-pub use textures::{FloatTex, SpectrumTex};
+pub use textures::{FloatTex, SpectrumTex, Tex};
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::path::PathBuf;
@@ -196,6 +196,12 @@ pub struct ShapeDesc {
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
+    /// pbrt-v3's `alpha` mask (triangle meshes): hits where it is 0 are
+    /// ignored by every ray. `None`: no test.
+    pub alpha: Option<FloatTex>,
+    /// pbrt-v3's `shadowalpha`: hits where it is 0 are ignored by shadow
+    /// rays.
+    pub shadow_alpha: Option<FloatTex>,
 }
 
 #[derive(Clone, Debug)]

@@ -7,11 +7,13 @@
 //! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
 //! delegates to the files.
 
+mod bump;
 mod glass;
 mod matte;
 mod mirror;
 
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use bump::bump;
 pub use glass::Glass;
 pub use matte::Matte;
 pub use mirror::Mirror;
@@ -19,7 +21,8 @@ pub use mirror::Mirror;
 use crate::render::accel::SurfaceHit;
 use crate::render::geometry::Frame;
 use crate::render::shapes::DiffGeom;
-use crate::scene::{MaterialDesc, ParamSpec, ParamValues};
+use crate::scene::{FloatTex, MaterialDesc, ParamSpec, ParamValues};
+use std::sync::Arc;
 
 /// Whether pbrs renders a material kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,15 +111,39 @@ pub enum Material {
     Glass(Glass),
     /// `Material "none"`: no BSDF.
     None,
+    /// A material with a `bumpmap`: its shading frame is bumped before its
+    /// lobes are built (one code path for every material).
+    Bumped(Arc<Bumped>),
+}
+
+/// A material and its bump map.
+#[derive(Clone, Debug)]
+pub struct Bumped {
+    pub material: Material,
+    pub bumpmap: FloatTex,
 }
 
 impl Material {
     /// Builds the material from its description (the kind must be in
     /// [`MATERIALS`]; the loader guarantees it).
     pub fn new(desc: &MaterialDesc) -> Material {
-        match kind(desc.kind) {
+        let m = match kind(desc.kind) {
             Some(k) => (k.build)(&desc.params),
             None => panic!("material kind \"{}\" is not in the table", desc.kind),
+        };
+        // Every material's `bumpmap` (ParamSpec::BUMPMAP) is read here. A
+        // constant 0 displaces nothing; another constant still moves the
+        // shading normal on curved surfaces (d·∂n/∂u), as in pbrt-v3.
+        match desc.params.get("bumpmap") {
+            Some(crate::scene::ParamValue::FloatTexture(b))
+                if b.as_constant() != Some(0.0) && !m.is_none() =>
+            {
+                Material::Bumped(Arc::new(Bumped {
+                    material: m,
+                    bumpmap: b.clone(),
+                }))
+            }
+            _ => m,
         }
     }
 
@@ -134,6 +161,7 @@ impl Material {
             Material::Mirror(m) => m.needs_geom(),
             Material::Glass(m) => m.needs_geom(),
             Material::None => false,
+            Material::Bumped(_) => true,
         }
     }
 
@@ -142,6 +170,7 @@ impl Material {
     pub fn anisotropic(&self) -> bool {
         match self {
             Material::Matte(_) | Material::Mirror(_) | Material::Glass(_) | Material::None => false,
+            Material::Bumped(b) => b.material.anisotropic(),
         }
     }
 
@@ -154,14 +183,27 @@ impl Material {
 
     /// [`Material::bsdf`] written into `out` (reset first), so that the
     /// integrators build BSDFs in place.
+    ///
+    /// A bumped material is built at the bumped hit: the shading frame of
+    /// `out` (`out.frame.n`) is then the bumped shading normal, which the
+    /// integrators use for the cosine terms (pbrt-v3's `isect.shading.n`
+    /// after `Bump`).
     #[inline]
     pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+        if let Material::Bumped(b) = self {
+            let (hit, geom) = bump(&b.bumpmap, sc);
+            let bumped = ShadingContext {
+                hit: &hit,
+                geom: &geom,
+            };
+            return b.material.bsdf_into(&bumped, ctx, out);
+        }
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
         match self {
             Material::Matte(m) => m.scatter(sc, out),
             Material::Mirror(m) => m.scatter(sc, out),
             Material::Glass(m) => m.scatter(sc, ctx, out),
-            Material::None => {}
+            Material::None | Material::Bumped(_) => {}
         }
     }
 }
