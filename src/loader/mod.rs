@@ -4,10 +4,12 @@
 //! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
 //! - [`color`]: spectra to linear RGB; [`ply`]: the PLY reader for `plymesh`.
+//! - [`image`]: image files for textures and lights, read once per scene.
 //! - [`summary`]: what `pbrs --check` prints.
 
 pub mod color;
 pub mod entities;
+pub mod image;
 pub mod material;
 pub mod meshfile;
 pub mod ply;
@@ -55,6 +57,8 @@ pub struct Ctx {
     pub diags: Diags,
     pub base_dir: PathBuf,
     pub loader: Box<dyn FileLoader>,
+    /// Images read so far (each file is read once).
+    pub images: image::ImageCache,
 }
 
 impl Ctx {
@@ -168,6 +172,7 @@ fn load(
         diags,
         base_dir,
         loader,
+        images: Default::default(),
     };
     if !ctx.diags.errors.is_empty() {
         return Err(LoadFailure {

@@ -6,9 +6,11 @@
 //! Transforms are `f64` so that long chains of scene-file transforms do not lose
 //! precision before the render core converts geometry to `f32` world space.
 
+pub mod image;
 mod params;
 mod textures;
 
+pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
 pub use params::{
     FourierTable, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
 };
