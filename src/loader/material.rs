@@ -151,6 +151,10 @@ fn missing_hint<A, B>(
     if other.contains_key(tex) {
         return format!(" (\"{tex}\" is a {other_type} texture)");
     }
+    // (Suggestions for one- and two-letter names are mostly noise.)
+    if tex.chars().count() < 3 {
+        return String::new();
+    }
     let names: Vec<&str> = same.keys().map(String::as_str).collect();
     match closest_name(tex, &names) {
         Some(c) => format!(" (did you mean \"{c}\"?)"),

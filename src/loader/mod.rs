@@ -197,6 +197,7 @@ fn load(
         skipped: std::mem::take(&mut b.skipped),
     };
     let kinds = std::mem::take(&mut b.material_kinds);
+    let textures = std::mem::take(&mut b.texture_state.by_class);
     drop(b);
     if !ctx.diags.errors.is_empty() {
         return Err(LoadFailure {
@@ -204,7 +205,8 @@ fn load(
             warnings: ctx.diags.warnings,
         });
     }
-    let summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
+    let mut summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
+    summary.textures_by_class = textures;
     Ok(LoadedScene {
         scene,
         warnings: ctx.diags.warnings,

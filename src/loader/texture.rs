@@ -6,6 +6,7 @@
 //! and its images. Also the shapes' `alpha` and `shadowalpha` textures.
 
 use super::entities::one;
+use super::image::load_image;
 use super::material::{read_params, read_params_as, Lookup};
 use super::state::closest_name;
 use super::Ctx;
@@ -13,10 +14,10 @@ use crate::lang::params::{ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
 use crate::render::textures::{
-    self, ImageSource, Mapping2D, Mapping3D, MappingUse, MipCache, RgbImage, TexBuilder, TexValue,
+    self, ImageSource, Mapping2D, Mapping3D, MappingUse, MipCache, TexBuilder, TexValue,
     TextureClass, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, TEXTURES, UV_MAPPING_PARAMS,
 };
-use crate::scene::{FloatTex, ParamValues, Tex};
+use crate::scene::{Decode, FloatTex, ParamValues, RgbImage, Tex};
 use glam::{DMat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -60,13 +61,9 @@ struct Images<'a> {
 
 impl ImageSource for Images<'_> {
     fn image(&mut self, path: &str) -> Option<Arc<RgbImage>> {
-        let _ = path;
-        self.ctx.warn(
-            self.loc,
-            "image files are not read yet: a constant 0.5 grey is used",
-            "not read",
-        );
-        None
+        // Raw values: the texture decodes them (a float texture decodes the
+        // luminance, not each channel).
+        load_image(self.ctx, self.loc, path, Decode::Raw)
     }
 }
 

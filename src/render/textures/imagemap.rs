@@ -23,7 +23,7 @@
 use super::mipmap::{MipMap, Wrap};
 use super::{Class, Mapping2D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
-use crate::scene::{ParamSpec, Tex};
+use crate::scene::{ParamSpec, RgbImage, Tex};
 use glam::Vec3;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -60,19 +60,11 @@ pub const CLASS: TextureClass = TextureClass {
     spectrum: Some(build::<Vec3>),
 };
 
-/// An image as read: RGB texels, linear or sRGB-encoded as stored in the
-/// file (decoding is the texture's `gamma`), rows top to bottom.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RgbImage {
-    pub width: usize,
-    pub height: usize,
-    pub pixels: Vec<Vec3>,
-}
-
 /// Where image textures get their images (the loader: files read once,
 /// failures reported with the statement's location).
 pub trait ImageSource {
-    /// The image of a resolved file name, or `None` after a warning.
+    /// The image of a file name as written in the scene (raw values, as
+    /// pbrt-v3's `ReadImage`), or `None` after a located error.
     fn image(&mut self, path: &str) -> Option<Arc<RgbImage>>;
 }
 
@@ -143,20 +135,16 @@ fn build<T: TexValue>(b: &mut TexBuilder) -> Result<Tex<T>, String> {
 /// The MIP map of an image texture (pbrt-v3's `GetTexture`).
 fn mip_map<T: TexValue>(key: &MipKey, b: &mut TexBuilder) -> Result<MipMap<T>, String> {
     let scale = f32::from_bits(key.scale);
-    let image = if key.path.is_empty() {
-        None
-    } else {
-        b.images.image(&key.path)
-    };
+    let image = b.images.image(&key.path);
     let (w, h, texels) = match image.as_deref() {
         Some(img) => {
+            let (w, h) = (img.width() as usize, img.height() as usize);
             // Texture space has t = 0 at the bottom row.
-            let mut texels = Vec::with_capacity(img.width * img.height);
-            for t in 0..img.height {
-                let row = &img.pixels[(img.height - 1 - t) * img.width..][..img.width];
+            let mut texels = Vec::with_capacity(w * h);
+            for row in img.pixels().chunks_exact(w).rev() {
                 texels.extend(row.iter().map(|&c| T::from_texel(c, scale, key.gamma)));
             }
-            (img.width, img.height, texels)
+            (w, h, texels)
         }
         None => (
             1,

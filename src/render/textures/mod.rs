@@ -36,7 +36,7 @@ pub use bilerp::Bilerp;
 pub use checkerboard::{AaMode, Checkerboard2D, Checkerboard3D};
 pub use dots::Dots;
 pub use fbm::Fbm;
-pub use imagemap::{ImageMap, ImageSource, MipCache, MipKey, RgbImage};
+pub use imagemap::{ImageMap, ImageSource, MipCache, MipKey};
 pub use mapping::{Mapping2D, Mapping3D, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, UV_MAPPING_PARAMS};
 pub use marble::Marble;
 pub use mipmap::{ewa_weights, lanczos, resample_weights, MipMap, Wrap, MAX_TEXELS};
