@@ -733,3 +733,29 @@ fn garbage_parameters_never_panic() {
         }
     }
 }
+
+#[test]
+fn reference_documents_every_texture_class() {
+    let reference = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md"),
+    )
+    .unwrap();
+    let start = reference.find("## Textures").expect("a Textures section");
+    let section = &reference[start..];
+    let section = &section[..section[3..].find("\n## ").map_or(section.len(), |e| e + 3)];
+    for class in TEXTURES {
+        assert!(
+            section.contains(&format!("`{}`", class.name)),
+            "REFERENCE.md's Textures section lacks `{}`",
+            class.name
+        );
+        for p in class.params {
+            assert!(
+                section.contains(&format!("`{}`", p.name)),
+                "REFERENCE.md lacks `{}` of `{}`",
+                p.name,
+                class.name
+            );
+        }
+    }
+}
