@@ -37,7 +37,10 @@ fn bumped_normal(m: &Material, at: &At) -> Vec3 {
 #[track_caller]
 fn assert_dir(got: Vec3, want: Vec3) {
     let want = want.normalize();
-    assert!((got - want).length() < 2e-4, "normal {got} vs expected {want}");
+    assert!(
+        (got - want).length() < 2e-4,
+        "normal {got} vs expected {want}"
+    );
 }
 
 /// d(u, v) = k·u as a float bilerp (v00 = v01 = 0, v10 = v11 = k).
@@ -53,10 +56,7 @@ fn a_linear_ramp_tilts_the_normal() {
         assert!(m.needs_geom());
         // z-up plane, dp/du = x, dp/dv = y: dp'/du = x + k·z, so the
         // normal is (−k, 0, 1) normalised, whatever the step.
-        for at in [
-            At::uv(0.3, 0.6),
-            At::uv(0.9, 0.1).duv(0.1, 0.0, 0.2, 0.05),
-        ] {
+        for at in [At::uv(0.3, 0.6), At::uv(0.9, 0.1).duv(0.1, 0.0, 0.2, 0.05)] {
             assert_dir(bumped_normal(&m, &at), Vec3::new(-k, 0.0, 1.0));
         }
     }
@@ -78,7 +78,10 @@ fn the_finite_difference_step_is_pbrt_v3s() {
         Vec3::new(-(2.0 * u + 0.0005), 0.0, 1.0),
     );
     let at = At::uv(u, 0.5).duv(0.1, 0.0, -0.3, 0.0);
-    assert_dir(bumped_normal(&m, &at), Vec3::new(-(2.0 * u + 0.2), 0.0, 1.0));
+    assert_dir(
+        bumped_normal(&m, &at),
+        Vec3::new(-(2.0 * u + 0.2), 0.0, 1.0),
+    );
     // The same along v.
     let tex_v = "Texture \"r\" \"float\" \"bilerp\" \"float v00\" 0 \"float v10\" 0 \"float v01\" 1 \"float v11\" 1\nTexture \"d\" \"float\" \"scale\" \"texture tex1\" \"r\" \"texture tex2\" \"r\"";
     let m = material(tex_v, "\"glass\" \"texture bumpmap\" \"d\"");
@@ -130,7 +133,10 @@ fn the_integrator_shades_with_the_bumped_normal() {
 
 /// The render-ready scene of world statements `world`.
 fn render_scene(world: &str) -> (RenderScene, String, Vec<String>) {
-    let s = load(&format!("WorldBegin\n{world}\nWorldEnd\n"), &MemFiles::default());
+    let s = load(
+        &format!("WorldBegin\n{world}\nWorldEnd\n"),
+        &MemFiles::default(),
+    );
     let w = warnings(&s);
     (RenderScene::new(&s.scene), w, s.scene.skipped.clone())
 }
@@ -156,7 +162,10 @@ fn sample_points() -> Vec<Vec2> {
     let mut v = Vec::new();
     for i in 0..9 {
         for j in 0..9 {
-            v.push(Vec2::new(-0.9 + 0.2 * i as f32 + 0.013, -0.9 + 0.2 * j as f32 + 0.007));
+            v.push(Vec2::new(
+                -0.9 + 0.2 * i as f32 + 0.013,
+                -0.9 + 0.2 * j as f32 + 0.007,
+            ));
         }
     }
     v
@@ -190,8 +199,14 @@ fn alpha_cuts_closest_hits_and_shadow_rays() {
         "{CK}\n{QUAD} \"texture alpha\" \"ck\"\nTranslate 0 0 2\n{QUAD}"
     ))
     .0;
-    let hole = sample_points().into_iter().find(|p| !solid(p.x, p.y)).unwrap();
-    let h = behind.geometry.intersect(&down_ray(hole.x, hole.y)).unwrap();
+    let hole = sample_points()
+        .into_iter()
+        .find(|p| !solid(p.x, p.y))
+        .unwrap();
+    let h = behind
+        .geometry
+        .intersect(&down_ray(hole.x, hole.y))
+        .unwrap();
     assert!((h.t - 3.0).abs() < 1e-4, "{}", h.t);
 }
 
@@ -211,7 +226,10 @@ fn alpha_in_instances_and_constant_alphas() {
     // (noted), unless it emits (lights still sample it).
     let (rs, _, skipped) = render_scene(&format!("{QUAD} \"float alpha\" 0"));
     assert!(rs.geometry.meshes.is_empty());
-    assert!(skipped.iter().any(|s| s.contains("\"alpha\" 0")), "{skipped:?}");
+    assert!(
+        skipped.iter().any(|s| s.contains("\"alpha\" 0")),
+        "{skipped:?}"
+    );
     let (rs, _, _) = render_scene(&format!(
         "AreaLightSource \"diffuse\"\n{QUAD} \"float alpha\" 0"
     ));
@@ -222,15 +240,24 @@ fn alpha_in_instances_and_constant_alphas() {
         "{QUAD} \"float alpha\" 0.5\nTranslate 5 0 0\n{QUAD} \"texture alpha\" \"nope\"\nShape \"sphere\" \"float alpha\" 0"
     ));
     assert!(rs.geometry.meshes.iter().all(|m| m.alpha.is_none()));
-    assert!(w.contains("couldn't find float texture \"nope\" for \"alpha\""), "{w}");
+    assert!(
+        w.contains("couldn't find float texture \"nope\" for \"alpha\""),
+        "{w}"
+    );
     // pbrt-v3 reads alpha for triangle meshes only.
     assert!(w.contains("\"float alpha\" not used"), "{w}");
     let s = load(
         &format!("WorldBegin\n{CK}\n{QUAD} \"texture alpha\" \"ck\"\nWorldEnd"),
         &MemFiles::default(),
     );
-    assert!(matches!(s.scene.shapes[0].geometry, Geometry::TriangleMesh(_)));
-    assert!(s.summary.to_string().contains("alpha:      1 shapes with alpha masks"));
+    assert!(matches!(
+        s.scene.shapes[0].geometry,
+        Geometry::TriangleMesh(_)
+    ));
+    assert!(s
+        .summary
+        .to_string()
+        .contains("alpha:      1 shapes with alpha masks"));
 }
 
 #[test]
@@ -248,7 +275,10 @@ fn a_checkerboard_cutout_shows_half_of_the_light_behind() {
     let px: Vec<f32> = img.data.chunks(3).map(|c| c[0]).collect();
     // (Samples that fall exactly on a pixel edge, which is a check edge,
     // land on either side: a few pixels are partly covered.)
-    let partial = px.iter().filter(|&&v| v.abs() > 1e-4 && (v - 1.0).abs() > 1e-4).count();
+    let partial = px
+        .iter()
+        .filter(|&&v| v.abs() > 1e-4 && (v - 1.0).abs() > 1e-4)
+        .count();
     assert!(partial < 16, "{partial} pixels partly covered");
     let mean = px.iter().map(|&v| v as f64).sum::<f64>() / px.len() as f64;
     assert!((mean - 0.5).abs() < 0.005, "hole fraction {mean}");

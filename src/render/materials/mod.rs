@@ -190,14 +190,16 @@ impl Material {
     /// after `Bump`).
     #[inline]
     pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
-        if let Material::Bumped(b) = self {
-            let (hit, geom) = bump(&b.bumpmap, sc);
-            let bumped = ShadingContext {
-                hit: &hit,
-                geom: &geom,
-            };
-            return b.material.bsdf_into(&bumped, ctx, out);
+        match self {
+            Material::Bumped(b) => b.bsdf_into(sc, ctx, out),
+            _ => self.unbumped_bsdf_into(sc, ctx, out),
         }
+    }
+
+    /// The BSDF without bump mapping (not recursive, so that it inlines
+    /// into the integrators).
+    #[inline(always)]
+    fn unbumped_bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
         match self {
             Material::Matte(m) => m.scatter(sc, out),
@@ -205,6 +207,20 @@ impl Material {
             Material::Glass(m) => m.scatter(sc, ctx, out),
             Material::None | Material::Bumped(_) => {}
         }
+    }
+}
+
+impl Bumped {
+    /// The material's BSDF at the bumped hit (`Material::new` never nests
+    /// bump maps).
+    #[inline(never)]
+    fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+        let (hit, geom) = bump(&self.bumpmap, sc);
+        let bumped = ShadingContext {
+            hit: &hit,
+            geom: &geom,
+        };
+        self.material.unbumped_bsdf_into(&bumped, ctx, out);
     }
 }
 

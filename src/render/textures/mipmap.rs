@@ -47,8 +47,9 @@ pub fn ewa_weights() -> &'static [f32; WEIGHT_LUT_SIZE] {
 }
 
 /// Most texels a MIP map's finest level may have after resampling to powers
-/// of two (a bound on memory; pbrt-v3 has none): 2²⁶, 768 MiB of RGB.
-pub const MAX_TEXELS: usize = 1 << 26;
+/// of two (a bound on memory; pbrt-v3 has none): the image reader's bound,
+/// 2²⁷ (1.5 GiB of RGB, 2 GiB with the coarser levels).
+pub const MAX_TEXELS: usize = 1 << 27;
 
 struct Level<T> {
     w: i32,
