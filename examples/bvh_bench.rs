@@ -43,6 +43,7 @@ fn grid(n: u32) -> TriangleMesh {
         reverse_orientation: false,
         material: 0,
         first_light: None,
+        alpha: None,
     }
 }
 

@@ -172,10 +172,10 @@ fn anisotropy_stretches_the_specular_lobe_along_dpdu() {
     assert!((d.tr.alpha_x - 0.25 / aspect).abs() < 1e-6, "{d:?}");
     assert!((d.tr.alpha_y - 0.25 * aspect).abs() < 1e-6, "{d:?}");
     // The material asks for the dp/du frame only when it is anisotropic.
-    let m = common::materials_of(r#""disney" "float anisotropic" 0.8"#);
-    assert!(m[0].anisotropic() && m[0].needs_geom());
-    let m = common::materials_of(r#""disney""#);
-    assert!(!m[0].anisotropic() && !m[0].needs_geom());
+    let (m, i) = common::materials_of(r#""disney" "float anisotropic" 0.8"#);
+    assert!(m[i].anisotropic() && m[i].needs_geom());
+    let (m, i) = common::materials_of(r#""disney""#);
+    assert!(!m[i].anisotropic() && !m[i].needs_geom());
 }
 
 #[test]

@@ -401,18 +401,26 @@ fn materials_and_substitutes() {
 }
 
 #[test]
-fn textures_constant_and_unsupported() {
-    let s = load("WorldBegin\nTexture \"c\" \"color\" \"constant\" \"rgb value\" [0.1 0.2 0.3]\nTexture \"s\" \"float\" \"constant\" \"float value\" 10\nTexture \"img\" \"color\" \"imagemap\" \"string filename\" \"a.png\"\nMaterial \"matte\" \"texture Kd\" \"c\" \"texture sigma\" \"s\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"img\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"missing\"\nShape \"sphere\"\nWorldEnd");
+fn textures_constant_named_and_missing() {
+    let s = load("WorldBegin\nTexture \"c\" \"color\" \"constant\" \"rgb value\" [0.1 0.2 0.3]\nTexture \"s\" \"float\" \"constant\" \"float value\" 10\nTexture \"ch\" \"color\" \"checkerboard\"\nMaterial \"matte\" \"texture Kd\" \"c\" \"texture sigma\" \"s\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"ch\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"missing\"\nShape \"sphere\"\nMaterial \"matte\" \"texture Kd\" \"s\"\nShape \"sphere\"\nWorldEnd");
     let m = &s.scene.materials;
     assert_eq!(matte_of(&m[0]), (Vec3::new(0.1, 0.2, 0.3), 10.0));
-    assert_eq!(matte_of(&m[1]), (Vec3::splat(0.5), 0.0));
-    assert_eq!(m.len(), 2, "the default-valued materials are one");
+    assert!(
+        m[1].constant_spectrum("Kd").is_none(),
+        "a checkerboard Kd is a texture: {:?}",
+        m[1]
+    );
+    assert_eq!(matte_of(&m[2]), (Vec3::splat(0.5), 0.0));
+    assert_eq!(m.len(), 3, "the default-valued materials are one");
     let w = warnings(&s);
     assert!(
-        w.contains("texture class \"imagemap\" is not supported"),
+        w.contains("mem.pbrt:9:31: unknown spectrum texture \"missing\""),
         "{w}"
     );
-    assert!(w.contains("unknown spectrum texture \"missing\""), "{w}");
+    assert!(
+        w.contains("unknown spectrum texture \"s\" for \"Kd\" (\"s\" is a float texture)"),
+        "{w}"
+    );
 }
 
 #[test]
@@ -489,8 +497,8 @@ fn triangle_mesh_details() {
         "{w}"
     );
     assert!(
-        w.contains("\"alpha\": alpha masks are not supported"),
-        "{w}"
+        s.scene.shapes[1].alpha.is_none(),
+        "a constant alpha other than 0 cuts nothing"
     );
 }
 
@@ -511,7 +519,7 @@ fn sphere_parameters() {
 
 #[test]
 fn unsupported_shapes_and_directives_warn_and_load() {
-    let s = load("WorldBegin\nShape \"disk\" \"float radius\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"fbm\"\nShape \"sphere\"\nWorldEnd");
+    let s = load("WorldBegin\nShape \"disk\" \"float radius\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"ptex\"\nShape \"sphere\"\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 1);
     let w = warnings(&s);
     assert!(
@@ -520,7 +528,7 @@ fn unsupported_shapes_and_directives_warn_and_load() {
     );
     assert!(w.contains("did you mean \"cylinder\""), "{w}");
     assert!(w.contains("participating media are not supported"), "{w}");
-    assert!(w.contains("texture class \"fbm\" is not supported"), "{w}");
+    assert!(w.contains("texture class \"ptex\" is not supported"), "{w}");
 }
 
 #[test]

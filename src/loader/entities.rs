@@ -14,7 +14,6 @@ use crate::scene::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::PathBuf;
-use std::rc::Rc;
 use std::sync::Arc;
 
 pub const MAX_RESOLUTION: i64 = 32768;
@@ -156,96 +155,6 @@ fn light_scale(ctx: &mut Ctx, p: &ParamList) -> Vec3 {
         return Vec3::splat(f as f32);
     }
     spectrum(ctx, p, "scale", Vec3::ONE)
-}
-
-// ---------------------------------------------------------------- textures
-
-#[derive(Clone, Debug)]
-pub enum TexValue {
-    Float(f64),
-    Spectrum(Vec3),
-    /// A texture class pbrs does not evaluate.
-    Unsupported(String),
-}
-
-#[derive(Clone, Debug)]
-pub struct TexSpec {
-    pub value: TexValue,
-    pub loc: Loc,
-}
-
-#[derive(Clone, Debug, Default)]
-pub struct Textures {
-    pub float: HashMap<String, Rc<TexSpec>>,
-    pub spectrum: HashMap<String, Rc<TexSpec>>,
-}
-
-const TEXTURE_CLASSES: &[&str] = &[
-    "constant",
-    "scale",
-    "mix",
-    "bilerp",
-    "imagemap",
-    "uv",
-    "checkerboard",
-    "dots",
-    "fbm",
-    "wrinkled",
-    "marble",
-    "windy",
-    "ptex",
-];
-
-/// `Texture name kind class params`: `Some((is_float, spec))` to record.
-pub fn texture(
-    ctx: &mut Ctx,
-    name: &Name,
-    kind: &Name,
-    class: &Name,
-    params: &ParamList,
-    _tex: &Textures,
-) -> Option<(bool, TexSpec)> {
-    let is_float = match kind.value.as_str() {
-        "float" => true,
-        "color" | "spectrum" => false,
-        other => {
-            params.mark_all_used();
-            ctx.warn(kind.loc, format!("texture type \"{other}\" is neither \"float\", \"color\" nor \"spectrum\": texture \"{}\" ignored", name.value), "unknown texture type");
-            return None;
-        }
-    };
-    let value = if class.value == "constant" {
-        let v = if is_float {
-            TexValue::Float(float(params, "value", 1.0))
-        } else {
-            TexValue::Spectrum(spectrum(ctx, params, "value", Vec3::ONE))
-        };
-        ctx.report_unused(params, &format!("Texture \"{}\"", name.value));
-        v
-    } else {
-        params.mark_all_used();
-        if TEXTURE_CLASSES.contains(&class.value.as_str()) {
-            ctx.warn(class.loc, format!("texture class \"{}\" is not supported by pbrs: material parameters that use texture \"{}\" get their default value", class.value, name.value), "only \"constant\" textures are evaluated");
-        } else {
-            ctx.warn(
-                class.loc,
-                format!(
-                    "unknown texture class \"{}\": texture \"{}\" ignored",
-                    class.value, name.value
-                ),
-                "not a pbrt-v3 texture class",
-            );
-            return None;
-        }
-        TexValue::Unsupported(class.value.clone())
-    };
-    Some((
-        is_float,
-        TexSpec {
-            value,
-            loc: name.loc,
-        },
-    ))
 }
 
 /// pbrt-v3 `shapeMaySetMaterialParameters` (api.cpp): whether a shape's parameters
@@ -500,7 +409,6 @@ fn mesh_file(
         );
         return None;
     };
-    alpha_ignored(ctx, p);
     let path = resolve(&ctx.base_dir, file);
     if let Some(m) = meshes.get(&path) {
         return m.clone().map(Geometry::TriangleMesh);
@@ -560,23 +468,6 @@ fn mesh_file(
     };
     meshes.insert(path, mesh.clone());
     mesh.map(Geometry::TriangleMesh)
-}
-
-fn alpha_ignored(ctx: &mut Ctx, p: &ParamList) {
-    for n in ["alpha", "shadowalpha"] {
-        if let Some(q) = p
-            .items
-            .iter()
-            .find(|q| q.name == n && matches!(q.ty, ParamType::Float | ParamType::Texture))
-        {
-            q.used.set(true);
-            ctx.warn(
-                q.loc,
-                format!("\"{n}\": alpha masks are not supported by pbrs; ignored"),
-                "ignored",
-            );
-        }
-    }
 }
 
 fn to_vec3(v: &[f64]) -> Vec<Vec3> {
@@ -714,7 +605,6 @@ fn triangle_mesh(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> 
         }
         None => None,
     };
-    alpha_ignored(ctx, p);
     Some(MeshData {
         positions,
         indices,

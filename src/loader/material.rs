@@ -4,8 +4,9 @@
 //! override its material's, a texture reference before a value in each list.
 
 use super::color::sampled_to_rgb;
-use super::entities::{find_spectrum, float_opt, one, spectrum_value, TexValue, Textures};
+use super::entities::{find_spectrum, float_opt, one, spectrum_value};
 use super::state::closest_name;
+use super::texture::Textures;
 use super::{Ctx, DeclaredKind};
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::Loc;
@@ -81,14 +82,16 @@ impl Lookup<'_> {
     pub fn spectrum(&self, ctx: &mut Ctx, name: &str) -> Option<(SpectrumTex, Loc)> {
         for l in self.lists() {
             if let Some((tex, loc)) = self.texture_ref(name, l) {
-                return match self.textures.spectrum.get(&tex).map(|t| t.value.clone()) {
-                    Some(TexValue::Spectrum(v)) => Some((SpectrumTex::Constant(v), loc)),
-                    Some(TexValue::Unsupported(class)) => {
-                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which is not supported by pbrs: the default is used"), "unsupported texture");
-                        None
-                    }
-                    _ => {
-                        ctx.warn(loc, format!("unknown spectrum texture \"{tex}\" for \"{name}\": the default is used (as pbrt-v3)"), "no such \"color\" texture");
+                return match self.textures.spectrum.get(&tex) {
+                    Some(e) => Some((e.tex.clone(), loc)),
+                    None => {
+                        let hint = missing_hint(
+                            &tex,
+                            "float",
+                            &self.textures.float,
+                            &self.textures.spectrum,
+                        );
+                        ctx.warn(loc, format!("unknown spectrum texture \"{tex}\" for \"{name}\"{hint}: the default is used (as pbrt-v3)"), "no such \"color\" texture");
                         None
                     }
                 };
@@ -104,14 +107,16 @@ impl Lookup<'_> {
     pub fn float(&self, ctx: &mut Ctx, name: &str) -> Option<(FloatTex, Loc)> {
         for l in self.lists() {
             if let Some((tex, loc)) = self.texture_ref(name, l) {
-                return match self.textures.float.get(&tex).map(|t| t.value.clone()) {
-                    Some(TexValue::Float(v)) => Some((FloatTex::Constant(v as f32), loc)),
-                    Some(TexValue::Unsupported(class)) => {
-                        ctx.warn(loc, format!("\"{name}\" uses texture \"{tex}\" of class \"{class}\", which is not supported by pbrs: the default is used"), "unsupported texture");
-                        None
-                    }
-                    _ => {
-                        ctx.warn(loc, format!("unknown float texture \"{tex}\" for \"{name}\": the default is used (as pbrt-v3)"), "no such \"float\" texture");
+                return match self.textures.float.get(&tex) {
+                    Some(e) => Some((e.tex.clone(), loc)),
+                    None => {
+                        let hint = missing_hint(
+                            &tex,
+                            "spectrum",
+                            &self.textures.spectrum,
+                            &self.textures.float,
+                        );
+                        ctx.warn(loc, format!("unknown float texture \"{tex}\" for \"{name}\"{hint}: the default is used (as pbrt-v3)"), "no such \"float\" texture");
                         None
                     }
                 };
@@ -132,6 +137,28 @@ impl Lookup<'_> {
     /// Marks the material's own parameters (not the shape's) used.
     pub fn mark_all(&self) {
         self.second.mark_all_used();
+    }
+}
+
+/// Why a texture name was not found: defined with the other type, or a
+/// near miss among the names of the right type.
+fn missing_hint<A, B>(
+    tex: &str,
+    other_type: &str,
+    other: &HashMap<String, A>,
+    same: &HashMap<String, B>,
+) -> String {
+    if other.contains_key(tex) {
+        return format!(" (\"{tex}\" is a {other_type} texture)");
+    }
+    // (Suggestions for one- and two-letter names are mostly noise.)
+    if tex.chars().count() < 3 {
+        return String::new();
+    }
+    let names: Vec<&str> = same.keys().map(String::as_str).collect();
+    match closest_name(tex, &names) {
+        Some(c) => format!(" (did you mean \"{c}\"?)"),
+        None => String::new(),
     }
 }
 
@@ -162,18 +189,18 @@ pub fn material(
             Support::Unsupported(why) => {
                 let kd = l
                     .spectrum(ctx, "Kd")
-                    .and_then(|(t, _)| t.as_constant())
-                    .unwrap_or(Vec3::splat(0.5));
+                    .map(|(t, _)| t)
+                    .unwrap_or(SpectrumTex::Constant(Vec3::splat(0.5)));
                 let kept = l.lists().any(|p| p.get("Kd").is_some_and(|q| q.used.get()));
                 l.mark_all();
-                let keep = if kept {
-                    format!("its Kd {kd}")
-                } else {
-                    "the default Kd 0.5".to_string()
+                let keep = match (&kd, kept) {
+                    (_, false) => "the default Kd 0.5".to_string(),
+                    (SpectrumTex::Constant(c), true) => format!("its Kd {c}"),
+                    (SpectrumTex::Texture(t), true) => format!("its Kd texture \"{}\"", t.name),
                 };
                 ctx.warn(spec.loc, format!("{what}: material type \"{}\" is not supported by pbrs ({why}): substituted by a matte with {keep}", spec.ty), "substituted by matte");
                 let mut params = defaults(ctx, matte.params);
-                params.set("Kd", ParamValue::SpectrumTexture(SpectrumTex::Constant(kd)));
+                params.set("Kd", ParamValue::SpectrumTexture(kd));
                 return (
                     MaterialDesc {
                         kind: "matte",
@@ -248,6 +275,17 @@ pub fn read_params(
     specs: &'static [ParamSpec],
     l: &Lookup,
 ) -> (ParamValues, Vec<NamedRef>) {
+    read_params_as(ctx, specs, l, true)
+}
+
+/// [`read_params`] for a texture of type float (`same_is_float`) or
+/// spectrum: the type of its `SameTexture` and `SameValue` parameters.
+pub fn read_params_as(
+    ctx: &mut Ctx,
+    specs: &'static [ParamSpec],
+    l: &Lookup,
+    same_is_float: bool,
+) -> (ParamValues, Vec<NamedRef>) {
     let mut out = ParamValues::default();
     let mut refs = Vec::new();
     for s in specs {
@@ -256,9 +294,84 @@ pub fn read_params(
                 Some((FloatTex::Constant(v), loc)) => {
                     Some(FloatTex::Constant(check_range(ctx, s, v, loc)))
                 }
+                Some((t, _)) => Some(t),
                 None => def.map(FloatTex::Constant),
             }
             .map(ParamValue::FloatTexture),
+            ParamKind::SameTexture(def) if same_is_float => Some(ParamValue::FloatTexture(
+                l.float(ctx, s.name)
+                    .map(|(t, _)| t)
+                    .unwrap_or(FloatTex::Constant(def)),
+            )),
+            ParamKind::SameTexture(def) => Some(ParamValue::SpectrumTexture(
+                l.spectrum(ctx, s.name)
+                    .map(|(t, _)| t)
+                    .unwrap_or(SpectrumTex::Constant(Vec3::splat(def))),
+            )),
+            ParamKind::SameValue(def) if same_is_float => {
+                let v = l
+                    .plain(s.name, ParamType::Float)
+                    .map(|q| q.nums()[0] as f32)
+                    .unwrap_or(def);
+                Some(ParamValue::FloatTexture(FloatTex::Constant(v)))
+            }
+            ParamKind::SameValue(def) => {
+                let v = l
+                    .lists()
+                    .find_map(|list| find_spectrum(list, s.name))
+                    .and_then(|q| spectrum_value(ctx, q))
+                    .unwrap_or(Vec3::splat(def));
+                Some(ParamValue::SpectrumTexture(SpectrumTex::Constant(v)))
+            }
+            ParamKind::Int(def) => Some(ParamValue::Int(
+                l.plain(s.name, ParamType::Integer)
+                    .map(|q| q.nums()[0].clamp(i32::MIN as f64, i32::MAX as f64) as i32)
+                    .unwrap_or(def),
+            )),
+            ParamKind::Vector3(def) => Some(ParamValue::Vector(
+                l.plain(s.name, ParamType::Vector3)
+                    .map(|q| {
+                        let v = q.nums();
+                        Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+                    })
+                    .unwrap_or(Vec3::from_array(def)),
+            )),
+            ParamKind::BoolOpt => l
+                .plain(s.name, ParamType::Bool)
+                .map(|q| ParamValue::Bool(q.bools()[0])),
+            ParamKind::Choice { default, options } => {
+                let v = match l.plain(s.name, ParamType::String) {
+                    Some(q) => {
+                        let v = q.strs()[0].clone();
+                        if options.contains(&v.as_str()) {
+                            v
+                        } else {
+                            let hint = match closest_name(&v, options) {
+                                Some(c) => format!("did you mean \"{c}\"?"),
+                                None => format!(
+                                    "one of {}",
+                                    options
+                                        .iter()
+                                        .map(|o| format!("\"{o}\""))
+                                        .collect::<Vec<_>>()
+                                        .join(", ")
+                                ),
+                            };
+                            ctx.warn(q.values_loc, format!("\"{}\" is \"{v}\", which pbrt-v3 does not know ({hint}): \"{default}\" is used (as pbrt-v3)", s.name), "unknown value");
+                            default.to_string()
+                        }
+                    }
+                    None => default.to_string(),
+                };
+                Some(ParamValue::String(v))
+            }
+            // As written: the image reader resolves it against the scene
+            // file's directory.
+            ParamKind::Filename => Some(ParamValue::String(
+                l.plain(s.name, ParamType::String)
+                    .map(|q| q.strs()[0].clone())
+                    .unwrap_or_default(),
+            )),
             ParamKind::SpectrumTexture(def) => match l.spectrum(ctx, s.name) {
                 Some((t, _)) => Some(t),
                 None => def.map(|d| SpectrumTex::Constant(spectrum_default(d))),

@@ -5,11 +5,13 @@
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
 //! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
 //!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`.
+//! - [`image`]: image files for textures and lights, read once per scene.
 //! - [`summary`]: what `pbrs --check` prints.
 
 pub mod cie1931;
 pub mod color;
 pub mod entities;
+pub mod image;
 pub mod material;
 pub mod meshfile;
 pub mod ply;
@@ -17,6 +19,7 @@ pub mod reference;
 pub mod spd;
 pub mod state;
 pub mod summary;
+pub mod texture;
 
 use crate::lang::params::{Param, ParamList};
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
@@ -60,6 +63,8 @@ pub struct Ctx {
     pub diags: Diags,
     pub base_dir: PathBuf,
     pub loader: Box<dyn FileLoader>,
+    /// Images read so far (each file is read once).
+    pub images: image::ImageCache,
     /// Spectrum files read so far, by resolved path, as RGB (pbrt-v3 reads
     /// each file once: `cachedSpectra`).
     pub spectra: HashMap<PathBuf, Vec3>,
@@ -132,7 +137,25 @@ fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
         }
         ParamKind::Float(_) => &["float"],
         ParamKind::Bool(_) => &["bool"],
-        ParamKind::String(_) | ParamKind::NamedMaterial | ParamKind::FourierFile => &["string"],
+        ParamKind::String(_)
+        | ParamKind::NamedMaterial
+        | ParamKind::FourierFile
+        | ParamKind::Choice { .. }
+        | ParamKind::Filename => &["string"],
+        ParamKind::BoolOpt => &["bool"],
+        ParamKind::Int(_) => &["integer"],
+        ParamKind::Vector3(_) => &["vector3", "vector"],
+        // The texture's own type decides which of these applies.
+        ParamKind::SameTexture(_) => &[
+            "float",
+            "rgb",
+            "color",
+            "xyz",
+            "blackbody",
+            "spectrum",
+            "texture",
+        ],
+        ParamKind::SameValue(_) => &["float", "rgb", "color", "xyz", "blackbody", "spectrum"],
         ParamKind::Unsupported(_) => &[],
     }
 }
@@ -182,7 +205,13 @@ fn kind_name(kind: ParamKind) -> &'static str {
         ParamKind::Bool(_) => "bool",
         ParamKind::String(_) => "string",
         ParamKind::NamedMaterial => "named-material",
-        ParamKind::FourierFile => "file-name",
+        ParamKind::FourierFile | ParamKind::Filename => "file-name",
+        ParamKind::Choice { .. } => "string",
+        ParamKind::BoolOpt => "bool",
+        ParamKind::Int(_) => "integer",
+        ParamKind::Vector3(_) => "vector3",
+        ParamKind::SameTexture(_) => "texture",
+        ParamKind::SameValue(_) => "value",
         ParamKind::Unsupported(_) => "ignored",
     }
 }
@@ -253,6 +282,7 @@ fn load(
         diags,
         base_dir,
         loader,
+        images: Default::default(),
         spectra: HashMap::new(),
     };
     if !ctx.diags.errors.is_empty() {
@@ -278,6 +308,7 @@ fn load(
         skipped: std::mem::take(&mut b.skipped),
     };
     let kinds = std::mem::take(&mut b.material_kinds);
+    let textures = std::mem::take(&mut b.texture_state.by_class);
     drop(b);
     if !ctx.diags.errors.is_empty() {
         return Err(LoadFailure {
@@ -285,7 +316,8 @@ fn load(
             warnings: ctx.diags.warnings,
         });
     }
-    let summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
+    let mut summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
+    summary.textures_by_class = textures;
     Ok(LoadedScene {
         scene,
         warnings: ctx.diags.warnings,

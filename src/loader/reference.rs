@@ -120,6 +120,22 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
         ParamKind::NamedMaterial => ("string: a named material".to_string(), None),
         ParamKind::FourierFile => ("string: a `.bsdf` file".to_string(), None),
         ParamKind::Unsupported(_) => ("any".to_string(), None),
+        ParamKind::BoolOpt => ("bool".to_string(), None),
+        ParamKind::Int(d) => ("integer".to_string(), Some(format!("{d}"))),
+        ParamKind::Vector3([x, y, z]) => (
+            "vector3".to_string(),
+            Some(format!("{} {} {}", num(x), num(y), num(z))),
+        ),
+        ParamKind::Choice { default, options } => {
+            let list: Vec<String> = options.iter().map(|o| format!("`\"{o}\"`")).collect();
+            (
+                format!("string: one of {}", list.join(", ")),
+                Some(format!("`\"{default}\"`")),
+            )
+        }
+        ParamKind::Filename => ("string: a file name".to_string(), None),
+        ParamKind::SameTexture(d) => ("texture of the texture's type".to_string(), Some(num(d))),
+        ParamKind::SameValue(d) => ("value of the texture's type".to_string(), Some(num(d))),
     };
     (
         format!("{ty}{nonneg}"),

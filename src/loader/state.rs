@@ -2,8 +2,9 @@
 //! and transform stacks, current and named materials, textures, area light,
 //! ReverseOrientation, object definitions, and the option directives.
 
-use super::entities::{self, Textures};
+use super::entities;
 use super::material::{self, Lookup, MaterialSpec};
+use super::texture::{self as texture, Defined, TextureState, Textures};
 use super::Ctx;
 use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
 use crate::lang::Loc;
@@ -97,6 +98,8 @@ pub struct Builder<'s, 'c> {
     area_lights: HashMap<usize, AreaLightDesc>,
     named_material_defs: Vec<(String, Rc<MaterialSpec>)>,
     pub meshes: HashMap<std::path::PathBuf, Option<Arc<MeshData>>>,
+    /// Shared MIP maps and texture counts.
+    pub texture_state: TextureState,
     after_warned: bool,
     world_seen: bool,
     world_ended: bool,
@@ -145,6 +148,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             area_lights: HashMap::new(),
             named_material_defs: Vec::new(),
             meshes: HashMap::new(),
+            texture_state: TextureState::default(),
             after_warned: false,
             world_seen: false,
             world_ended: false,
@@ -435,14 +439,28 @@ impl<'s, 'c> Builder<'s, 'c> {
             }
             K::Texture => {
                 let Directive::Texture { name, kind, class, params } = &s.dir else { return };
-                let spec = entities::texture(self.ctx, name, kind, class, params, &self.graphics.textures);
-                if let Some((is_float, spec)) = spec {
-                    let tex = Rc::make_mut(&mut self.graphics.textures);
-                    let map = if is_float { &mut tex.float } else { &mut tex.spectrum };
-                    if map.contains_key(&name.value) {
-                        self.ctx.warn(name.loc, format!("texture \"{}\" redefined", name.value), "redefinition");
+                if self.ctm[0] != self.ctm[1] {
+                    self.ctx.warn(s.loc, "animated texture transform: the start transform is used", "this Texture");
+                }
+                let defined = texture::texture(self.ctx, name, kind, class, params, &self.graphics.textures, self.ctm[0], &mut self.texture_state);
+                let redefined = |ctx: &mut Ctx, old: Option<Loc>| {
+                    if let Some(old) = old {
+                        let at = ctx.sources.position(old);
+                        ctx.warn(name.loc, format!("texture \"{}\" redefined (first defined at {at})", name.value), "redefinition");
                     }
-                    map.insert(name.value.clone(), Rc::new(spec));
+                };
+                match defined {
+                    Some(Defined::Float(e)) => {
+                        let old = self.graphics.textures.float.get(&name.value).map(|o| o.loc);
+                        redefined(self.ctx, old);
+                        Rc::make_mut(&mut self.graphics.textures).float.insert(name.value.clone(), e);
+                    }
+                    Some(Defined::Spectrum(e)) => {
+                        let old = self.graphics.textures.spectrum.get(&name.value).map(|o| o.loc);
+                        redefined(self.ctx, old);
+                        Rc::make_mut(&mut self.graphics.textures).spectrum.insert(name.value.clone(), e);
+                    }
+                    None => {}
                 }
             }
             K::LightSource => {
@@ -646,16 +664,36 @@ impl<'s, 'c> Builder<'s, 'c> {
             params.mark_all_used();
             return None;
         };
+        // pbrt-v3 reads alpha textures for triangle meshes only.
+        let (alpha, shadow_alpha) = match geometry {
+            Geometry::TriangleMesh(_) => (
+                texture::shape_alpha(self.ctx, params, "alpha", &g.textures),
+                texture::shape_alpha(self.ctx, params, "shadowalpha", &g.textures),
+            ),
+            Geometry::Sphere { .. } => (None, None),
+        };
         let material = self.material_for_shape(&g.material, params, &g.textures);
         let area_light = area.map(|a| self.area_light(a));
         self.ctx
             .report_unused(params, &format!("Shape \"{}\"", name.value));
+        let emits = area_light.is_some_and(|a| a.l.max_element() > 0.0);
+        if alpha == Some(FloatTex::Constant(0.0)) && !emits {
+            // Every ray ignores it (an emitter stays: lights sample it).
+            self.skipped.push(format!(
+                "Shape \"{}\" at {}: \"alpha\" 0 makes it invisible to every ray (as pbrt-v3): left out",
+                name.value,
+                self.ctx.sources.position(stmts[i].loc)
+            ));
+            return None;
+        }
         Some(ShapeDesc {
             geometry,
             object_to_world: ctm,
             reverse_orientation: g.reverse,
             material,
             area_light,
+            alpha,
+            shadow_alpha,
         })
     }
 

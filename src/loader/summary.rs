@@ -29,6 +29,10 @@ pub struct Summary {
     pub materials_by_type: BTreeMap<&'static str, usize>,
     /// Materials of types pbrs does not know (read as mattes), by type.
     pub unknown_materials: BTreeMap<String, usize>,
+    /// Textures defined (`Texture` statements that made one), by class.
+    pub textures_by_class: BTreeMap<&'static str, usize>,
+    /// World shapes with an `alpha` or `shadowalpha` mask.
+    pub alpha_shapes: usize,
     pub objects: usize,
     pub object_shapes: usize,
     pub object_triangles: usize,
@@ -112,6 +116,7 @@ impl Summary {
                 .or_default() += 1;
             s.triangles += triangles(&sh.geometry);
             s.area_lights += usize::from(sh.area_light.is_some());
+            s.alpha_shapes += usize::from(sh.alpha.is_some() || sh.shadow_alpha.is_some());
         }
         for l in &scene.lights {
             let k = match l {
@@ -234,6 +239,21 @@ impl fmt::Display for Summary {
                 "            {}: unknown material type{}, read as matte (as pbrt-v3)",
                 names.join(", "),
                 if names.len() == 1 { "" } else { "s" }
+            )?;
+        }
+        if !self.textures_by_class.is_empty() {
+            writeln!(
+                f,
+                "textures:   {} ({})",
+                self.textures_by_class.values().sum::<usize>(),
+                by_type(&self.textures_by_class)
+            )?;
+        }
+        if self.alpha_shapes > 0 {
+            writeln!(
+                f,
+                "alpha:      {} shapes with alpha masks",
+                self.alpha_shapes
             )?;
         }
         if self.objects > 0 || self.instances > 0 {

@@ -7,7 +7,7 @@ use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
-use crate::render::shapes::{Sphere, TriangleMesh};
+use crate::render::shapes::{AlphaMask, Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::sync::Arc;
@@ -37,7 +37,7 @@ impl RenderScene {
             match &s.geometry {
                 scene::Geometry::TriangleMesh(m) => {
                     let mesh_index = meshes.len() as u32;
-                    let mut tm = world_mesh(m, to_world, s.reverse_orientation, s.material.0);
+                    let mut tm = world_mesh(m, to_world, s);
                     if let Some(a) = emit {
                         tm.first_light = Some(area.len() as u32);
                         for tri in 0..tm.triangle_count() {
@@ -244,12 +244,7 @@ fn object(obj: &scene::ObjectDesc) -> Object {
     let mut spheres = Vec::new();
     for s in &obj.shapes {
         match &s.geometry {
-            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(
-                m,
-                s.object_to_world,
-                s.reverse_orientation,
-                s.material.0,
-            )),
+            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, s.object_to_world, s)),
             &scene::Geometry::Sphere {
                 radius,
                 z_min,
@@ -270,8 +265,10 @@ fn object(obj: &scene::ObjectDesc) -> Object {
 }
 
 /// Transform an object-space mesh to world space (positions in f64 before
-/// rounding; normals by the inverse transpose).
-fn world_mesh(m: &scene::MeshData, to_world: DMat4, reverse: bool, material: u32) -> TriangleMesh {
+/// rounding; normals by the inverse transpose), with the shape's material,
+/// orientation and alpha masks.
+fn world_mesh(m: &scene::MeshData, to_world: DMat4, s: &ShapeDesc) -> TriangleMesh {
+    let (reverse, material) = (s.reverse_orientation, s.material.0);
     let p = m
         .positions
         .iter()
@@ -293,5 +290,11 @@ fn world_mesh(m: &scene::MeshData, to_world: DMat4, reverse: bool, material: u32
         reverse_orientation: reverse,
         material,
         first_light: None,
+        alpha: (s.alpha.is_some() || s.shadow_alpha.is_some()).then(|| {
+            Arc::new(AlphaMask {
+                alpha: s.alpha.clone(),
+                shadow: s.shadow_alpha.clone(),
+            })
+        }),
     }
 }

@@ -6,13 +6,15 @@
 //! Transforms are `f64` so that long chains of scene-file transforms do not lose
 //! precision before the render core converts geometry to `f32` world space.
 
+pub mod image;
 mod params;
 mod textures;
 
+pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
 pub use params::{
     FourierTable, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
 };
-pub use textures::{FloatTex, SpectrumTex};
+pub use textures::{FloatTex, SpectrumTex, Tex};
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::path::PathBuf;
@@ -196,6 +198,12 @@ pub struct ShapeDesc {
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
+    /// pbrt-v3's `alpha` mask (triangle meshes): hits where it is 0 are
+    /// ignored by every ray. `None`: no test.
+    pub alpha: Option<FloatTex>,
+    /// pbrt-v3's `shadowalpha`: hits where it is 0 are ignored by shadow
+    /// rays.
+    pub shadow_alpha: Option<FloatTex>,
 }
 
 #[derive(Clone, Debug)]

@@ -9,6 +9,7 @@
 
 use super::textures::{FloatTex, SpectrumTex};
 use super::MaterialId;
+use glam::Vec3;
 use std::sync::Arc;
 
 /// A spectrum default: RGB, or a sampled spectrum the loader converts to RGB
@@ -33,7 +34,29 @@ pub enum ParamKind {
     SpectrumTexture(Option<SpectrumDefault>),
     Float(f32),
     Bool(bool),
+    /// A bool without a default: absent unless given (the entity decides).
+    BoolOpt,
     String(&'static str),
+    Int(i32),
+    /// A `vector3` (or `vector`) value.
+    Vector3([f32; 3]),
+    /// A string that must be one of `options` (else a warning, and the
+    /// default, which is what pbrt-v3 falls back to in every such case).
+    Choice {
+        default: &'static str,
+        options: &'static [&'static str],
+    },
+    /// A file name as written (readers resolve it against the scene file's
+    /// directory, as pbrt-v3's `FindFilename`); empty if not given.
+    Filename,
+    /// Textures only: a texture of the texture's own type (a float texture
+    /// for a `float` texture, a spectrum texture for a `color` one) with
+    /// this default (a grey for spectra), e.g. `checkerboard`'s `tex1`.
+    SameTexture(f32),
+    /// Textures only: a plain value of the texture's own type (pbrt-v3's
+    /// `FindFloat` / `FindSpectrum`, no texture reference), e.g. `bilerp`'s
+    /// `v00`.
+    SameValue(f32),
     /// The name of a material made by `MakeNamedMaterial` (`mix`).
     NamedMaterial,
     /// A tabulated Fourier BSDF file (`.bsdf`, pbrt-v3's format).
@@ -171,10 +194,72 @@ impl ParamSpec {
             doc: why,
         }
     }
-    /// pbrt-v3's `bumpmap` float texture (not evaluated yet).
-    pub const BUMPMAP: ParamSpec = ParamSpec::unsupported(
+    pub const fn bool_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::BoolOpt,
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn int(name: &'static str, default: i32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Int(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn vector3(name: &'static str, default: [f32; 3], doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Vector3(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn choice(
+        name: &'static str,
+        default: &'static str,
+        options: &'static [&'static str],
+        doc: &'static str,
+    ) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Choice { default, options },
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn filename(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Filename,
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn same_tex(name: &'static str, default: f32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::SameTexture(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn same_value(name: &'static str, default: f32, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::SameValue(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    /// pbrt-v3's `bumpmap`: a float texture of displacements along the
+    /// shading normal, applied by `Material::bsdf_into` for every material.
+    pub const BUMPMAP: ParamSpec = ParamSpec::float_tex_opt(
         "bumpmap",
-        "bump mapping is not supported by pbrs yet: \"bumpmap\" ignored",
+        "displacement along the shading normal (pbrt-v3's Bump)",
     );
 }
 
@@ -186,6 +271,8 @@ pub enum ParamValue {
     Float(f32),
     Bool(bool),
     String(String),
+    Int(i32),
+    Vector(Vec3),
     Material(MaterialId),
     Fourier(Arc<FourierTable>),
 }
@@ -235,10 +322,29 @@ impl ParamValues {
             v => panic!("parameter \"{name}\" is {v:?}, not a bool"),
         }
     }
+    pub fn bool_opt(&self, name: &str) -> Option<bool> {
+        match self.get(name) {
+            Some(ParamValue::Bool(b)) => Some(*b),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a bool"),
+        }
+    }
     pub fn string(&self, name: &str) -> &str {
         match self.get(name) {
             Some(ParamValue::String(s)) => s,
             v => panic!("parameter \"{name}\" is {v:?}, not a string"),
+        }
+    }
+    pub fn int(&self, name: &str) -> i32 {
+        match self.get(name) {
+            Some(ParamValue::Int(i)) => *i,
+            v => panic!("parameter \"{name}\" is {v:?}, not an integer"),
+        }
+    }
+    pub fn vector(&self, name: &str) -> Vec3 {
+        match self.get(name) {
+            Some(ParamValue::Vector(v)) => *v,
+            v => panic!("parameter \"{name}\" is {v:?}, not a vector"),
         }
     }
     pub fn material(&self, name: &str) -> Option<MaterialId> {

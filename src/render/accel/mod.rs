@@ -16,7 +16,7 @@
 mod bvh4;
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
-use crate::render::shapes::{DiffGeom, Sphere, SurfacePoint, TriangleMesh};
+use crate::render::shapes::{intersect_triangle, DiffGeom, Sphere, SurfacePoint, TriangleMesh};
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
@@ -311,10 +311,14 @@ impl Level {
         let bvh = if prims.is_empty() {
             None
         } else {
+            // Triangles of meshes with alpha masks are left to the
+            // callbacks (like spheres), so that only they pay for the test.
             let (bvh, order) = Bvh4::build(&aabbs, build_params(aabbs.len()), |i| {
                 let p = prims[i];
-                (p.mesh != SPHERE_TAG && p.mesh != INSTANCE_TAG)
-                    .then(|| meshes[p.mesh as usize].vertices(p.index))
+                (p.mesh != SPHERE_TAG
+                    && p.mesh != INSTANCE_TAG
+                    && meshes[p.mesh as usize].alpha.is_none())
+                .then(|| meshes[p.mesh as usize].vertices(p.index))
             });
             prims = order.iter().map(|&i| prims[i as usize]).collect();
             Some(bvh)
@@ -352,7 +356,7 @@ impl Shapes<'_> {
             let prim = self.level.prims[pos as usize];
             let h = if prim.mesh == INSTANCE_TAG {
                 instance_hit(prim.index, t_max)
-            } else {
+            } else if prim.mesh == SPHERE_TAG {
                 let s = &self.spheres[prim.index as usize];
                 s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
                     t,
@@ -360,6 +364,8 @@ impl Shapes<'_> {
                     instance: NO_INSTANCE,
                     local: HitLocal::SpherePoint(p),
                 })
+            } else {
+                self.alpha_triangle(ray, prim, t_max, false)
             }?;
             other = Some(h);
             Some(h.t)
@@ -387,11 +393,29 @@ impl Shapes<'_> {
             let prim = self.level.prims[pos as usize];
             if prim.mesh == INSTANCE_TAG {
                 instance_hit(prim.index)
-            } else {
+            } else if prim.mesh == SPHERE_TAG {
                 self.spheres[prim.index as usize]
                     .intersect(ray.o, ray.d, ray.t_max)
                     .is_some()
+            } else {
+                self.alpha_triangle(ray, prim, ray.t_max, true).is_some()
             }
+        })
+    }
+
+    /// A triangle of a mesh with an alpha mask: hit, and not cut away
+    /// (pbrt-v3 tests `alpha` for every ray, and `shadowalpha` too for
+    /// shadow rays, after the hit is found and before it is accepted).
+    #[inline(never)]
+    fn alpha_triangle(&self, ray: &Ray, prim: PrimRef, t_max: f32, shadow: bool) -> Option<Hit> {
+        let m = &self.meshes[prim.mesh as usize];
+        let [p0, p1, p2] = m.vertices(prim.index);
+        let (t, b) = intersect_triangle(ray.o, ray.d, t_max, p0, p1, p2)?;
+        m.alpha_passes(prim.index, b, shadow).then_some(Hit {
+            t,
+            prim,
+            instance: NO_INSTANCE,
+            local: HitLocal::Bary(b),
         })
     }
 

@@ -236,16 +236,33 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<Image, String> {
         "Pf" => 1,
         m => return Err(format!("not a PFM file (magic {m:?})")),
     };
-    let w: usize = token()?.parse().map_err(|_| "bad PFM width".to_string())?;
-    let h: usize = token()?.parse().map_err(|_| "bad PFM height".to_string())?;
+    let w: u64 = token()?.parse().map_err(|_| "bad PFM width".to_string())?;
+    let h: u64 = token()?.parse().map_err(|_| "bad PFM height".to_string())?;
     let scale: f32 = token()?.parse().map_err(|_| "bad PFM scale".to_string())?;
     let data_start = pos + 1;
+    if w == 0 || h == 0 {
+        return Err(format!("the image is empty ({w}×{h} pixels)"));
+    }
+    // Bounded before anything is allocated (the header is untrusted).
+    let max = crate::scene::MAX_IMAGE_PIXELS;
+    if w.checked_mul(h).is_none_or(|n| n > max) {
+        return Err(format!(
+            "the image declares {w}×{h} pixels, more than pbrs reads ({max} pixels)"
+        ));
+    }
+    let (w, h) = (w as usize, h as usize);
     let n = w * h * channels;
     if bytes.len() < data_start + n * 4 {
         return Err(format!(
             "PFM data truncated: {w}x{h}x{channels} floats expected"
         ));
     }
+    // pbrt-v3 scales the values by |scale| unless it is 1.
+    let mag = if scale.abs() != 1.0 && scale.is_finite() {
+        scale.abs()
+    } else {
+        1.0
+    };
     let little = scale < 0.0;
     let mut data = vec![0.0f32; w * h * 3];
     for row in 0..h {
@@ -256,11 +273,12 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<Image, String> {
                 let src_c = if channels == 3 { c } else { 0 };
                 let o = data_start + 4 * ((row * w + x) * channels + src_c);
                 let b = [bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]];
-                data[3 * (y * w + x) + c] = if little {
+                let v = if little {
                     f32::from_le_bytes(b)
                 } else {
                     f32::from_be_bytes(b)
                 };
+                data[3 * (y * w + x) + c] = v * mag;
             }
         }
     }

@@ -233,7 +233,7 @@ impl Integrator {
                 l += w.beta * escaped(scene);
                 continue;
             };
-            let s = scene.geometry.surface(&hit);
+            let mut s = scene.geometry.surface(&hit);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 if w.pass < MAX_PASS_THROUGH {
@@ -247,7 +247,7 @@ impl Integrator {
                 continue;
             }
             let wo = -w.ray.d;
-            shade(scene, &hit, &s, material, false, &mut bsdf);
+            shade(scene, &hit, &mut s, material, false, &mut bsdf);
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
                 Integrator::Direct {
@@ -341,12 +341,14 @@ impl Integrator {
 }
 
 /// The BSDF of `material` at a hit, built into `bsdf`, with the hit's
-/// differential geometry computed only if the material uses it.
+/// differential geometry computed only if the material uses it. The hit's
+/// shading normal becomes the BSDF's (a bump map changes it; pbrt-v3's
+/// integrators then use the bumped `shading.n`).
 #[inline]
 fn shade(
     scene: &RenderScene,
     hit: &Hit,
-    s: &SurfaceHit,
+    s: &mut SurfaceHit,
     material: &Material,
     multiple_lobes: bool,
     bsdf: &mut Bsdf,
@@ -372,6 +374,7 @@ fn shade(
         };
         material.bsdf_into(&sc, &ctx, bsdf);
     }
+    s.point.ns = bsdf.frame.n;
 }
 
 /// Emission of the surface towards `wo` (zero unless it is an area light).
@@ -444,7 +447,7 @@ fn path_li(
             }
             break;
         };
-        let s = scene.geometry.surface(&hit);
+        let mut s = scene.geometry.surface(&hit);
         let wo = -ray.d;
         if let Some(light_index) = s.light {
             let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
@@ -471,7 +474,7 @@ fn path_li(
             ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
             continue;
         }
-        shade(scene, &hit, &s, material, true, &mut bsdf);
+        shade(scene, &hit, &mut s, material, true, &mut bsdf);
         if bsdf.has_non_specular() {
             l += beta * sample_light_mis(scene, &s, &bsdf, wo, sampler, scratch, lights);
         }

@@ -21,7 +21,7 @@
 //! | `thin` | bool | false | thin surface: diffuse blends with fake subsurface, diffuse transmission |
 //! | `flatness` | float texture | 0 | thin only: blend of diffuse towards fake subsurface |
 //! | `difftrans` | float texture | 1 | thin only: diffuse transmission, fraction difftrans/2 |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! The lobes, in pbrt-v3's order (with diffuse weight (1 − metallic)(1 − spectrans)
 //! and dt = difftrans/2), each added as pbrt-v3 adds it, even with a zero

@@ -9,7 +9,7 @@
 //! | `index` | float texture | 1.5 | index of refraction when `eta` is absent |
 //! | `uroughness`, `vroughness` | float texture | 0 | microfacet roughness along dp/du and dp/dv (0: smooth) |
 //! | `remaproughness` | bool | true | map roughness to α as pbrt-v3's `RoughnessToAlpha` |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! Smooth glass (both roughnesses 0) under the path tracer is one
 //! FresnelSpecular lobe; under directlighting and whitted a specular

@@ -4,7 +4,7 @@
 //! |---|---|---|---|
 //! | `Kd` | spectrum texture | 0.5 | reflectance |
 //! | `sigma` | float texture | 0 | Oren–Nayar facet slope σ in degrees (0: Lambertian), clamped to [0, 90] |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 
 use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{Bsdf, LambertianReflection, OrenNayar};

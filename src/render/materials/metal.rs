@@ -10,7 +10,7 @@
 //! | `uroughness` | float texture | `roughness` | roughness along dp/du |
 //! | `vroughness` | float texture | `roughness` | roughness along dp/dv |
 //! | `remaproughness` | bool | true | roughness → α as pbrt-v3's `RoughnessToAlpha` |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! The default η and k are pbrt-v3's measured copper, converted to RGB by the
 //! loader as pbrt-v3's `RGBSpectrum::FromSampled` does.

@@ -3,7 +3,7 @@
 //! | parameter | type | default | |
 //! |---|---|---|---|
 //! | `Kr` | spectrum texture | 0.9 | reflectance |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 
 use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{Bsdf, Fresnel, SpecularReflection};

@@ -1,7 +1,10 @@
 //! `mix`: a blend of two named materials (pbrt-v3's `MixMaterial`): the
 //! lobes of `namedmaterial1` weighted by `amount` and those of
 //! `namedmaterial2` weighted by 1 − `amount`, both clamped ≥ 0. The shading
-//! frame and η are material 1's. Mixes nest.
+//! frame and η are material 1's, bumped by material 1's `bumpmap` if it has
+//! one (material 2's bump map is ignored, as in pbrt-v3, where material 2's
+//! lobes join material 1's BSDF). `mix` itself has no `bumpmap` (pbrt-v3's
+//! `MixMaterial` does not bump). Mixes nest.
 //!
 //! | parameter | type | default | |
 //! |---|---|---|---|
@@ -16,7 +19,7 @@
 
 use super::{BsdfContext, Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::Bsdf;
-use crate::scene::{MaterialId, ParamSpec, ParamValues, SpectrumTex};
+use crate::scene::{FloatTex, MaterialId, ParamSpec, ParamValues, SpectrumTex};
 use glam::Vec3;
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -44,6 +47,9 @@ pub struct Mix {
     /// geometry, known once the materials are [`super::link_materials`]ed.
     pub anisotropic: bool,
     pub needs_geom: bool,
+    /// Material 1's bump map (through nested mixes), which bumps the hit
+    /// before either material's lobes are built.
+    pub leading_bump: Option<FloatTex>,
 }
 
 impl Mix {
@@ -55,6 +61,7 @@ impl Mix {
             m1: p.material("namedmaterial1"),
             m2: p.material("namedmaterial2"),
             anisotropic: false,
+            leading_bump: None,
         }
     }
 
@@ -70,6 +77,9 @@ impl Mix {
             self.needs_geom |= m.needs_geom();
         }
         self.needs_geom |= self.anisotropic;
+        self.leading_bump = self
+            .m1
+            .and_then(|m| before[m.0 as usize].leading_bump().cloned());
     }
 
     /// The most lobes the mix can add, given the same count for the

@@ -7,6 +7,7 @@
 //! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
 //! delegates to the files.
 
+mod bump;
 mod disney;
 mod glass;
 mod matte;
@@ -19,6 +20,7 @@ mod translucent;
 mod uber;
 
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use bump::bump;
 pub use disney::Disney;
 pub use glass::Glass;
 pub use matte::Matte;
@@ -35,6 +37,7 @@ use crate::render::bxdf::{roughness_to_alpha, MicrofacetDistribution, Trowbridge
 use crate::render::geometry::Frame;
 use crate::render::shapes::DiffGeom;
 use crate::scene::{FloatTex, MaterialDesc, MaterialId, ParamSpec, ParamValues, SpectrumTex};
+use std::sync::Arc;
 
 /// Whether pbrs renders a material kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -137,6 +140,16 @@ pub enum Material {
     Disney(Disney),
     /// `Material "none"`: no BSDF.
     None,
+    /// A material with a `bumpmap`: its shading frame is bumped before its
+    /// lobes are built (one code path for every material).
+    Bumped(Arc<Bumped>),
+}
+
+/// A material and its bump map.
+#[derive(Clone, Debug)]
+pub struct Bumped {
+    pub material: Material,
+    pub bumpmap: FloatTex,
 }
 
 impl Material {
@@ -144,9 +157,23 @@ impl Material {
     /// [`MATERIALS`]; the loader guarantees it). A `mix` needs
     /// [`link_materials`] afterwards.
     pub fn new(desc: &MaterialDesc) -> Material {
-        match kind(desc.kind) {
+        let m = match kind(desc.kind) {
             Some(k) => (k.build)(&desc.params),
             None => panic!("material kind \"{}\" is not in the table", desc.kind),
+        };
+        // Every material's `bumpmap` (ParamSpec::BUMPMAP) is read here. A
+        // constant 0 displaces nothing; another constant still moves the
+        // shading normal on curved surfaces (d·∂n/∂u), as in pbrt-v3.
+        match desc.params.get("bumpmap") {
+            Some(crate::scene::ParamValue::FloatTexture(b))
+                if b.as_constant() != Some(0.0) && !m.is_none() =>
+            {
+                Material::Bumped(Arc::new(Bumped {
+                    material: m,
+                    bumpmap: b.clone(),
+                }))
+            }
+            _ => m,
         }
     }
 
@@ -171,6 +198,7 @@ impl Material {
             Material::Uber(m) => m.needs_geom(),
             Material::Disney(m) => m.needs_geom(),
             Material::None => false,
+            Material::Bumped(_) => true,
         }
     }
 
@@ -183,6 +211,7 @@ impl Material {
             Material::Metal(m) => m.anisotropic(),
             Material::Substrate(m) => m.anisotropic(),
             Material::Uber(m) => m.anisotropic(),
+            Material::Bumped(b) => b.material.anisotropic(),
             Material::Disney(m) => m.anisotropic(),
             Material::Matte(_)
             | Material::Plastic(_)
@@ -208,6 +237,7 @@ impl Material {
             Material::Uber(m) => m.max_lobes(),
             Material::Disney(m) => m.max_lobes(),
             Material::None => 0,
+            Material::Bumped(b) => b.material.max_lobes(lobes_of),
         }
     }
 
@@ -220,8 +250,52 @@ impl Material {
 
     /// [`Material::bsdf`] written into `out` (reset first), so that the
     /// integrators build BSDFs in place.
+    ///
+    /// A bumped material is built at the bumped hit: the shading frame of
+    /// `out` (`out.frame.n`) is then the bumped shading normal, which the
+    /// integrators use for the cosine terms (pbrt-v3's `isect.shading.n`
+    /// after `Bump`).
     #[inline]
     pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+        match self.leading_bump() {
+            Some(b) => self.bumped_bsdf_into(b, sc, ctx, out),
+            None => self.unbumped_bsdf_into(sc, ctx, out),
+        }
+    }
+
+    /// The bump map that sets the BSDF's shading frame: the material's own,
+    /// or for a mix, that of its first material (recursively), since
+    /// pbrt-v3's `MixMaterial` keeps material 1's bumped interaction.
+    #[inline]
+    fn leading_bump(&self) -> Option<&FloatTex> {
+        match self {
+            Material::Bumped(b) => Some(&b.bumpmap),
+            Material::Mix(m) => m.leading_bump.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// The BSDF at the hit bumped by `bumpmap` (out of line: the common,
+    /// unbumped path stays small).
+    #[inline(never)]
+    fn bumped_bsdf_into(
+        &self,
+        bumpmap: &FloatTex,
+        sc: &ShadingContext,
+        ctx: &BsdfContext,
+        out: &mut Bsdf,
+    ) {
+        let (hit, geom) = bump(bumpmap, sc);
+        let bumped = ShadingContext {
+            hit: &hit,
+            geom: &geom,
+        };
+        self.unbumped_bsdf_into(&bumped, ctx, out);
+    }
+
+    /// The BSDF at `sc` as given (no bump step; the caller did it).
+    #[inline(always)]
+    fn unbumped_bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
         self.scatter(sc, ctx, out);
     }
@@ -242,6 +316,10 @@ impl Material {
             Material::Uber(m) => m.scatter(sc, bsdf),
             Material::Disney(m) => m.scatter(sc, bsdf),
             Material::None => {}
+            // The caller bumped the hit if this material leads the BSDF
+            // (see `leading_bump`); a mix's second material's bump map
+            // is ignored, as in pbrt-v3 (its lobes take material 1's frame).
+            Material::Bumped(b) => b.material.scatter(sc, ctx, bsdf),
         }
     }
 }

@@ -9,7 +9,7 @@
 //! | `Ks` | spectrum texture | 0.25 | glossy reflectance (clamped ≥ 0) |
 //! | `roughness` | float texture | 0.1 | microfacet roughness (isotropic) |
 //! | `remaproughness` | bool | true | roughness → α as pbrt-v3's `RoughnessToAlpha` |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! Lobes: Lambertian if Kd ≠ 0, then the microfacet reflection if Ks ≠ 0.
 

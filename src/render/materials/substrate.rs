@@ -10,7 +10,7 @@
 //! | `uroughness` | float texture | 0.1 | roughness along dp/du |
 //! | `vroughness` | float texture | 0.1 | roughness along dp/dv |
 //! | `remaproughness` | bool | true | roughness → α as pbrt-v3's `RoughnessToAlpha` |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! Lobes: the FresnelBlend if Kd or Ks ≠ 0.
 

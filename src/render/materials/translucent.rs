@@ -10,7 +10,7 @@
 //! | `transmit` | spectrum texture | 0.5 | fraction transmitted |
 //! | `roughness` | float texture | 0.1 | glossy roughness (isotropic) |
 //! | `remaproughness` | bool | true | roughness → α as pbrt-v3's `RoughnessToAlpha` |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! Lobes (weights clamped ≥ 0; none if reflect and transmit are both
 //! black): Lambertian reflection reflect·Kd, Lambertian transmission

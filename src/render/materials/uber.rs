@@ -14,7 +14,7 @@
 //! | `index` | float texture | 1.5 | index of refraction when `eta` is absent |
 //! | `opacity` | spectrum texture | 1 | 1 − opacity passes straight through |
 //! | `remaproughness` | bool | true | roughness → α as pbrt-v3's `RoughnessToAlpha` |
-//! | `bumpmap` | float texture | | not evaluated yet (warning) |
+//! | `bumpmap` | float texture | | displacement for bump mapping (every material: `bump.rs`) |
 //!
 //! Lobes, in pbrt-v3's order, each only if its weight is not black (all
 //! weights clamped ≥ 0; op = opacity):

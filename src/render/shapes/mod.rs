@@ -7,8 +7,8 @@ mod triangle;
 pub use sphere::Sphere;
 pub use sphere::{area_to_solid_angle, to_solid_angle};
 pub use triangle::{
-    intersect_triangle, pack_triangles, sample_triangle_point, TriangleMesh, TrianglePack,
-    TriangleRay, TriangleRay4,
+    intersect_triangle, pack_triangles, sample_triangle_point, AlphaMask, TriangleMesh,
+    TrianglePack, TriangleRay, TriangleRay4,
 };
 
 use glam::{Vec2, Vec3};

@@ -1,7 +1,11 @@
 use super::{coordinate_system, DiffGeom, ShapeSample, SurfacePoint};
+use crate::render::accel::SurfaceHit;
 use crate::render::geometry::{face_forward, gamma, Bounds3};
+use crate::render::materials::ShadingContext;
 use crate::render::sampling::uniform_sample_triangle;
+use crate::scene::FloatTex;
 use glam::{Vec2, Vec3, Vec4};
+use std::sync::Arc;
 
 /// A triangle mesh with vertices in world space. Vertex arrays are shared by
 /// all triangles (32-bit indices).
@@ -21,9 +25,45 @@ pub struct TriangleMesh {
     /// Index of the area light of this mesh's first triangle; triangle `i`
     /// has light `first_light + i` (one light per triangle, as pbrt-v3).
     pub first_light: Option<u32>,
+    /// pbrt-v3's alpha masks, if any (then the BVH hands this mesh's
+    /// triangles to [`TriangleMesh::alpha_passes`] instead of testing them
+    /// four at a time).
+    pub alpha: Option<Arc<AlphaMask>>,
+}
+
+/// A mesh's `alpha` and `shadowalpha` textures (at least one is set).
+#[derive(Clone, Debug)]
+pub struct AlphaMask {
+    /// Hits where it is 0 are ignored by every ray.
+    pub alpha: Option<FloatTex>,
+    /// Hits where it is 0 are ignored by shadow rays.
+    pub shadow: Option<FloatTex>,
 }
 
 impl TriangleMesh {
+    /// pbrt-v3's alpha test of a hit at barycentrics `b`: false if the hit
+    /// is to be ignored (`alpha` is 0 there, or for a shadow ray
+    /// `shadowalpha` is). The textures see the hit's point, uv and
+    /// dp/du, dp/dv, without differentials (pbrt-v3's `isectLocal`).
+    pub fn alpha_passes(&self, tri: u32, b: [f32; 3], shadow: bool) -> bool {
+        let Some(mask) = &self.alpha else {
+            return true;
+        };
+        let point = self.surface_point(tri, b);
+        let geom = self.diff_geom(tri, b, point.n);
+        let hit = SurfaceHit {
+            point,
+            material: self.material,
+            light: None,
+        };
+        let sc = ShadingContext {
+            hit: &hit,
+            geom: &geom,
+        };
+        let cut = |t: &Option<FloatTex>| t.as_ref().is_some_and(|t| t.eval(&sc) == 0.0);
+        !(cut(&mask.alpha) || (shadow && cut(&mask.shadow)))
+    }
+
     #[inline(always)]
     pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
         let i = 3 * tri as usize;

@@ -1,0 +1,51 @@
+//! `fbm`: fractional Brownian motion of Perlin noise at the 3D-mapped
+//! point (pbrt-v3's `FBm`), the same value in every channel.
+//!
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `octaves` | integer | 8 | most octaves (fewer where the footprint is large) |
+//! | `roughness` | float | 0.5 | amplitude factor per octave (ω) |
+
+use super::noise::fbm;
+use super::{Class, Mapping3D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use crate::render::materials::ShadingContext;
+use crate::scene::{ParamSpec, Tex};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::int("octaves", 8, "most octaves"),
+    ParamSpec::float("roughness", 0.5, "amplitude factor per octave"),
+];
+
+pub const CLASS: TextureClass = TextureClass {
+    name: "fbm",
+    unsupported: None,
+    mapping: MappingUse::ThreeD,
+    params: PARAMS,
+    doc: "fractional Brownian motion (sum of noise octaves)",
+    float: Some(build::<f32>),
+    spectrum: Some(build::<glam::Vec3>),
+};
+
+pub struct Fbm {
+    pub mapping: Mapping3D,
+    pub octaves: i32,
+    pub omega: f32,
+}
+
+fn build<T: TexValue>(b: &mut TexBuilder) -> Result<Tex<T>, String> {
+    Ok(Texture::new_handle(
+        b.name,
+        Class::Fbm(Fbm {
+            mapping: b.mapping3d,
+            octaves: b.params.int("octaves"),
+            omega: b.params.float("roughness"),
+        }),
+    ))
+}
+
+impl Fbm {
+    pub fn eval(&self, sc: &ShadingContext) -> f32 {
+        let (p, dpdx, dpdy) = self.mapping.map(sc);
+        fbm(p, dpdx, dpdy, self.omega, self.octaves)
+    }
+}
