@@ -5,6 +5,7 @@
 
 use super::color::sampled_to_rgb;
 use super::entities::{find_spectrum, float_opt, one, spectrum_value, TexValue, Textures};
+use super::fourier::fourier_table;
 use super::state::closest_name;
 use super::Ctx;
 use crate::lang::params::{ParamList, ParamType};
@@ -198,6 +199,14 @@ pub fn material(
         }
     };
     let (params, refs) = read_params(ctx, kind.params, l);
+    for s in kind.params {
+        let named = l
+            .plain(s.name, ParamType::String)
+            .is_some_and(|q| !q.strs()[0].is_empty());
+        if matches!(s.kind, ParamKind::FourierFile) && !named {
+            ctx.warn(spec.loc, format!("{what}: \"string {}\" is not given: the material does not scatter light (black, as pbrt-v3, which cannot open a file named \"\")", s.name), "no BSDF file");
+        }
+    }
     // Rough glass comes with the microfacet lobes; until then, say so.
     if kind.name == "glass" {
         let ur = params.float_tex("uroughness").and_then(|t| t.as_constant());
@@ -292,12 +301,13 @@ pub fn read_params(
                 });
                 None
             }
-            ParamKind::FourierFile => {
-                if let Some(q) = l.plain(s.name, ParamType::String) {
-                    ctx.warn(q.values_loc, format!("\"{}\": tabulated Fourier BSDF files are not supported by pbrs yet: ignored", s.name), "not read");
-                }
-                None
-            }
+            // pbrt-v3's FindFilename: an empty name is no name; a missing
+            // one is reported by `material` (which knows the statement).
+            ParamKind::FourierFile => l
+                .plain(s.name, ParamType::String)
+                .filter(|q| !q.strs()[0].is_empty())
+                .and_then(|q| fourier_table(ctx, &q.strs()[0], q.values_loc))
+                .map(ParamValue::Fourier),
             ParamKind::Unsupported(why) => {
                 for list in l.lists() {
                     if let Some(q) = list.get(s.name) {

@@ -3,11 +3,13 @@
 //! - [`state`]: the walk over statements with pbrt-v3's graphics state.
 //! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
-//! - [`color`]: spectra to linear RGB; [`ply`]: the PLY reader for `plymesh`.
+//! - [`color`]: spectra to linear RGB; [`ply`]: the PLY reader for `plymesh`;
+//!   [`fourier`]: the tabulated BSDF reader for the `fourier` material.
 //! - [`summary`]: what `pbrs --check` prints.
 
 pub mod color;
 pub mod entities;
+pub mod fourier;
 pub mod material;
 pub mod meshfile;
 pub mod ply;
@@ -17,8 +19,9 @@ pub mod summary;
 use crate::lang::params::ParamList;
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
 use crate::lang::{Diags, Loc, SourceMap};
-use crate::scene::SceneDescription;
+use crate::scene::{FourierTable, SceneDescription};
 use miette::Severity;
+use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -54,6 +57,9 @@ pub struct Ctx {
     pub diags: Diags,
     pub base_dir: PathBuf,
     pub loader: Box<dyn FileLoader>,
+    /// Tabulated BSDFs by resolved path, read once per scene (`None`: the
+    /// file could not be read, already reported).
+    pub fourier_tables: HashMap<PathBuf, Option<Arc<FourierTable>>>,
 }
 
 impl Ctx {
@@ -167,6 +173,7 @@ fn load(
         diags,
         base_dir,
         loader,
+        fourier_tables: HashMap::new(),
     };
     if !ctx.diags.errors.is_empty() {
         return Err(LoadFailure {

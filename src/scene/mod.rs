@@ -6,12 +6,12 @@
 //! Transforms are `f64` so that long chains of scene-file transforms do not lose
 //! precision before the render core converts geometry to `f32` world space.
 
+mod fourier;
 mod params;
 mod textures;
 
-pub use params::{
-    FourierTable, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
-};
+pub use fourier::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
+pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex};
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
