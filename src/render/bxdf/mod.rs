@@ -10,12 +10,14 @@
 //! `BSDF` with `Add` and no allocation per hit.
 
 mod bsdf;
+mod fourier;
 mod fresnel;
 mod lambertian;
 mod oren_nayar;
 mod specular;
 
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
+pub use fourier::FourierBsdf;
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use lambertian::{LambertianReflection, LambertianTransmission};
 pub use oren_nayar::OrenNayar;
@@ -125,18 +127,20 @@ pub trait BxdfModel {
 /// Generates the closed enum of lobes and its delegating impl.
 macro_rules! bxdfs {
     ($($(#[$doc:meta])* $variant:ident($ty:ty),)*) => {
-        /// The closed set of lobes; each variant is one struct of this module.
+        /// The closed set of lobes; each variant is one struct of this
+        /// module. `'a` is the lifetime of tabulated data a lobe refers to
+        /// (the material's: see `FourierBsdf`).
         #[derive(Clone, Copy, Debug)]
-        pub enum Bxdf {
+        pub enum Bxdf<'a> {
             $($(#[$doc])* $variant($ty),)*
         }
-        $(impl From<$ty> for Bxdf {
+        $(impl<'a> From<$ty> for Bxdf<'a> {
             #[inline]
-            fn from(b: $ty) -> Bxdf {
+            fn from(b: $ty) -> Bxdf<'a> {
                 Bxdf::$variant(b)
             }
         })*
-        impl BxdfModel for Bxdf {
+        impl BxdfModel for Bxdf<'_> {
             #[inline]
             fn flags(&self) -> BxdfFlags {
                 match self { $(Bxdf::$variant(b) => b.flags(),)* }
@@ -168,6 +172,7 @@ bxdfs! {
     SpecularReflection(SpecularReflection),
     SpecularTransmission(SpecularTransmission),
     FresnelSpecular(FresnelSpecular),
+    Fourier(FourierBsdf<'a>),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry

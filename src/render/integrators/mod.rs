@@ -343,13 +343,13 @@ impl Integrator {
 /// The BSDF of `material` at a hit, built into `bsdf`, with the hit's
 /// differential geometry computed only if the material uses it.
 #[inline]
-fn shade(
-    scene: &RenderScene,
+fn shade<'a>(
+    scene: &'a RenderScene,
     hit: &Hit,
     s: &SurfaceHit,
-    material: &Material,
+    material: &'a Material,
     multiple_lobes: bool,
-    bsdf: &mut Bsdf,
+    bsdf: &mut Bsdf<'a>,
 ) {
     let ctx = BsdfContext {
         materials: &scene.materials,

@@ -7,11 +7,13 @@
 //! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
 //! delegates to the files.
 
+mod fourier;
 mod glass;
 mod matte;
 mod mirror;
 
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use fourier::Fourier;
 pub use glass::Glass;
 pub use matte::Matte;
 pub use mirror::Mirror;
@@ -55,6 +57,7 @@ pub static MATERIALS: &[MaterialKind] = &[
         "kdsubsurface",
         "subsurface scattering comes with participating media",
     ),
+    fourier::KIND,
     unsupported("hair", "the hair BSDF comes after curves"),
 ];
 
@@ -106,6 +109,7 @@ pub enum Material {
     Matte(Matte),
     Mirror(Mirror),
     Glass(Glass),
+    Fourier(Fourier),
     /// `Material "none"`: no BSDF.
     None,
 }
@@ -133,6 +137,7 @@ impl Material {
             Material::Matte(m) => m.needs_geom(),
             Material::Mirror(m) => m.needs_geom(),
             Material::Glass(m) => m.needs_geom(),
+            Material::Fourier(m) => m.needs_geom(),
             Material::None => false,
         }
     }
@@ -141,12 +146,16 @@ impl Material {
     /// follows the shading dp/du (else any frame around the normal does).
     pub fn anisotropic(&self) -> bool {
         match self {
-            Material::Matte(_) | Material::Mirror(_) | Material::Glass(_) | Material::None => false,
+            Material::Matte(_)
+            | Material::Mirror(_)
+            | Material::Glass(_)
+            | Material::Fourier(_)
+            | Material::None => false,
         }
     }
 
     /// The BSDF at a hit (pbrt-v3's `ComputeScatteringFunctions`).
-    pub fn bsdf(&self, sc: &ShadingContext, ctx: &BsdfContext) -> Bsdf {
+    pub fn bsdf<'a>(&'a self, sc: &ShadingContext, ctx: &BsdfContext<'a>) -> Bsdf<'a> {
         let mut b = Bsdf::new(shading_frame(sc, false), sc.hit.point.n, 1.0);
         self.bsdf_into(sc, ctx, &mut b);
         b
@@ -155,12 +164,13 @@ impl Material {
     /// [`Material::bsdf`] written into `out` (reset first), so that the
     /// integrators build BSDFs in place.
     #[inline]
-    pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+    pub fn bsdf_into<'a>(&'a self, sc: &ShadingContext, ctx: &BsdfContext<'a>, out: &mut Bsdf<'a>) {
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
         match self {
             Material::Matte(m) => m.scatter(sc, out),
             Material::Mirror(m) => m.scatter(sc, out),
             Material::Glass(m) => m.scatter(sc, ctx, out),
+            Material::Fourier(m) => m.scatter(sc, out),
             Material::None => {}
         }
     }
