@@ -79,10 +79,12 @@ fn table(name: &str) -> FourierTable {
 
 /// The material as a scene declares it, loaded through the real loader
 /// (the file resolved against the repository root).
+/// Only the shape's material is kept (a fourier material refers to no other).
 fn fourier_materials(name: &str) -> Vec<Material> {
-    materials_of(&format!(
+    let (mut m, i) = materials_of(&format!(
         "\"fourier\" \"string bsdffile\" \"tests/inputs/fourier/{name}\""
-    ))
+    ));
+    vec![m.swap_remove(i)]
 }
 
 /// wo at polar angle `deg` (above the surface below 90°), azimuth off the axes.
@@ -399,7 +401,7 @@ WorldEnd
             let m = &materials[s.material.0 as usize];
             let mut ms = vec![m.clone()];
             ms.extend(materials.iter().cloned());
-            let n = bsdf_of(&ms, true).lobes().len();
+            let n = bsdf_of(&ms, 0, true).lobes().len();
             n
         })
         .collect();
@@ -408,11 +410,11 @@ WorldEnd
 
 #[test]
 fn missing_file_gives_a_black_material() {
-    let m = materials_of("\"fourier\" \"string bsdffile\" \"tests/inputs/fourier/none.bsdf\"");
+    let m = fourier_materials("none.bsdf");
     assert!(matches!(&m[0], Material::Fourier(f) if f.table.is_none()));
-    assert!(bsdf_of(&m, true).is_empty());
+    assert!(bsdf_of(&m, 0, true).is_empty());
     let m = fourier_materials("leather.bsdf");
-    let b = bsdf_of(&m, true);
+    let b = bsdf_of(&m, 0, true);
     assert_eq!(b.lobes().len(), 1);
     assert_eq!(
         b.lobes()[0].flags,
@@ -420,7 +422,7 @@ fn missing_file_gives_a_black_material() {
     );
     // pbrt-v3's FourierMaterial leaves the BSDF's eta at 1, even for glass.
     let g = fourier_materials("roughglass_alpha_0.2.bsdf");
-    assert_eq!(bsdf_of(&g, true).eta, 1.0);
+    assert_eq!(bsdf_of(&g, 0, true).eta, 1.0);
 }
 
 // ------------------------------------------------- the lobe
@@ -469,7 +471,7 @@ fn sampling_matches_pdf_chi2() {
     let mut n = 0;
     for name in FILES {
         let m = fourier_materials(name);
-        let b = bsdf_of(&m, true);
+        let b = bsdf_of(&m, 0, true);
         for &deg in angles(name) {
             n += 1;
             let wo = wo_at(deg);
@@ -571,7 +573,7 @@ fn rough_glass_pdf_uses_the_files_cdf() {
 fn sampled_values_equal_evaluation() {
     for name in FILES {
         let m = fourier_materials(name);
-        let b = bsdf_of(&m, true);
+        let b = bsdf_of(&m, 0, true);
         for &deg in angles(name) {
             let wo = wo_at(deg);
             let mut rng = Pcg32::with_sequence(deg as u64);
@@ -784,7 +786,7 @@ fn renders_without_nan_or_negative_samples() {
 #[test]
 fn material_lobe_is_the_table_lobe() {
     let m = fourier_materials("leather.bsdf");
-    let b: Bsdf = bsdf_of(&m, false);
+    let b: Bsdf = bsdf_of(&m, 0, false);
     let t = table("leather.bsdf");
     let lobe = FourierBsdf::new(&t);
     let (wo, wi) = (wo_at(40.0), Vec3::new(-0.3, 0.2, 0.9).normalize());

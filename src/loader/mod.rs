@@ -3,30 +3,35 @@
 //! - [`state`]: the walk over statements with pbrt-v3's graphics state.
 //! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
-//! - [`color`]: spectra to linear RGB; [`ply`]: the PLY reader for `plymesh`;
+//! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
+//!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`;
 //!   [`fourier`]: the tabulated BSDF reader for the `fourier` material.
 //! - [`summary`]: what `pbrs --check` prints.
 
+pub mod cie1931;
 pub mod color;
 pub mod entities;
 pub mod fourier;
 pub mod material;
 pub mod meshfile;
 pub mod ply;
+pub mod reference;
+pub mod spd;
 pub mod state;
 pub mod summary;
 
-use crate::lang::params::ParamList;
+use crate::lang::params::{Param, ParamList};
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
 use crate::lang::{Diags, Loc, SourceMap};
-use crate::scene::{FourierTable, SceneDescription};
+use crate::scene::{FourierTable, ParamKind, ParamSpec, SceneDescription};
+use glam::Vec3;
 use miette::Severity;
 use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-pub use summary::Summary;
+pub use summary::{DeclaredKind, Summary};
 
 /// A scene that loaded, with its warnings and a summary for `--check`.
 pub struct LoadedScene {
@@ -57,6 +62,9 @@ pub struct Ctx {
     pub diags: Diags,
     pub base_dir: PathBuf,
     pub loader: Box<dyn FileLoader>,
+    /// Spectrum files read so far, by resolved path, as RGB (pbrt-v3 reads
+    /// each file once: `cachedSpectra`).
+    pub spectra: HashMap<PathBuf, Vec3>,
     /// Tabulated BSDFs by resolved path, read once per scene (`None`: the
     /// file could not be read, already reported).
     pub fourier_tables: HashMap<PathBuf, Option<Arc<FourierTable>>>,
@@ -87,6 +95,19 @@ impl Ctx {
     }
 
     pub fn report_unused_except(&mut self, p: &ParamList, what: &str, except: &[&str]) {
+        self.report_unused_with_specs(p, what, except, &[]);
+    }
+
+    /// [`Ctx::report_unused_except`] for an entity kind with a `ParamSpec`
+    /// list: the warning's help says which type a known name takes, or
+    /// which known name is close ("did you mean").
+    pub fn report_unused_with_specs(
+        &mut self,
+        p: &ParamList,
+        what: &str,
+        except: &[&str],
+        specs: &[ParamSpec],
+    ) {
         for q in p.unused() {
             if except.contains(&q.name.as_str()) {
                 continue;
@@ -100,10 +121,74 @@ impl Ctx {
                     q.type_name, q.name
                 ),
                 "unused parameter",
-                None,
+                unused_hint(q, specs),
             );
             self.diags.warnings.push(r);
         }
+    }
+}
+
+/// The parameter types a spec accepts, the one to suggest first.
+fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
+    match kind {
+        ParamKind::FloatTexture(_) => &["float", "texture"],
+        ParamKind::SpectrumTexture(_) => {
+            &["rgb", "color", "xyz", "blackbody", "spectrum", "texture"]
+        }
+        ParamKind::Float(_) => &["float"],
+        ParamKind::Bool(_) => &["bool"],
+        ParamKind::String(_) | ParamKind::NamedMaterial | ParamKind::FourierFile => &["string"],
+        ParamKind::Unsupported(_) => &[],
+    }
+}
+
+/// Why an unused parameter was not read, when its kind's specs tell.
+fn unused_hint(q: &Param, specs: &[ParamSpec]) -> Option<String> {
+    let accepts = |s: &ParamSpec| accepted_types(s.kind).contains(&q.type_name);
+    if let Some(s) = specs.iter().find(|s| s.name == q.name) {
+        let types = accepted_types(s.kind);
+        if accepts(s) {
+            let n = q.count();
+            return (n != 1).then(|| format!("\"{}\" takes one value; {n} were given", q.name));
+        }
+        let forms: Vec<String> = types
+            .iter()
+            .filter(|t| **t != "color")
+            .map(|t| format!("\"{t} {}\"", q.name))
+            .collect();
+        let list = match forms.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => return None,
+        };
+        return Some(format!(
+            "\"{}\" is a {} parameter, not \"{}\": write {list}",
+            q.name,
+            kind_name(s.kind),
+            q.type_name
+        ));
+    }
+    let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
+    let close = state::closest_name(&q.name, &names)?;
+    let s = specs.iter().find(|s| s.name == close)?;
+    let ty = if accepts(s) {
+        q.type_name
+    } else {
+        accepted_types(s.kind).first()?
+    };
+    Some(format!("did you mean \"{ty} {close}\"?"))
+}
+
+fn kind_name(kind: ParamKind) -> &'static str {
+    match kind {
+        ParamKind::FloatTexture(_) => "float texture",
+        ParamKind::SpectrumTexture(_) => "spectrum texture",
+        ParamKind::Float(_) => "float",
+        ParamKind::Bool(_) => "bool",
+        ParamKind::String(_) => "string",
+        ParamKind::NamedMaterial => "named-material",
+        ParamKind::FourierFile => "file-name",
+        ParamKind::Unsupported(_) => "ignored",
     }
 }
 
@@ -173,6 +258,7 @@ fn load(
         diags,
         base_dir,
         loader,
+        spectra: HashMap::new(),
         fourier_tables: HashMap::new(),
     };
     if !ctx.diags.errors.is_empty() {

@@ -44,14 +44,34 @@ pub fn render_at(
     .expect("render failed")
 }
 
+/// The file of a converged pbrt-v3 reference: `STEM-128-SPP.pfm` in
+/// `scenes/references/` with the highest SPP (the Cornell boxes have 16384,
+/// the feature scenes 2048; "128" names the resolution set, and a few
+/// scenes of it are not square).
+pub fn reference_path(stem: &str) -> PathBuf {
+    let dir = repo().join("scenes/references");
+    let prefix = format!("{stem}-128-");
+    let best = std::fs::read_dir(&dir)
+        .expect("scenes/references")
+        .filter_map(|e| {
+            let name = e.ok()?.file_name().into_string().ok()?;
+            let spp: u32 = name
+                .strip_prefix(&prefix)?
+                .strip_suffix(".pfm")?
+                .parse()
+                .ok()?;
+            (spp > 64).then_some((spp, name))
+        })
+        .max();
+    match best {
+        Some((_, name)) => dir.join(name),
+        None => panic!("no converged reference {prefix}*.pfm"),
+    }
+}
+
 /// A converged pbrt-v3 reference from `scenes/references/`.
 pub fn reference(stem: &str) -> Image {
-    read_image(
-        &repo()
-            .join("scenes/references")
-            .join(format!("{stem}-128-16384.pfm")),
-    )
-    .expect("reference")
+    read_image(&reference_path(stem)).expect("reference")
 }
 
 /// pbrt-v3's own render at 64 spp (the noise to expect).
@@ -141,13 +161,24 @@ pub fn exists(p: &Path) -> bool {
 
 /// Renders with an explicit seed (independent scrambling per seed).
 pub fn render_seeded(
-    mut desc: SceneDescription,
+    desc: SceneDescription,
     res: u32,
     spp: u32,
     seed: u64,
 ) -> (Image, RenderStats) {
-    desc.film.xresolution = res;
-    desc.film.yresolution = res;
+    render_seeded_wh(desc, res, res, spp, seed)
+}
+
+/// [`render_seeded`] at `width`×`height`.
+pub fn render_seeded_wh(
+    mut desc: SceneDescription,
+    width: u32,
+    height: u32,
+    spp: u32,
+    seed: u64,
+) -> (Image, RenderStats) {
+    desc.film.xresolution = width;
+    desc.film.yresolution = height;
     desc.sampler.pixel_samples = spp;
     render(
         &desc,
@@ -170,10 +201,18 @@ pub fn average(images: &[Image]) -> Image {
     out
 }
 
-/// The materials of `Material {decl}` (and of named materials it refers
-/// to), loaded through the real scene loader; the first is the statement's.
-pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
-    let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n");
+/// The materials of `Material {decl}` (after the named materials it refers
+/// to, in the scene's order, linked as the renderer links them) and the
+/// index of the statement's own, loaded through the real scene loader.
+///
+/// `decl` may start with other statements (`MakeNamedMaterial` lines): then
+/// its last line is a whole `Material` statement.
+pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usize) {
+    let text = if decl.contains('\n') {
+        format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd\n")
+    } else {
+        format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n")
+    };
     let l = pbrs::loader::load_scene_str(&text, &repo().join("mem.pbrt"))
         .unwrap_or_else(|f| panic!("{decl}: {:?}", f.errors));
     let first = l.scene.shapes[0].material.0 as usize;
@@ -183,8 +222,8 @@ pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
         .iter()
         .map(pbrs::render::materials::Material::new)
         .collect();
-    m.swap(0, first);
-    m
+    pbrs::render::materials::link_materials(&mut m);
+    (m, first)
 }
 
 /// The BSDF of `Material {decl}` at a point with normals +z and, when the
@@ -192,13 +231,15 @@ pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
 /// (the BSDF may refer to them); for tabulated materials, whose tables are
 /// large, use [`bsdf_of`] with materials the test keeps.
 pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::materials::Bsdf<'static> {
-    bsdf_of(Vec::leak(materials_of(decl)), multiple_lobes)
+    let (materials, first) = materials_of(decl);
+    bsdf_of(Vec::leak(materials), first, multiple_lobes)
 }
 
-/// The BSDF of `materials[0]` (the others are what it may refer to) at the
-/// point of [`material_bsdf`].
+/// The BSDF of `materials[first]` (the others are what it may refer to) at
+/// the point of [`material_bsdf`].
 pub fn bsdf_of(
     materials: &[pbrs::render::materials::Material],
+    first: usize,
     multiple_lobes: bool,
 ) -> pbrs::render::materials::Bsdf<'_> {
     use glam::{Vec2, Vec3};
@@ -227,7 +268,7 @@ pub fn bsdf_of(
         materials,
         multiple_lobes,
     };
-    materials[0].bsdf(
+    materials[first].bsdf(
         &ShadingContext {
             hit: &hit,
             geom: &geom,

@@ -265,6 +265,7 @@ impl Instance {
             shading_dpdv: l * g.shading_dpdv,
             shading_dndu: n * g.shading_dndu,
             shading_dndv: n * g.shading_dndv,
+            ..DiffGeom::ZERO
         }
     }
 }

@@ -20,7 +20,7 @@ use std::sync::Arc;
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::fourier_file(
         "bsdffile",
-        "tabulated BSDF file (pbrt-v3's `.bsdf` format), relative to the scene file",
+        "tabulated BSDF (pbrt-v3's `.bsdf` format), relative to the top-level scene file's directory; read once per scene; missing or malformed: warning, black",
     ),
     ParamSpec::BUMPMAP,
 ];
@@ -48,6 +48,10 @@ impl Fourier {
 
     pub fn needs_geom(&self) -> bool {
         false
+    }
+
+    pub fn max_lobes(&self) -> usize {
+        1
     }
 
     #[inline]

@@ -35,11 +35,17 @@ pub struct Chi2Config {
     /// Seed of the PCG32 stream that drives `sample`.
     pub seed: u64,
     /// How each cell's expected count is integrated: `None`, adaptive
-    /// Simpson to a 1e-9 tolerance (analytic densities); `Some(n)`,
+    /// Simpson to `cell_tolerance` (analytic densities); `Some(n)`,
     /// composite Simpson with `n` intervals per axis (rounded up to even),
     /// for tabulated densities, whose f32 rounding and spline knots keep the
     /// adaptive rule from converging before its depth limit.
     pub simpson_intervals: Option<usize>,
+    /// Absolute error allowed in each cell's integrated probability; `None`:
+    /// 1e-9 × the cell's area. Peaked densities (glossy lobes) need a
+    /// looser bound to integrate in reasonable time: an error well below
+    /// `sqrt(p / sample_count)` for a cell of probability `p` does not move
+    /// the statistic.
+    pub cell_tolerance: Option<f64>,
 }
 
 impl Default for Chi2Config {
@@ -51,6 +57,7 @@ impl Default for Chi2Config {
             min_expected: 5.0,
             seed: 0,
             simpson_intervals: None,
+            cell_tolerance: None,
         }
     }
 }
@@ -276,8 +283,7 @@ fn finish(
     }
 }
 
-/// ∫∫ f(x, y) dy dx over a rectangle: adaptive Simpson in both directions,
-/// each started from 4 panels so narrow features are not missed.
+/// ∫∫ f(x, y) dy dx over a cell, by the rule `cfg` asks for.
 fn integrate_cell(
     f: &impl Fn(f64, f64) -> f64,
     x0: f64,
@@ -287,7 +293,7 @@ fn integrate_cell(
     cfg: &Chi2Config,
 ) -> f64 {
     match cfg.simpson_intervals {
-        None => integrate_2d(f, x0, x1, y0, y1),
+        None => integrate_2d(f, x0, x1, y0, y1, cfg.cell_tolerance),
         Some(n) => simpson_2d(f, x0, x1, y0, y1, n),
     }
 }
@@ -312,11 +318,23 @@ fn simpson_2d(f: &impl Fn(f64, f64) -> f64, x0: f64, x1: f64, y0: f64, y1: f64, 
     sum * hx * hy / 9.0
 }
 
-fn integrate_2d(f: &impl Fn(f64, f64) -> f64, x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
+/// ∫∫ f(x, y) dy dx over a rectangle: adaptive Simpson in both directions,
+/// each started from 4 panels so narrow features are not missed, to the
+/// absolute error `tolerance` (default 1e-9 × area).
+fn integrate_2d(
+    f: &impl Fn(f64, f64) -> f64,
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    tolerance: Option<f64>,
+) -> f64 {
     let area = (x1 - x0) * (y1 - y0);
-    let eps = 1e-9 * area.max(1e-12) / (x1 - x0);
+    let tol = tolerance.unwrap_or(1e-9 * area.max(1e-12));
+    // The inner integrals' errors add up over the outer interval.
+    let eps = tol / (x1 - x0);
     let inner = |x: f64| integrate_1d(&|y| f(x, y), y0, y1, eps, 14);
-    integrate_1d(&inner, x0, x1, 1e-9 * area.max(1e-12), 14)
+    integrate_1d(&inner, x0, x1, tol, 14)
 }
 
 fn integrate_1d(f: &impl Fn(f64) -> f64, a: f64, b: f64, eps: f64, depth: u32) -> f64 {
@@ -457,10 +475,10 @@ mod tests {
     fn integrator_handles_discontinuities() {
         // Indicator of the triangle x + y < 1 over the unit square: 1/2.
         let f = |x: f64, y: f64| if x + y < 1.0 { 1.0 } else { 0.0 };
-        let v = integrate_2d(&f, 0.0, 1.0, 0.0, 1.0);
+        let v = integrate_2d(&f, 0.0, 1.0, 0.0, 1.0, None);
         assert!((v - 0.5).abs() < 1e-5, "{v}");
         let g = |t: f64, _p: f64| t.sin();
-        let v = integrate_2d(&g, 0.0, PI, 0.0, 2.0 * PI);
+        let v = integrate_2d(&g, 0.0, PI, 0.0, 2.0 * PI, None);
         assert!((v - 4.0 * PI).abs() < 1e-9, "{v}");
     }
 

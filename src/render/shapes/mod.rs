@@ -40,6 +40,15 @@ pub struct DiffGeom {
     pub shading_dpdv: Vec3,
     pub shading_dndu: Vec3,
     pub shading_dndv: Vec3,
+    /// Screen-space derivatives of the hit point and of uv from the ray's
+    /// differentials (pbrt-v3's `ComputeDifferentials`); all zero when the
+    /// ray carries none (then textures are point-sampled).
+    pub dpdx: Vec3,
+    pub dpdy: Vec3,
+    pub dudx: f32,
+    pub dvdx: f32,
+    pub dudy: f32,
+    pub dvdy: f32,
 }
 
 impl DiffGeom {
@@ -54,6 +63,12 @@ impl DiffGeom {
         shading_dpdv: Vec3::ZERO,
         shading_dndu: Vec3::ZERO,
         shading_dndv: Vec3::ZERO,
+        dpdx: Vec3::ZERO,
+        dpdy: Vec3::ZERO,
+        dudx: 0.0,
+        dvdx: 0.0,
+        dudy: 0.0,
+        dvdy: 0.0,
     };
 }
 

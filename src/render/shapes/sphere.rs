@@ -265,6 +265,7 @@ impl Sphere {
             shading_dpdv: dpdv,
             shading_dndu: dndu,
             shading_dndv: dndv,
+            ..DiffGeom::ZERO
         }
     }
 
