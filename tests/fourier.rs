@@ -408,6 +408,47 @@ WorldEnd
     assert_eq!(lobes, [1, 1, 0, 0, 0, 0], "{all}");
 }
 
+/// Files served from memory by full path.
+struct ByPath(HashMap<std::path::PathBuf, Vec<u8>>);
+
+impl FileLoader for ByPath {
+    fn load(&self, path: &Path) -> Result<Vec<u8>, String> {
+        self.0
+            .get(path)
+            .cloned()
+            .ok_or_else(|| format!("no file {}", path.display()))
+    }
+}
+
+/// pbrt-v3 resolves `bsdffile` against its search directory, the top-level
+/// file's, also in an `Include`d file in another directory.
+#[test]
+fn included_files_resolve_against_the_top_level_directory() {
+    let inc = "Material \"fourier\" \"string bsdffile\" \"good.bsdf\"\nShape \"sphere\"\n";
+    let top = "WorldBegin\nInclude \"sub/inc.pbrt\"\nWorldEnd\n";
+    let files = |good_at: &str| {
+        let mut f = HashMap::new();
+        f.insert("/virtual/sub/inc.pbrt".into(), inc.as_bytes().to_vec());
+        f.insert(good_at.into(), input("roughgold_alpha_0.2.bsdf"));
+        ByPath(f)
+    };
+    let lobes = |good_at: &str| {
+        let l = load_scene_with(
+            top,
+            Path::new("/virtual/top.pbrt"),
+            Box::new(files(good_at)),
+        )
+        .unwrap_or_else(|f| panic!("{:?}", f.errors));
+        let ms: Vec<Material> = l.scene.materials.iter().map(Material::new).collect();
+        let i = l.scene.shapes[0].material.0 as usize;
+        let n = bsdf_of(&ms, i, true).lobes().len();
+        (n, l.warnings.len())
+    };
+    assert_eq!(lobes("/virtual/good.bsdf"), (1, 0));
+    // Next to the included file is not where pbrt-v3 looks.
+    assert_eq!(lobes("/virtual/sub/good.bsdf"), (0, 1));
+}
+
 #[test]
 fn missing_file_gives_a_black_material() {
     let m = fourier_materials("none.bsdf");

@@ -40,11 +40,11 @@
 //! rotate from and returns every `wi` on the axis (with the density of the
 //! sampled μi, φ); pbrs does the same (a set of measure zero).
 //!
-//! pbrt-v3's `Sample_f` uses the sampled luminance unclamped; here it is
-//! clamped at zero as its `f` clamps it, so that a sample's value is `f`'s
-//! and never negative. They differ only where the luminance is negative with
-//! a positive pdf, which needs a negative μ density too (pathological
-//! tables).
+//! pbrt-v3's `FourierBSDF::Sample_f` uses the sampled luminance unclamped,
+//! but its `BSDF::Sample_f` then replaces a non-specular sample's value by
+//! `f(wo, wi)`, which clamps it at zero; clamping here gives that value
+//! without a second interpolation (equal up to rounding: `f` recomputes
+//! cos φ from the normalised `wi`).
 
 use super::{sin2_theta, BxdfFlags, BxdfModel, BxdfSample};
 use crate::render::sampling::interpolation::{

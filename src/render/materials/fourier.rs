@@ -3,7 +3,7 @@
 //!
 //! | parameter | type | default | |
 //! |---|---|---|---|
-//! | `bsdffile` | string | | the `.bsdf` file, relative to the scene file's directory |
+//! | `bsdffile` | string | (none: warning, black) | the `.bsdf` file, relative to the top-level scene file's directory (pbrt-v3's search directory, also for an `Include`d file's materials); read once per scene |
 //! | `bumpmap` | float texture | | not evaluated yet (warning) |
 //!
 //! One [`FourierBsdf`] lobe (reflection and transmission, glossy); the
