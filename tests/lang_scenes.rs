@@ -98,6 +98,42 @@ const EXPECT: &[Expect] = &[
         materials: &[("matte", 2)],
         lines: &["objects:    1 (1 shapes, 43534 triangles), 100 instances"],
     },
+    Expect {
+        file: "materials-a.pbrt",
+        warnings: &[],
+        shapes: 9,
+        triangles: 12,
+        area_lights: 1,
+        materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
+        lines: &[
+            "materials:  7 (4 matte, 1 metal, 1 plastic, 1 substrate)",
+            "integrator: path, maxdepth 8, rrthreshold 1, light samples spatial",
+        ],
+    },
+    Expect {
+        file: "materials-direct.pbrt",
+        warnings: &[],
+        shapes: 9,
+        triangles: 12,
+        area_lights: 1,
+        materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
+        lines: &[
+            "materials:  7 (4 matte, 1 metal, 1 plastic, 1 substrate)",
+            "integrator: directlighting, maxdepth 5, strategy all",
+        ],
+    },
+    Expect {
+        file: "materials-whitted.pbrt",
+        warnings: &[],
+        shapes: 9,
+        triangles: 12,
+        area_lights: 1,
+        materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
+        lines: &[
+            "materials:  7 (4 matte, 1 metal, 1 plastic, 1 substrate)",
+            "integrator: whitted, maxdepth 5",
+        ],
+    },
 ];
 
 fn scenes_dir() -> std::path::PathBuf {

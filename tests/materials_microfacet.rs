@@ -364,8 +364,7 @@ fn rough_glass_lobes() {
     assert!(transmitted > 400, "{transmitted}");
 }
 
-const NAMED: &str = "\"matte\"
-MakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [0.8 0 0]
+const NAMED: &str = "MakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [0.8 0 0]
 MakeNamedMaterial \"coat\" \"string type\" \"plastic\"
 MakeNamedMaterial \"clear\" \"string type\" \"glass\" \"float index\" 1.7
 MakeNamedMaterial \"brushed\" \"string type\" \"metal\" \"float uroughness\" 0.05 \"float vroughness\" 0.3
@@ -429,20 +428,19 @@ Material \"mix\" \"string namedmaterial1\" \"inner\" \"string namedmaterial2\" \
     for (a, w) in s.iter().zip(want) {
         assert!((a - w).abs() < 1e-6, "{s:?} vs {want:?}");
     }
-    assert!(!warnings_of(&format!(
-        "WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd"
-    ))
-    .contains("lobes"));
+    assert!(
+        !warnings_of(&format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd")).contains("lobes")
+    );
 }
 
 #[test]
 fn mix_beyond_eight_lobes_warns_and_drops() {
     // uber with opacity, Kr and Kt has 5 lobes: two of them are 10.
     let decl = format!("{NAMED}Material \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"full\" \"rgb amount\" [0.3 0.3 0.3]");
-    let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd");
+    let text = format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd");
     let w = warnings_of(&text);
     assert!(
-        w.contains("mem.pbrt:8:") && w.contains("up to 10 lobes, more than the 8 a BSDF holds"),
+        w.contains("mem.pbrt:7:") && w.contains("up to 10 lobes, more than the 8 a BSDF holds"),
         "{w}"
     );
     let b = material_bsdf(&decl, false);
@@ -452,17 +450,15 @@ fn mix_beyond_eight_lobes_warns_and_drops() {
         "{NAMED}MakeNamedMaterial \"inner\" \"string type\" \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"red\"
 Material \"mix\" \"string namedmaterial1\" \"inner\" \"string namedmaterial2\" \"full\""
     );
-    let w = warnings_of(&format!(
-        "WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd"
-    ));
+    let w = warnings_of(&format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd"));
     assert!(
-        w.contains("mem.pbrt:9:") && w.contains("up to 11 lobes"),
+        w.contains("mem.pbrt:8:") && w.contains("up to 11 lobes"),
         "{w}"
     );
     assert_eq!(w.matches("lobes, more than").count(), 1, "{w}");
     // Within 8 (5 + 2): no warning.
     let w = warnings_of(&format!(
-        "WorldBegin\nMaterial {NAMED}Material \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"coat\"\nShape \"sphere\"\nWorldEnd"
+        "WorldBegin\n{NAMED}Material \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"coat\"\nShape \"sphere\"\nWorldEnd"
     ));
     assert!(!w.contains("lobes"), "{w}");
 }
