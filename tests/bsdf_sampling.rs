@@ -29,7 +29,7 @@ fn wo_at(deg: f32) -> Vec3 {
     Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
 }
 
-fn matte(kd: Vec3, sigma: f32) -> Bsdf {
+fn matte(kd: Vec3, sigma: f32) -> Bsdf<'static> {
     material_bsdf(
         &format!(
             "\"matte\" \"rgb Kd\" [{} {} {}] \"float sigma\" {sigma}",

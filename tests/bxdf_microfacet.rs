@@ -177,7 +177,7 @@ fn check_sampled_f(name: &str, b: &Bxdf, wo: Vec3) {
     assert!(n > 500, "{name}: only {n} samples");
 }
 
-fn reflection(d: Dist, fresnel: Fresnel) -> Bxdf {
+fn reflection(d: Dist, fresnel: Fresnel) -> Bxdf<'static> {
     MicrofacetReflection {
         r: Vec3::new(0.9, 0.7, 0.5),
         distribution: d.make(),
@@ -186,7 +186,7 @@ fn reflection(d: Dist, fresnel: Fresnel) -> Bxdf {
     .into()
 }
 
-fn transmission(d: Dist) -> Bxdf {
+fn transmission(d: Dist) -> Bxdf<'static> {
     MicrofacetTransmission {
         t: Vec3::new(0.9, 0.7, 0.5),
         distribution: d.make(),
@@ -196,7 +196,7 @@ fn transmission(d: Dist) -> Bxdf {
     .into()
 }
 
-fn blend(d: Dist) -> Bxdf {
+fn blend(d: Dist) -> Bxdf<'static> {
     FresnelBlend {
         rd: Vec3::new(0.6, 0.4, 0.2),
         rs: Vec3::new(0.05, 0.1, 0.3),

@@ -23,7 +23,7 @@ fn wo_at(deg: f32) -> Vec3 {
     Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
 }
 
-fn lobes() -> Vec<(&'static str, Bxdf)> {
+fn lobes() -> Vec<(&'static str, Bxdf<'static>)> {
     let r = Vec3::new(0.8, 0.5, 0.3);
     vec![
         ("diffuse", DisneyDiffuse { r }.into()),

@@ -36,7 +36,7 @@ const SETTINGS: [&str; 9] = [
     r#""bool thin" "true" "float sheen" 1 "float clearcoat" 1 "float clearcoatgloss" 0.3 "float spectrans" 0.7 "float roughness" 0.6 "float flatness" 0.3"#,
 ];
 
-fn disney(params: &str) -> Bsdf {
+fn disney(params: &str) -> Bsdf<'static> {
     material_bsdf(
         &format!("\"disney\" \"rgb color\" [0.8 0.5 0.3] {params}"),
         true,
@@ -360,7 +360,7 @@ fn albedo(b: &Bsdf, wo: Vec3, n: usize, seed: u64) -> (f64, f64) {
     )
 }
 
-fn white(params: &str) -> Bsdf {
+fn white(params: &str) -> Bsdf<'static> {
     material_bsdf(&format!("\"disney\" \"rgb color\" [1 1 1] {params}"), true)
 }
 

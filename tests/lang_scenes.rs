@@ -107,6 +107,7 @@ const EXPECT: &[Expect] = &[
         materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
         lines: &[
             "shapes:     9 (3 sphere, 6 trianglemesh)",
+            "materials:  7 (4 matte, 1 metal, 1 plastic, 1 substrate)",
             "integrator: path, maxdepth 8, rrthreshold 1, light samples spatial",
         ],
     },
@@ -119,6 +120,7 @@ const EXPECT: &[Expect] = &[
         materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
         lines: &[
             "shapes:     9 (3 sphere, 6 trianglemesh)",
+            "materials:  7 (4 matte, 1 metal, 1 plastic, 1 substrate)",
             "integrator: directlighting, maxdepth 5, strategy all",
         ],
     },
@@ -131,6 +133,7 @@ const EXPECT: &[Expect] = &[
         materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
         lines: &[
             "shapes:     9 (3 sphere, 6 trianglemesh)",
+            "materials:  7 (4 matte, 1 metal, 1 plastic, 1 substrate)",
             "integrator: whitted, maxdepth 5",
         ],
     },

@@ -46,6 +46,7 @@ fn kinds(b: &Bsdf) -> Vec<&'static str> {
             Bxdf::DisneyRetro(_) => "disney-retro",
             Bxdf::DisneySheen(_) => "disney-sheen",
             Bxdf::DisneyClearcoat(_) => "disney-clearcoat",
+            Bxdf::Fourier(_) => "fourier",
         })
         .collect()
 }

@@ -31,7 +31,8 @@ fn bumped_normal(m: &Material, at: &At) -> Vec3 {
         materials: &ms,
         multiple_lobes: true,
     };
-    m.bsdf(&at.sc(), &ctx).frame.n
+    let n = m.bsdf(&at.sc(), &ctx).frame.n;
+    n
 }
 
 #[track_caller]

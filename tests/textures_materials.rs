@@ -25,7 +25,7 @@ fn materials(world: &str) -> (Vec<Material>, usize, String) {
     (m, i, warnings(&s))
 }
 
-fn bsdf_at(m: &[Material], i: usize, at: &At) -> Bsdf {
+fn bsdf_at<'a>(m: &'a [Material], i: usize, at: &At) -> Bsdf<'a> {
     let ctx = BsdfContext {
         materials: m,
         multiple_lobes: true,

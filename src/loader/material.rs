@@ -5,6 +5,7 @@
 
 use super::color::sampled_to_rgb;
 use super::entities::{find_spectrum, float_opt, one, spectrum_value};
+use super::fourier::fourier_table;
 use super::state::closest_name;
 use super::texture::Textures;
 use super::{Ctx, DeclaredKind};
@@ -227,6 +228,14 @@ pub fn material(
         }
     };
     let (params, refs) = read_params(ctx, kind.params, l);
+    for s in kind.params {
+        let named = l
+            .plain(s.name, ParamType::String)
+            .is_some_and(|q| !q.strs()[0].is_empty());
+        if matches!(s.kind, ParamKind::FourierFile) && !named {
+            ctx.warn(spec.loc, format!("{what}: \"string {}\" is not given: the material does not scatter light (black, as pbrt-v3, which cannot open a file named \"\")", s.name), "no BSDF file");
+        }
+    }
     if kind.name == "disney" {
         for msg in materials::Disney::load_warnings(&params) {
             ctx.warn(spec.loc, format!("{what}: {msg}"), "disney");
@@ -404,12 +413,13 @@ pub fn read_params_as(
                 });
                 None
             }
-            ParamKind::FourierFile => {
-                if let Some(q) = l.plain(s.name, ParamType::String) {
-                    ctx.warn(q.values_loc, format!("\"{}\": tabulated Fourier BSDF files are not supported by pbrs yet: ignored", s.name), "not read");
-                }
-                None
-            }
+            // pbrt-v3's FindFilename: an empty name is no name; a missing
+            // one is reported by `material` (which knows the statement).
+            ParamKind::FourierFile => l
+                .plain(s.name, ParamType::String)
+                .filter(|q| !q.strs()[0].is_empty())
+                .and_then(|q| fourier_table(ctx, &q.strs()[0], q.values_loc))
+                .map(ParamValue::Fourier),
             ParamKind::Unsupported(why) => {
                 for list in l.lists() {
                     if let Some(q) = list.get(s.name) {

@@ -4,13 +4,15 @@
 //! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
 //! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
-//!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`.
+//!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`;
+//!   [`fourier`]: the tabulated BSDF reader for the `fourier` material.
 //! - [`image`]: image files for textures and lights, read once per scene.
 //! - [`summary`]: what `pbrs --check` prints.
 
 pub mod cie1931;
 pub mod color;
 pub mod entities;
+pub mod fourier;
 pub mod image;
 pub mod material;
 pub mod meshfile;
@@ -24,7 +26,7 @@ pub mod texture;
 use crate::lang::params::{Param, ParamList};
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
 use crate::lang::{Diags, Loc, SourceMap};
-use crate::scene::{ParamKind, ParamSpec, SceneDescription};
+use crate::scene::{FourierTable, ParamKind, ParamSpec, SceneDescription};
 use glam::Vec3;
 use miette::Severity;
 use std::collections::HashMap;
@@ -68,6 +70,9 @@ pub struct Ctx {
     /// Spectrum files read so far, by resolved path, as RGB (pbrt-v3 reads
     /// each file once: `cachedSpectra`).
     pub spectra: HashMap<PathBuf, Vec3>,
+    /// Tabulated BSDFs by resolved path, read once per scene (`None`: the
+    /// file could not be read, already reported).
+    pub fourier_tables: HashMap<PathBuf, Option<Arc<FourierTable>>>,
 }
 
 impl Ctx {
@@ -284,6 +289,7 @@ fn load(
         loader,
         images: Default::default(),
         spectra: HashMap::new(),
+        fourier_tables: HashMap::new(),
     };
     if !ctx.diags.errors.is_empty() {
         return Err(LoadFailure {

@@ -6,14 +6,14 @@
 //! Transforms are `f64` so that long chains of scene-file transforms do not lose
 //! precision before the render core converts geometry to `f32` world space.
 
+mod fourier;
 pub mod image;
 mod params;
 mod textures;
 
+pub use fourier::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
 pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
-pub use params::{
-    FourierTable, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
-};
+pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};
 
 use glam::{DMat4, DVec3, Vec2, Vec3};

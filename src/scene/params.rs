@@ -7,6 +7,7 @@
 //! the material's, texture references before values); `--check`, "did you
 //! mean", `grammar/REFERENCE.md` and the tests read the same lists.
 
+use super::fourier::FourierTable;
 use super::textures::{FloatTex, SpectrumTex};
 use super::MaterialId;
 use glam::Vec3;
@@ -361,28 +362,4 @@ impl ParamValues {
             Some(v) => panic!("parameter \"{name}\" is {v:?}, not a Fourier table"),
         }
     }
-}
-
-/// A tabulated BSDF in pbrt-v3's Fourier representation (the data of a
-/// `.bsdf` file; layout as pbrt-v3's `FourierBSDFTable`).
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct FourierTable {
-    /// Relative index of refraction of the layer stack (1: reflection only).
-    pub eta: f32,
-    /// Maximum Fourier order over all (μi, μo) pairs.
-    pub m_max: usize,
-    /// Colour channels: 1 (luminance) or 3 (Y, R, B as pbrt-v3 stores them).
-    pub n_channels: usize,
-    /// The discretised zenith cosines μ, increasing.
-    pub mu: Vec<f32>,
-    /// Per (μo, μi) pair: offset into `a` and order.
-    pub a_offset: Vec<u32>,
-    pub m: Vec<u32>,
-    /// Fourier coefficients (channel-major within each pair, as the file).
-    pub a: Vec<f32>,
-    /// a0 coefficients per pair (for sampling) and their CDF over μi.
-    pub a0: Vec<f32>,
-    pub cdf: Vec<f32>,
-    /// ∫ weights over μ for the recurrence (pbrt-v3's `recip`: 1/i).
-    pub recip: Vec<f32>,
 }

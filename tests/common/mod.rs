@@ -227,13 +227,25 @@ pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usiz
 }
 
 /// The BSDF of `Material {decl}` at a point with normals +z and, when the
-/// material needs them, dp/du = +x and dp/dv = +y.
-pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::materials::Bsdf {
+/// material needs them, dp/du = +x and dp/dv = +y. The materials are leaked
+/// (the BSDF may refer to them); for tabulated materials, whose tables are
+/// large, use [`bsdf_of`] with materials the test keeps.
+pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::materials::Bsdf<'static> {
+    let (materials, first) = materials_of(decl);
+    bsdf_of(Vec::leak(materials), first, multiple_lobes)
+}
+
+/// The BSDF of `materials[first]` (the others are what it may refer to) at
+/// the point of [`material_bsdf`].
+pub fn bsdf_of(
+    materials: &[pbrs::render::materials::Material],
+    first: usize,
+    multiple_lobes: bool,
+) -> pbrs::render::materials::Bsdf<'_> {
     use glam::{Vec2, Vec3};
     use pbrs::render::accel::SurfaceHit;
     use pbrs::render::materials::{BsdfContext, ShadingContext};
     use pbrs::render::shapes::{DiffGeom, SurfacePoint};
-    let (materials, first) = materials_of(decl);
     let hit = SurfaceHit {
         point: SurfacePoint {
             p: Vec3::ZERO,
@@ -253,7 +265,7 @@ pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::material
         ..DiffGeom::ZERO
     };
     let ctx = BsdfContext {
-        materials: &materials,
+        materials,
         multiple_lobes,
     };
     materials[first].bsdf(

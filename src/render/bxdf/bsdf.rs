@@ -18,8 +18,8 @@ pub const MAX_BXDFS: usize = 8;
 
 /// One lobe with its weight (pbrt-v3's `ScaledBxDF` when not one).
 #[derive(Clone, Copy, Debug)]
-pub struct Lobe {
-    pub bxdf: Bxdf,
+pub struct Lobe<'a> {
+    pub bxdf: Bxdf<'a>,
     pub scale: Vec3,
     /// `bxdf.flags()`, cached.
     pub flags: BxdfFlags,
@@ -47,19 +47,20 @@ impl BsdfSample {
     }
 }
 
+/// `'a`: the lifetime of the material the lobes may refer to.
 #[derive(Clone, Debug)]
-pub struct Bsdf {
+pub struct Bsdf<'a> {
     pub frame: Frame,
     pub ng: Vec3,
     /// Relative index of refraction (1 for opaque materials), for the path
     /// tracer's Russian roulette (pbrt-v3's `BSDF::eta`).
     pub eta: f32,
-    lobes: ArrayVec<Lobe, MAX_BXDFS>,
+    lobes: ArrayVec<Lobe<'a>, MAX_BXDFS>,
 }
 
-impl Bsdf {
+impl<'a> Bsdf<'a> {
     #[inline]
-    pub fn new(frame: Frame, ng: Vec3, eta: f32) -> Bsdf {
+    pub fn new(frame: Frame, ng: Vec3, eta: f32) -> Bsdf<'a> {
         Bsdf {
             frame,
             ng,
@@ -70,7 +71,7 @@ impl Bsdf {
 
     /// A BSDF with no lobes and a z-up frame, to be [`Bsdf::reset`].
     #[inline]
-    pub fn empty() -> Bsdf {
+    pub fn empty() -> Bsdf<'a> {
         let frame = Frame {
             s: Vec3::X,
             t: Vec3::Y,
@@ -91,12 +92,12 @@ impl Bsdf {
     /// Adds a lobe (pbrt-v3's `BSDF::Add`). Beyond [`MAX_BXDFS`] lobes are
     /// dropped; materials are checked at load time never to get there.
     #[inline]
-    pub fn add(&mut self, b: impl Into<Bxdf>) {
+    pub fn add(&mut self, b: impl Into<Bxdf<'a>>) {
         self.add_scaled(b, Vec3::ONE);
     }
 
     #[inline]
-    pub fn add_scaled(&mut self, b: impl Into<Bxdf>, scale: Vec3) {
+    pub fn add_scaled(&mut self, b: impl Into<Bxdf<'a>>, scale: Vec3) {
         let bxdf = b.into();
         let _ = self.lobes.try_push(Lobe {
             flags: bxdf.flags(),
@@ -114,7 +115,7 @@ impl Bsdf {
     }
 
     #[inline]
-    pub fn lobes(&self) -> &[Lobe] {
+    pub fn lobes(&self) -> &[Lobe<'a>] {
         &self.lobes
     }
 
@@ -301,7 +302,13 @@ impl Bsdf {
     /// `sample` for a BSDF of one lobe (the common case): no lobe choice,
     /// `u` used as it is, the value recomputed only for the hemisphere test.
     #[inline]
-    fn sample_one(&self, lobe: &Lobe, wo_w: Vec3, u: Vec2, flags: BxdfFlags) -> Option<BsdfSample> {
+    fn sample_one(
+        &self,
+        lobe: &Lobe<'a>,
+        wo_w: Vec3,
+        u: Vec2,
+        flags: BxdfFlags,
+    ) -> Option<BsdfSample> {
         if !lobe.flags.matches(flags) {
             return None;
         }

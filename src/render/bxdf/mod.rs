@@ -11,6 +11,7 @@
 
 mod bsdf;
 mod disney;
+mod fourier;
 mod fresnel;
 mod fresnel_blend;
 mod lambertian;
@@ -24,6 +25,7 @@ pub use disney::{
     fr_schlick, gtr1, schlick_r0_from_eta, schlick_weight, DisneyClearcoat, DisneyDiffuse,
     DisneyFakeSS, DisneyFresnel, DisneyMicrofacet, DisneyRetro, DisneySheen,
 };
+pub use fourier::FourierBsdf;
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use fresnel_blend::FresnelBlend;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
@@ -138,18 +140,20 @@ pub trait BxdfModel {
 /// Generates the closed enum of lobes and its delegating impl.
 macro_rules! bxdfs {
     ($($(#[$doc:meta])* $variant:ident($ty:ty),)*) => {
-        /// The closed set of lobes; each variant is one struct of this module.
+        /// The closed set of lobes; each variant is one struct of this
+        /// module. `'a` is the lifetime of tabulated data a lobe refers to
+        /// (the material's: see `FourierBsdf`).
         #[derive(Clone, Copy, Debug)]
-        pub enum Bxdf {
+        pub enum Bxdf<'a> {
             $($(#[$doc])* $variant($ty),)*
         }
-        $(impl From<$ty> for Bxdf {
+        $(impl<'a> From<$ty> for Bxdf<'a> {
             #[inline]
-            fn from(b: $ty) -> Bxdf {
+            fn from(b: $ty) -> Bxdf<'a> {
                 Bxdf::$variant(b)
             }
         })*
-        impl BxdfModel for Bxdf {
+        impl BxdfModel for Bxdf<'_> {
             #[inline]
             fn flags(&self) -> BxdfFlags {
                 match self { $(Bxdf::$variant(b) => b.flags(),)* }
@@ -189,6 +193,7 @@ bxdfs! {
     DisneyRetro(DisneyRetro),
     DisneySheen(DisneySheen),
     DisneyClearcoat(DisneyClearcoat),
+    Fourier(FourierBsdf<'a>),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry

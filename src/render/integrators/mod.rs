@@ -345,13 +345,13 @@ impl Integrator {
 /// shading normal becomes the BSDF's (a bump map changes it; pbrt-v3's
 /// integrators then use the bumped `shading.n`).
 #[inline]
-fn shade(
-    scene: &RenderScene,
+fn shade<'a>(
+    scene: &'a RenderScene,
     hit: &Hit,
     s: &mut SurfaceHit,
-    material: &Material,
+    material: &'a Material,
     multiple_lobes: bool,
-    bsdf: &mut Bsdf,
+    bsdf: &mut Bsdf<'a>,
 ) {
     let ctx = BsdfContext {
         materials: &scene.materials,

@@ -89,7 +89,7 @@ impl Mix {
     }
 
     #[inline]
-    pub fn scatter(&self, sc: &ShadingContext, ctx: &BsdfContext, bsdf: &mut Bsdf) {
+    pub fn scatter<'a>(&self, sc: &ShadingContext, ctx: &BsdfContext<'a>, bsdf: &mut Bsdf<'a>) {
         let s1 = self.amount.eval(sc).max(Vec3::ZERO);
         let s2 = (Vec3::ONE - s1).max(Vec3::ZERO);
         let material = |m: Option<MaterialId>| m.and_then(|id| ctx.materials.get(id.0 as usize));

@@ -9,6 +9,7 @@
 
 mod bump;
 mod disney;
+mod fourier;
 mod glass;
 mod matte;
 mod metal;
@@ -22,6 +23,7 @@ mod uber;
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
 pub use bump::bump;
 pub use disney::Disney;
+pub use fourier::Fourier;
 pub use glass::Glass;
 pub use matte::Matte;
 pub use metal::Metal;
@@ -71,6 +73,7 @@ pub static MATERIALS: &[MaterialKind] = &[
     substrate::KIND,
     uber::KIND,
     disney::KIND,
+    fourier::KIND,
     NONE_KIND,
     unsupported(
         "subsurface",
@@ -138,6 +141,7 @@ pub enum Material {
     Substrate(Substrate),
     Uber(Uber),
     Disney(Disney),
+    Fourier(Fourier),
     /// `Material "none"`: no BSDF.
     None,
     /// A material with a `bumpmap`: its shading frame is bumped before its
@@ -197,6 +201,7 @@ impl Material {
             Material::Substrate(m) => m.needs_geom(),
             Material::Uber(m) => m.needs_geom(),
             Material::Disney(m) => m.needs_geom(),
+            Material::Fourier(m) => m.needs_geom(),
             Material::None => false,
             Material::Bumped(_) => true,
         }
@@ -213,10 +218,12 @@ impl Material {
             Material::Uber(m) => m.anisotropic(),
             Material::Bumped(b) => b.material.anisotropic(),
             Material::Disney(m) => m.anisotropic(),
+            // pbrt-v3's FourierBSDF is isotropic.
             Material::Matte(_)
             | Material::Plastic(_)
             | Material::Translucent(_)
             | Material::Mirror(_)
+            | Material::Fourier(_)
             | Material::None => false,
         }
     }
@@ -236,13 +243,14 @@ impl Material {
             Material::Substrate(m) => m.max_lobes(),
             Material::Uber(m) => m.max_lobes(),
             Material::Disney(m) => m.max_lobes(),
+            Material::Fourier(m) => m.max_lobes(),
             Material::None => 0,
             Material::Bumped(b) => b.material.max_lobes(lobes_of),
         }
     }
 
     /// The BSDF at a hit (pbrt-v3's `ComputeScatteringFunctions`).
-    pub fn bsdf(&self, sc: &ShadingContext, ctx: &BsdfContext) -> Bsdf {
+    pub fn bsdf<'a>(&'a self, sc: &ShadingContext, ctx: &BsdfContext<'a>) -> Bsdf<'a> {
         let mut b = Bsdf::new(shading_frame(sc, false), sc.hit.point.n, 1.0);
         self.bsdf_into(sc, ctx, &mut b);
         b
@@ -256,7 +264,7 @@ impl Material {
     /// integrators use for the cosine terms (pbrt-v3's `isect.shading.n`
     /// after `Bump`).
     #[inline]
-    pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+    pub fn bsdf_into<'a>(&'a self, sc: &ShadingContext, ctx: &BsdfContext<'a>, out: &mut Bsdf<'a>) {
         match self.leading_bump() {
             Some(b) => self.bumped_bsdf_into(b, sc, ctx, out),
             None => self.unbumped_bsdf_into(sc, ctx, out),
@@ -278,12 +286,12 @@ impl Material {
     /// The BSDF at the hit bumped by `bumpmap` (out of line: the common,
     /// unbumped path stays small).
     #[inline(never)]
-    fn bumped_bsdf_into(
-        &self,
+    fn bumped_bsdf_into<'a>(
+        &'a self,
         bumpmap: &FloatTex,
         sc: &ShadingContext,
-        ctx: &BsdfContext,
-        out: &mut Bsdf,
+        ctx: &BsdfContext<'a>,
+        out: &mut Bsdf<'a>,
     ) {
         let (hit, geom) = bump(bumpmap, sc);
         let bumped = ShadingContext {
@@ -295,7 +303,12 @@ impl Material {
 
     /// The BSDF at `sc` as given (no bump step; the caller did it).
     #[inline(always)]
-    fn unbumped_bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
+    fn unbumped_bsdf_into<'a>(
+        &'a self,
+        sc: &ShadingContext,
+        ctx: &BsdfContext<'a>,
+        out: &mut Bsdf<'a>,
+    ) {
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
         self.scatter(sc, ctx, out);
     }
@@ -303,7 +316,7 @@ impl Material {
     /// Adds the material's lobes to `bsdf` and sets its η (the frame is
     /// the caller's; a `mix` adds both materials' lobes to one BSDF).
     #[inline]
-    pub fn scatter(&self, sc: &ShadingContext, ctx: &BsdfContext, bsdf: &mut Bsdf) {
+    pub fn scatter<'a>(&'a self, sc: &ShadingContext, ctx: &BsdfContext<'a>, bsdf: &mut Bsdf<'a>) {
         match self {
             Material::Matte(m) => m.scatter(sc, bsdf),
             Material::Plastic(m) => m.scatter(sc, bsdf),
@@ -315,6 +328,7 @@ impl Material {
             Material::Substrate(m) => m.scatter(sc, bsdf),
             Material::Uber(m) => m.scatter(sc, bsdf),
             Material::Disney(m) => m.scatter(sc, bsdf),
+            Material::Fourier(m) => m.scatter(sc, bsdf),
             Material::None => {}
             // The caller bumped the hit if this material leads the BSDF
             // (see `leading_bump`); a mix's second material's bump map

@@ -34,6 +34,12 @@ pub struct Chi2Config {
     pub min_expected: f64,
     /// Seed of the PCG32 stream that drives `sample`.
     pub seed: u64,
+    /// How each cell's expected count is integrated: `None`, adaptive
+    /// Simpson to `cell_tolerance` (analytic densities); `Some(n)`,
+    /// composite Simpson with `n` intervals per axis (rounded up to even),
+    /// for tabulated densities, whose f32 rounding and spline knots keep the
+    /// adaptive rule from converging before its depth limit.
+    pub simpson_intervals: Option<usize>,
     /// Absolute error allowed in each cell's integrated probability; `None`:
     /// 1e-9 × the cell's area. Peaked densities (glossy lobes) need a
     /// looser bound to integrate in reasonable time: an error well below
@@ -50,6 +56,7 @@ impl Default for Chi2Config {
             sample_count: 1_000_000,
             min_expected: 5.0,
             seed: 0,
+            simpson_intervals: None,
             cell_tolerance: None,
         }
     }
@@ -172,7 +179,7 @@ pub fn chi2_sphere(
         for ip in 0..np {
             let p0 = 2.0 * PI * ip as f64 / np as f64;
             let p1 = 2.0 * PI * (ip + 1) as f64 / np as f64;
-            expected[it * np + ip] = integrate_2d(&f, t0, t1, p0, p1, cfg.cell_tolerance);
+            expected[it * np + ip] = integrate_cell(&f, t0, t1, p0, p1, cfg);
         }
     }
     finish(observed, expected, invalid, rejected, (nt, np), cfg)
@@ -213,7 +220,7 @@ pub fn chi2_square(
         for iy in 0..ny {
             let y0 = iy as f64 / ny as f64;
             let y1 = (iy + 1) as f64 / ny as f64;
-            expected[ix * ny + iy] = integrate_2d(&f, x0, x1, y0, y1, cfg.cell_tolerance);
+            expected[ix * ny + iy] = integrate_cell(&f, x0, x1, y0, y1, cfg);
         }
     }
     finish(observed, expected, invalid, rejected, (nx, ny), cfg)
@@ -274,6 +281,41 @@ fn finish(
         cols,
         sample_count: cfg.sample_count,
     }
+}
+
+/// ∫∫ f(x, y) dy dx over a cell, by the rule `cfg` asks for.
+fn integrate_cell(
+    f: &impl Fn(f64, f64) -> f64,
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    cfg: &Chi2Config,
+) -> f64 {
+    match cfg.simpson_intervals {
+        None => integrate_2d(f, x0, x1, y0, y1, cfg.cell_tolerance),
+        Some(n) => simpson_2d(f, x0, x1, y0, y1, n),
+    }
+}
+
+/// Composite Simpson over a rectangle with `n` (made even) intervals per axis.
+fn simpson_2d(f: &impl Fn(f64, f64) -> f64, x0: f64, x1: f64, y0: f64, y1: f64, n: usize) -> f64 {
+    let n = (n.max(2) + 1) & !1;
+    let weight = |i: usize| match i {
+        0 => 1.0,
+        i if i == n => 1.0,
+        i if i % 2 == 1 => 4.0,
+        _ => 2.0,
+    };
+    let (hx, hy) = ((x1 - x0) / n as f64, (y1 - y0) / n as f64);
+    let mut sum = 0.0;
+    for i in 0..=n {
+        let x = x0 + hx * i as f64;
+        for j in 0..=n {
+            sum += weight(i) * weight(j) * f(x, y0 + hy * j as f64);
+        }
+    }
+    sum * hx * hy / 9.0
 }
 
 /// ∫∫ f(x, y) dy dx over a rectangle: adaptive Simpson in both directions,
@@ -438,5 +480,19 @@ mod tests {
         let g = |t: f64, _p: f64| t.sin();
         let v = integrate_2d(&g, 0.0, PI, 0.0, 2.0 * PI, None);
         assert!((v - 4.0 * PI).abs() < 1e-9, "{v}");
+    }
+
+    #[test]
+    fn composite_simpson_is_exact_on_cubics() {
+        let f = |x: f64, y: f64| x * x * x - 2.0 * x * y + y * y + 1.0;
+        // ∫₀¹∫₀² = 1/4·2 − 2·(1/2)·2 + 8/3 + 2
+        let exact = 0.5 - 2.0 + 8.0 / 3.0 + 2.0;
+        for n in [2, 3, 8] {
+            let v = simpson_2d(&f, 0.0, 1.0, 0.0, 2.0, n);
+            assert!((v - exact).abs() < 1e-12, "n {n}: {v} vs {exact}");
+        }
+        let g = |t: f64, _p: f64| t.sin();
+        let v = simpson_2d(&g, 0.0, PI, 0.0, 2.0 * PI, 16);
+        assert!((v - 4.0 * PI).abs() < 1e-3, "{v}");
     }
 }

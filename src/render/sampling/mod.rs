@@ -4,6 +4,7 @@
 
 pub mod chi2;
 pub mod distribution;
+pub mod interpolation;
 pub mod rng;
 pub mod warps;
 
