@@ -78,25 +78,26 @@ pub fn read_bsdf(bytes: &[u8], source: &str) -> Result<FourierTable, String> {
             "maximum Fourier order (mMax) {m_max} is above pbrs's limit of {MAX_FOURIER_ORDER}"
         ));
     }
-    // Where each array ends, in bytes (u64: no overflow for i32 counts).
-    let n = n_mu as u64;
-    let mu_end = HEADER_BYTES + 4 * n;
+    // Where each array ends, in bytes (u128: 12·nMu² overflows u64 for
+    // i32 counts; every end is checked against the file's length below).
+    let n = n_mu as u128;
+    let mu_end = HEADER_BYTES as u128 + 4 * n;
     let cdf_end = mu_end + 4 * n * n;
     let offsets_end = cdf_end + 8 * n * n;
-    let a_end = offsets_end + 4 * n_coeffs as u64;
+    let a_end = offsets_end + 4 * n_coeffs as u128;
     for (what, end) in [
         ("zenith nodes", mu_end),
         ("CDF table", cdf_end),
         ("offset and order table", offsets_end),
         ("Fourier coefficients", a_end),
     ] {
-        if end > len {
+        if end > len as u128 {
             return Err(format!(
                 "truncated: the {what} end at byte {end} (nMu {n_mu}, nCoeffs {n_coeffs}), the file has {len} bytes"
             ));
         }
     }
-    let floats = |from: u64, to: u64| -> Vec<f32> {
+    let floats = |from: u128, to: u128| -> Vec<f32> {
         bytes[from as usize..to as usize]
             .chunks_exact(4)
             .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -116,7 +117,7 @@ pub fn read_bsdf(bytes: &[u8], source: &str) -> Result<FourierTable, String> {
         eta,
         m_max: m_max as usize,
         n_channels: n_channels as usize,
-        mu: floats(HEADER_BYTES, mu_end),
+        mu: floats(HEADER_BYTES as u128, mu_end),
         cdf: floats(mu_end, cdf_end),
         offset_and_length,
         a: floats(offsets_end, a_end),
