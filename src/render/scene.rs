@@ -15,6 +15,9 @@ use std::sync::Arc;
 pub struct RenderScene {
     pub geometry: Geometry,
     pub materials: Vec<Material>,
+    /// `materials[i].needs_geom()`, computed once: the answer walks the
+    /// material's textures (and a mix's materials), too much for every hit.
+    pub material_needs_geom: Vec<bool>,
     pub lights: Vec<Light>,
     /// Indices of infinite lights (seen by rays that escape).
     pub infinite_lights: Vec<u32>,
@@ -226,9 +229,11 @@ impl RenderScene {
             ));
         }
         let camera = Camera::new(&desc.camera, desc.film.xresolution, desc.film.yresolution);
+        let material_needs_geom = materials.iter().map(Material::needs_geom).collect();
         RenderScene {
             geometry,
             materials,
+            material_needs_geom,
             lights,
             infinite_lights,
             camera,

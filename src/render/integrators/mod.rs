@@ -344,7 +344,7 @@ impl Integrator {
 /// differential geometry computed only if the material uses it. The hit's
 /// shading normal becomes the BSDF's (a bump map changes it; pbrt-v3's
 /// integrators then use the bumped `shading.n`).
-#[inline]
+#[inline(always)]
 fn shade<'a>(
     scene: &'a RenderScene,
     hit: &Hit,
@@ -357,7 +357,7 @@ fn shade<'a>(
         materials: &scene.materials,
         multiple_lobes,
     };
-    if material.needs_geom() {
+    if scene.material_needs_geom[s.material as usize] {
         let geom = scene.geometry.diff_geom(hit, s);
         material.bsdf_into(
             &ShadingContext {

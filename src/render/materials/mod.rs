@@ -310,7 +310,14 @@ impl Material {
         out: &mut Bsdf<'a>,
     ) {
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
-        self.scatter(sc, ctx, out);
+        match self {
+            // The most common material, inline at the hit; `scatter` is
+            // recursive (mix, bump) and stays a call with every material's
+            // code in it (measured: 8 M of 1018 M instructions on
+            // cornell-path).
+            Material::Matte(m) => m.scatter(sc, out),
+            _ => self.scatter(sc, ctx, out),
+        }
     }
 
     /// Adds the material's lobes to `bsdf` and sets its η (the frame is
