@@ -5,7 +5,7 @@
 use crate::render::accel::{Geometry, Instance, Object};
 use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
-use crate::render::lights::{AreaShape, Light, TriangleCache};
+use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::Material;
 use crate::render::shapes::{Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
@@ -19,6 +19,9 @@ pub struct RenderScene {
     /// Indices of infinite lights (seen by rays that escape).
     pub infinite_lights: Vec<u32>,
     pub camera: Camera,
+    /// Camera rays carry differentials (some material reads the
+    /// differential geometry, so textures can filter and bump maps step).
+    pub differentials: bool,
     /// What was built and what was skipped, for `--stats`.
     pub notes: Vec<String>,
 }
@@ -187,14 +190,21 @@ impl RenderScene {
                 },
                 LightDesc::Infinite {
                     radiance,
+                    ref image,
+                    light_to_world,
                     n_samples,
-                    ..
+                    sampling,
                 } => {
                     infinite_lights.push(lights.len() as u32);
                     Light::Infinite {
-                        l: radiance,
                         n_samples,
                         scene_radius,
+                        map: Arc::new(EnvMap::new(
+                            image.as_deref(),
+                            radiance,
+                            light_to_world,
+                            sampling,
+                        )),
                     }
                 }
             };
@@ -225,12 +235,14 @@ impl RenderScene {
             ));
         }
         let camera = Camera::new(&desc.camera, desc.film.xresolution, desc.film.yresolution);
+        let differentials = materials.iter().any(|m| m.needs_geom());
         RenderScene {
             geometry,
             materials,
             lights,
             infinite_lights,
             camera,
+            differentials,
             notes,
         }
     }

@@ -3,7 +3,7 @@
 //! one, specular lobes followed recursively) and `whitted`.
 
 use crate::render::accel::{Hit, SurfaceHit};
-use crate::render::geometry::{spawn_ray, Ray};
+use crate::render::geometry::{spawn_ray, Ray, RayDiff};
 use crate::render::lights::{
     pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
 };
@@ -40,6 +40,9 @@ impl RayCounts {
 #[derive(Clone, Copy, Debug)]
 struct Work {
     ray: Ray,
+    /// The ray's differentials, if it carries them (camera rays and their
+    /// specular bounces, as pbrt-v3's SpecularReflect/SpecularTransmit).
+    diff: Option<RayDiff>,
     beta: Vec3,
     depth: u32,
     pass: u32,
@@ -174,11 +177,13 @@ impl Integrator {
         }
     }
 
-    /// Radiance arriving at the camera along `ray`.
+    /// Radiance arriving at the camera along `ray`, with its differentials
+    /// if it has them.
     #[inline]
     pub fn li(
         &self,
         ray: Ray,
+        diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
@@ -190,6 +195,7 @@ impl Integrator {
                 lights,
             } => path_li(
                 ray,
+                diff,
                 scene,
                 sampler,
                 scratch,
@@ -198,7 +204,7 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.specular_tree_li(ray, scene, sampler, scratch)
+                self.specular_tree_li(ray, diff, scene, sampler, scratch)
             }
         }
     }
@@ -213,6 +219,7 @@ impl Integrator {
     fn specular_tree_li(
         &self,
         ray: Ray,
+        diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
@@ -221,6 +228,7 @@ impl Integrator {
         stack.clear();
         stack.push(Work {
             ray,
+            diff,
             beta: Vec3::ONE,
             depth: 0,
             pass: 0,
@@ -230,7 +238,7 @@ impl Integrator {
         while let Some(w) = stack.pop() {
             scratch.counts.closest += 1;
             let Some(hit) = scene.geometry.intersect(&w.ray) else {
-                l += w.beta * escaped(scene);
+                l += w.beta * escaped(scene, w.ray.d);
                 continue;
             };
             let s = scene.geometry.surface(&hit);
@@ -238,8 +246,10 @@ impl Integrator {
             if material.is_none() {
                 if w.pass < MAX_PASS_THROUGH {
                     let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                    // A spawned ray has no differentials (pbrt-v3's SpawnRay).
                     stack.push(Work {
                         ray,
+                        diff: None,
                         pass: w.pass + 1,
                         ..w
                     });
@@ -247,7 +257,14 @@ impl Integrator {
                 continue;
             }
             let wo = -w.ray.d;
-            shade(scene, &hit, &s, material, false, &mut bsdf);
+            // With differentials the geometry is needed for the specular
+            // children's differentials too, whatever the material.
+            let geom = w.diff.map(|d| {
+                let mut g = scene.geometry.diff_geom(&hit, &s);
+                g.compute_differentials(s.point.p, s.point.n, &d);
+                g
+            });
+            shade_geom(scene, &hit, &s, material, false, geom.as_ref(), &mut bsdf);
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
                 Integrator::Direct {
@@ -322,8 +339,18 @@ impl Integrator {
                         if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
                             let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                             let beta = w.beta * bs.f * cos / bs.pdf;
+                            let diff = match (&w.diff, &geom) {
+                                (Some(d), Some(g)) if i == 0 => {
+                                    Some(g.reflected(s.point.p, s.point.ns, wo, bs.wi, d))
+                                }
+                                (Some(d), Some(g)) => Some(
+                                    g.transmitted(s.point.p, s.point.ns, wo, bs.wi, bsdf.eta, d),
+                                ),
+                                _ => None,
+                            };
                             children[i] = Some(Work {
                                 ray,
+                                diff,
                                 beta,
                                 depth: w.depth + 1,
                                 pass: 0,
@@ -341,7 +368,8 @@ impl Integrator {
 }
 
 /// The BSDF of `material` at a hit, built into `bsdf`, with the hit's
-/// differential geometry computed only if the material uses it.
+/// differential geometry (and its screen-space derivatives when the ray
+/// has differentials) computed only if the material uses it.
 #[inline]
 fn shade(
     scene: &RenderScene,
@@ -349,13 +377,38 @@ fn shade(
     s: &SurfaceHit,
     material: &Material,
     multiple_lobes: bool,
+    diff: Option<&RayDiff>,
+    bsdf: &mut Bsdf,
+) {
+    let geom = match diff {
+        Some(d) if material.needs_geom() => {
+            let mut g = scene.geometry.diff_geom(hit, s);
+            g.compute_differentials(s.point.p, s.point.n, d);
+            Some(g)
+        }
+        _ => None,
+    };
+    shade_geom(scene, hit, s, material, multiple_lobes, geom.as_ref(), bsdf);
+}
+
+/// `shade` with the hit's differential geometry, if already computed.
+#[inline]
+fn shade_geom(
+    scene: &RenderScene,
+    hit: &Hit,
+    s: &SurfaceHit,
+    material: &Material,
+    multiple_lobes: bool,
+    geom: Option<&DiffGeom>,
     bsdf: &mut Bsdf,
 ) {
     let ctx = BsdfContext {
         materials: &scene.materials,
         multiple_lobes,
     };
-    if material.needs_geom() {
+    if let Some(geom) = geom.filter(|_| material.needs_geom()) {
+        material.bsdf_into(&ShadingContext { hit: s, geom }, &ctx, bsdf);
+    } else if material.needs_geom() {
         let geom = scene.geometry.diff_geom(hit, s);
         material.bsdf_into(
             &ShadingContext {
@@ -383,13 +436,13 @@ fn emitted(scene: &RenderScene, s: &SurfaceHit, wo: Vec3) -> Vec3 {
     }
 }
 
-/// Radiance of rays that leave the scene.
+/// Radiance of rays with direction `d` that leave the scene.
 #[inline]
-fn escaped(scene: &RenderScene) -> Vec3 {
+fn escaped(scene: &RenderScene, d: Vec3) -> Vec3 {
     scene
         .infinite_lights
         .iter()
-        .map(|&i| scene.lights[i as usize].le_escaped())
+        .map(|&i| scene.lights[i as usize].le(d))
         .sum()
 }
 
@@ -407,8 +460,10 @@ fn escaped(scene: &RenderScene) -> Vec3 {
 /// each direction sum to one, so the expected image is pbrt-v3's; the path
 /// lengths covered are the same (emission is collected at depth `maxdepth`,
 /// next-event estimation happens below it).
+#[allow(clippy::too_many_arguments)]
 fn path_li(
     mut ray: Ray,
+    diff: Option<RayDiff>,
     scene: &RenderScene,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
@@ -419,6 +474,9 @@ fn path_li(
     let mut l = Vec3::ZERO;
     let mut bsdf = Bsdf::empty();
     let mut beta = Vec3::ONE;
+    // Only the camera ray has differentials: pbrt-v3's path tracer spawns
+    // every later ray without them, specular bounces included.
+    let mut diff = diff;
     let mut specular_bounce = false;
     let mut eta_scale = 1.0f32;
     let mut bounces = 0u32;
@@ -433,7 +491,7 @@ fn path_li(
         let Some(hit) = hit else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
-                let le = light.le_escaped();
+                let le = light.le(ray.d);
                 let w = match prev {
                     Some(r) if !specular_bounce => {
                         bsdf_mis_weight(scene, lights, &r, i, ray.d, bsdf_pdf)
@@ -469,9 +527,11 @@ fn path_li(
                 break;
             }
             ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            diff = None;
             continue;
         }
-        shade(scene, &hit, &s, material, true, &mut bsdf);
+        shade(scene, &hit, &s, material, true, diff.as_ref(), &mut bsdf);
+        diff = None;
         if bsdf.has_non_specular() {
             l += beta * sample_light_mis(scene, &s, &bsdf, wo, sampler, scratch, lights);
         }
@@ -715,7 +775,7 @@ fn estimate_direct(
                             Vec3::ZERO
                         }
                     }
-                    None => light.le_escaped(),
+                    None => light.le(bs.wi),
                 };
                 ld += f * li * weight / bs.pdf;
             }
