@@ -257,14 +257,23 @@ impl Integrator {
                 continue;
             }
             let wo = -w.ray.d;
-            // With differentials the geometry is needed for the specular
-            // children's differentials too, whatever the material.
-            let geom = w.diff.map(|d| {
+            let with_diff = |d: &RayDiff| {
                 let mut g = scene.geometry.diff_geom(&hit, &s);
-                g.compute_differentials(s.point.p, s.point.n, &d);
+                g.compute_differentials(s.point.p, s.point.n, d);
                 g
-            });
+            };
+            // A material that reads the geometry gets it with the ray's
+            // differentials; otherwise it is computed only if specular
+            // children will carry differentials.
+            let mut geom = w
+                .diff
+                .as_ref()
+                .filter(|_| material.needs_geom())
+                .map(with_diff);
             shade_geom(scene, &hit, &s, material, false, geom.as_ref(), &mut bsdf);
+            if geom.is_none() && bsdf.has_specular() {
+                geom = w.diff.as_ref().map(with_diff);
+            }
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
                 Integrator::Direct {
