@@ -79,6 +79,7 @@ fn render_golden(
 
 fn check(kind: &str) {
     let mut checked = 0;
+    let mut failed: Vec<String> = Vec::new();
     for e in manifest(&repo()) {
         let name = e
             .scene
@@ -88,10 +89,17 @@ fn check(kind: &str) {
         match &e.check {
             Check::Pbrt(stem) if kind == "pbrt" => {
                 checked += 1;
-                let r = reference(stem);
-                let (img, stats) = render_golden(&e.scene, &r, 0);
-                assert_eq!(stats.dropped_samples(), 0, "{}", e.scene);
-                assert_matches(&name, &img, &r, Bounds::against_pbrt(stem));
+                // Every scene is checked and reported, not only up to the
+                // first that fails.
+                let run = std::panic::catch_unwind(|| {
+                    let r = reference(stem);
+                    let (img, stats) = render_golden(&e.scene, &r, 0);
+                    assert_eq!(stats.dropped_samples(), 0, "{}", e.scene);
+                    assert_matches(&name, &img, &r, Bounds::against_pbrt(stem));
+                });
+                if run.is_err() {
+                    failed.push(name);
+                }
             }
             Check::Pbrs(_) | Check::PbrtOwnNoise(_) if kind == "own-noise" => {
                 checked += 1;
@@ -123,6 +131,11 @@ fn check(kind: &str) {
         }
     }
     assert!(checked > 0, "no scene of kind {kind} was checked");
+    assert!(
+        failed.is_empty(),
+        "scenes that do not match: {}",
+        failed.join(", ")
+    );
 }
 
 #[test]

@@ -180,3 +180,45 @@ fn reference_documents_every_directive_and_type() {
         );
     }
 }
+
+/// The material section of REFERENCE.md is what the generator writes from
+/// `render::materials::MATERIALS`; with `PBRS_WRITE_REFERENCE=1` the test
+/// rewrites it instead (then review and commit the diff).
+#[test]
+fn reference_material_section_is_generated_from_the_table() {
+    use pbrs::loader::reference::{materials_section, splice, MATERIALS_BEGIN, MATERIALS_END};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
+    let doc = std::fs::read_to_string(&path).unwrap();
+    let section = materials_section();
+    let Some(expected) = splice(&doc, &section) else {
+        panic!("REFERENCE.md lacks the lines {MATERIALS_BEGIN:?} and, after it, {MATERIALS_END:?}");
+    };
+    if std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1") {
+        if expected != doc {
+            std::fs::write(&path, &expected).unwrap();
+        }
+        return;
+    }
+    if expected != doc {
+        let first = doc
+            .lines()
+            .zip(expected.lines())
+            .position(|(a, b)| a != b)
+            .map_or_else(|| "(line count)".to_string(), |i| format!("line {}", i + 1));
+        panic!(
+            "grammar/REFERENCE.md's material section differs from the material table at {first}; \
+             regenerate it with `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` \
+             and commit the diff"
+        );
+    }
+    // What the section must say, read from the table itself (so that a
+    // generator that dropped rows would fail here too).
+    for k in pbrs::render::materials::MATERIALS {
+        assert!(section.contains(&format!("`{}`", k.name)), "{}", k.name);
+        for p in k.params {
+            let (ty, default) = pbrs::loader::reference::describe(p);
+            let row = format!("| `{}` | {ty} | {default} |", p.name);
+            assert!(section.contains(&row), "{}: no row {row:?}", k.name);
+        }
+    }
+}

@@ -337,8 +337,14 @@ fn colours() {
     let s = load(
         "WorldBegin\nMaterial \"matte\" \"spectrum Kd\" \"metal.spd\"\nShape \"sphere\"\nWorldEnd",
     );
-    assert!(warnings(&s).contains("spectrum files are not supported"));
-    assert_eq!(matte_of(&s.scene.materials[0]), (Vec3::splat(0.5), 0.0));
+    // A spectrum file that cannot be read is black, with a warning (pbrt-v3);
+    // files that can are tested in tests/lang_spectra.rs.
+    assert!(
+        warnings(&s).contains("cannot read spectrum file \"metal.spd\" for \"Kd\""),
+        "{}",
+        warnings(&s)
+    );
+    assert_eq!(matte_of(&s.scene.materials[0]), (Vec3::ZERO, 0.0));
 }
 
 #[test]
@@ -358,8 +364,11 @@ fn materials_and_substitutes() {
         glass_of(&m("\"glass\" \"float eta\" 2 \"float index\" 1.2").0),
         (Vec3::ONE, Vec3::ONE, 2.0)
     );
+    // Rough glass is rendered as rough glass: no warning.
     let (g, w) = m("\"glass\" \"float uroughness\" 0.1");
-    assert!(g.kind == "glass" && w.contains("treated as smooth"), "{w}");
+    assert!(g.kind == "glass" && w.is_empty(), "{w}");
+    assert_eq!(g.constant_float("uroughness"), Some(0.1));
+    assert_eq!(g.constant_float("vroughness"), Some(0.0));
     assert_eq!(
         m("\"mirror\"").0.constant_spectrum("Kr"),
         Some(Vec3::splat(0.9))
@@ -673,4 +682,119 @@ fn snippets_of_very_long_lines_are_cut() {
         &out[..out.len().min(500)]
     );
     assert!(out.len() < 2000, "snippet of {} bytes", out.len());
+}
+
+/// Each warning as its message, then its help (if any) after " | help: ".
+fn warnings_with_help(s: &LoadedScene) -> Vec<String> {
+    s.warnings
+        .iter()
+        .map(|w| match w.help() {
+            Some(h) => format!("{w} | help: {h}"),
+            None => w.to_string(),
+        })
+        .collect()
+}
+
+#[test]
+fn unused_material_parameters_say_what_was_meant() {
+    let one = |decl: &str| {
+        let s = load(&format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd"));
+        let w = warnings_with_help(&s);
+        assert_eq!(w.len(), 1, "{decl}: {w:?}");
+        (w[0].clone(), s)
+    };
+    let cases = [
+        // A known name with a type the kind does not read it as.
+        (
+            "Material \"matte\" \"float Kd\" 0.3",
+            "mem.pbrt:2:18: parameter \"float Kd\" not used by Material \"matte\" | help: \"Kd\" is a spectrum texture parameter, not \"float\": write \"rgb Kd\", \"xyz Kd\", \"blackbody Kd\", \"spectrum Kd\" or \"texture Kd\"",
+        ),
+        (
+            "Material \"glass\" \"rgb uroughness\" [0.1 0.1 0.1]",
+            "help: \"uroughness\" is a float texture parameter, not \"rgb\": write \"float uroughness\" or \"texture uroughness\"",
+        ),
+        (
+            "Material \"glass\" \"float remaproughness\" 0",
+            "help: \"remaproughness\" is a bool parameter, not \"float\": write \"bool remaproughness\"",
+        ),
+        // A name close to a known one: the type as written when it fits.
+        ("Material \"matte\" \"rgb kd\" [1 0 0]", "help: did you mean \"rgb Kd\"?"),
+        ("Material \"matte\" \"color Kdd\" [1 0 0]", "help: did you mean \"color Kd\"?"),
+        ("Material \"matte\" \"float sigm\" 10", "help: did you mean \"float sigma\"?"),
+        // ... and the kind's type when it does not.
+        ("Material \"mirror\" \"float kr\" 0.5", "help: did you mean \"rgb Kr\"?"),
+        (
+            "MakeNamedMaterial \"m\" \"string type\" \"glass\" \"float indx\" 1.3\nNamedMaterial \"m\"",
+            "not used by Material \"glass\" | help: did you mean \"float index\"?",
+        ),
+        // The right type, but a list where one value belongs.
+        (
+            "Material \"matte\" \"float sigma\" [10 20]",
+            "help: \"sigma\" takes one value; 2 were given",
+        ),
+    ];
+    for (decl, want) in cases {
+        let (w, _) = one(decl);
+        assert!(w.contains(want), "{decl}:\n  {w}\nlacks\n  {want}");
+    }
+    // Nothing close: no help.
+    let (w, _) = one("Material \"matte\" \"float zzzzzz\" 1");
+    assert!(!w.contains("help:"), "{w}");
+    // The value is not used: Kd keeps pbrt-v3's default.
+    let (_, s) = one("Material \"matte\" \"float Kd\" 0.3");
+    assert_eq!(matte_of(&s.scene.materials[0]), (Vec3::splat(0.5), 0.0));
+    // An unknown type is read as a matte: matte's names would mislead, so no help.
+    let s = load("WorldBegin\nMaterial \"plastik\" \"rgb Ks\" [1 1 1] \"rgb kd\" [1 0 0]\nShape \"sphere\"\nWorldEnd");
+    let w = warnings_with_help(&s);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("unknown material type \"plastik\"")),
+        "{w:?}"
+    );
+    let unused: Vec<&String> = w.iter().filter(|w| w.contains("not used")).collect();
+    assert_eq!(unused.len(), 2, "{w:?}");
+    assert!(unused.iter().all(|w| !w.contains("help:")), "{w:?}");
+}
+
+#[test]
+fn summary_counts_declared_material_kinds() {
+    use pbrs::render::materials::{kind, Support};
+    // The kdsubsurface has matte's default Kd, so its substitute equals the
+    // matte; it is still counted under its own kind.
+    let s = load("WorldBegin\nMaterial \"matte\"\nShape \"sphere\"\nMaterial \"glass\"\nShape \"sphere\"\nMaterial \"kdsubsurface\"\nShape \"sphere\"\nMaterial \"BUSH1\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\nWorldEnd");
+    let sum = &s.summary;
+    let by: Vec<(&str, usize)> = sum
+        .materials_by_type
+        .iter()
+        .map(|(k, v)| (*k, *v))
+        .collect();
+    assert_eq!(by, [("glass", 1), ("kdsubsurface", 1), ("matte", 1)]);
+    assert_eq!(sum.unknown_materials.get("BUSH1"), Some(&1));
+    assert_eq!(s.scene.materials.len(), 4);
+    let text = sum.to_string();
+    assert!(
+        text.contains("materials:  4 (1 glass, 1 kdsubsurface, 1 matte, 1 \"BUSH1\" (unknown))"),
+        "{text}"
+    );
+    let Some(Support::Unsupported(why)) = kind("kdsubsurface").map(|k| k.support) else {
+        panic!("kdsubsurface is in the table as unsupported");
+    };
+    assert!(
+        text.contains(&format!(
+            "kdsubsurface: not supported by pbrs ({why}), rendered as matte"
+        )),
+        "{text}"
+    );
+    assert!(
+        text.contains("\"BUSH1\": unknown material type, read as matte (as pbrt-v3)"),
+        "{text}"
+    );
+    // Only supported kinds: no extra lines.
+    let plain = load("WorldBegin\nMaterial \"glass\"\nShape \"sphere\"\nWorldEnd")
+        .summary
+        .to_string();
+    assert!(
+        plain.contains("materials:  1 (1 glass)\nwarnings:"),
+        "{plain}"
+    );
 }

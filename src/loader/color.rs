@@ -1,11 +1,15 @@
 //! Colours to linear RGB as pbrt-v3's default `RGBSpectrum` build does.
 //!
-//! `xyz` uses pbrt-v3's `XYZToRGB` matrix. Sampled spectra (`spectrum` pairs and
-//! `blackbody`) are integrated against the CIE 1931 2° colour matching functions
-//! over 360–830 nm at 1 nm as `RGBSpectrum::FromSampled` does; pbrs evaluates the
-//! matching functions with the multi-lobe Gaussian fit of Wyman, Sloan and Shirley
-//! (JCGT 2013) instead of the tabulated data, which agrees to about 1%.
+//! `xyz` uses pbrt-v3's `XYZToRGB` matrix. Sampled spectra (`spectrum` pairs,
+//! spectrum files and `blackbody`) are integrated against the tabulated CIE
+//! 1931 2° colour-matching functions ([`super::cie1931`]) at every nm from 360
+//! to 830 as `RGBSpectrum::FromSampled` does: the spectrum is interpolated
+//! linearly at each table wavelength (constant beyond its ends) and the sums
+//! are scaled by pbrt-v3's `CIE_Y_integral` normalisation, which makes a flat
+//! spectrum of 1 come out with Y = 470/471 (pbrt-v3 divides by the sample
+//! count, not by the 470 one-nm intervals).
 
+use super::cie1931::{CIE_1931_2DEG, CIE_LAMBDA_MAX, CIE_LAMBDA_MIN};
 use glam::Vec3;
 
 /// pbrt-v3 `XYZToRGB` (spectrum.h).
@@ -17,26 +21,20 @@ pub fn xyz_to_rgb(x: f64, y: f64, z: f64) -> Vec3 {
     )
 }
 
-fn lobe(l: f64, mu: f64, s1: f64, s2: f64) -> f64 {
-    let t = (l - mu) / if l < mu { s1 } else { s2 };
-    (-0.5 * t * t).exp()
+/// CIE 1931 x̄, ȳ, z̄ at a whole wavelength `l` in nm (0 outside 360–830).
+pub fn cie_xyz(l: i32) -> [f64; 3] {
+    if (CIE_LAMBDA_MIN..=CIE_LAMBDA_MAX).contains(&l) {
+        CIE_1931_2DEG[(l - CIE_LAMBDA_MIN) as usize]
+    } else {
+        [0.0; 3]
+    }
 }
 
-/// CIE 1931 x̄, ȳ, z̄ at wavelength `l` (nm), multi-lobe fit.
-pub fn cie_xyz(l: f64) -> [f64; 3] {
-    [
-        1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7)
-            - 0.065 * lobe(l, 501.1, 20.4, 26.2),
-        0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1),
-        1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8),
-    ]
-}
-
+/// pbrt-v3's `CIE_Y_integral` (spectrum.h).
 const CIE_Y_INTEGRAL: f64 = 106.856895;
-const LAMBDA_MIN: i32 = 360;
-const LAMBDA_MAX: i32 = 830;
 
-/// Piecewise-linear value of sorted samples at `l`, clamped at the ends.
+/// Piecewise-linear value of sorted samples at `l`, clamped at the ends
+/// (pbrt-v3 `InterpolateSpectrumSamples`).
 fn interpolate(samples: &[(f64, f64)], l: f64) -> f64 {
     let (first, last) = (samples[0], samples[samples.len() - 1]);
     if l <= first.0 {
@@ -53,28 +51,37 @@ fn interpolate(samples: &[(f64, f64)], l: f64) -> f64 {
     a.1 + t * (b.1 - a.1)
 }
 
-/// `RGBSpectrum::FromSampled`: (λ nm, value) pairs to linear RGB.
+/// `RGBSpectrum::FromSampled`: (λ nm, value) pairs to linear RGB. Pairs in
+/// any order are sorted first, as pbrt-v3 does; no pair gives black.
 pub fn sampled_to_rgb(pairs: &[f64]) -> Vec3 {
     let mut samples: Vec<(f64, f64)> = pairs.chunks_exact(2).map(|c| (c[0], c[1])).collect();
     if samples.is_empty() {
         return Vec3::ZERO;
     }
-    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     integrate(|l| interpolate(&samples, l))
 }
 
+/// The first wavelength that appears more than once among (λ, value) pairs.
+/// pbrt-v3 stops on a failed check for such a spectrum; pbrs warns and reads
+/// it as a step.
+pub fn repeated_wavelength(pairs: &[f64]) -> Option<f64> {
+    let mut l: Vec<f64> = pairs.chunks_exact(2).map(|c| c[0]).collect();
+    l.sort_by(f64::total_cmp);
+    l.windows(2).find(|w| w[0] == w[1]).map(|w| w[0])
+}
+
+/// The XYZ integral of `f` sampled at the table's wavelengths, to RGB.
 fn integrate(f: impl Fn(f64) -> f64) -> Vec3 {
     let mut xyz = [0.0f64; 3];
-    for l in LAMBDA_MIN..=LAMBDA_MAX {
-        let l = l as f64;
-        let v = f(l);
-        let c = cie_xyz(l);
+    for (i, c) in CIE_1931_2DEG.iter().enumerate() {
+        let v = f((CIE_LAMBDA_MIN + i as i32) as f64);
         for k in 0..3 {
             xyz[k] += v * c[k];
         }
     }
-    let n = (LAMBDA_MAX - LAMBDA_MIN + 1) as f64;
-    let scale = (LAMBDA_MAX - LAMBDA_MIN) as f64 / (CIE_Y_INTEGRAL * n);
+    let n = CIE_1931_2DEG.len() as f64;
+    let scale = (CIE_LAMBDA_MAX - CIE_LAMBDA_MIN) as f64 / (CIE_Y_INTEGRAL * n);
     xyz_to_rgb(xyz[0] * scale, xyz[1] * scale, xyz[2] * scale)
 }
 
@@ -101,16 +108,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn constant_spectrum_is_about_white() {
-        // A flat spectrum of 1 has Y = 1 and, in sRGB, roughly equal components
-        // (illuminant E is slightly pink in sRGB).
+    fn flat_spectrum_has_pbrt_v3_luminance() {
+        // Y of a flat 1 is ∑ȳ · 470 / (CIE_Y_INTEGRAL · 471): 470/471 up to the
+        // table's sum, pbrt-v3's normalisation. Y from RGB with sRGB's row.
         let c = sampled_to_rgb(&[300.0, 1.0, 900.0, 1.0]);
-        assert!(
-            (c.x - 1.2).abs() < 0.1 && (c.y - 0.95).abs() < 0.1 && (c.z - 0.9).abs() < 0.12,
-            "{c}"
+        let y = 0.2126729 * c.x + 0.7151522 * c.y + 0.0721750 * c.z;
+        let sum: f64 = CIE_1931_2DEG.iter().map(|c| c[1]).sum();
+        let want = sum * 470.0 / (CIE_Y_INTEGRAL * 471.0);
+        assert!((want - 470.0 / 471.0).abs() < 1e-6, "{want}");
+        assert!((y as f64 - want).abs() < 1e-4, "{y} vs {want}");
+        // Illuminant E is pink in sRGB.
+        assert!(c.x > c.y && c.y > c.z, "{c}");
+        assert_eq!(sampled_to_rgb(&[]), Vec3::ZERO);
+    }
+
+    #[test]
+    fn one_pair_is_constant_and_repeats_are_found() {
+        assert_eq!(
+            sampled_to_rgb(&[550.0, 0.5]),
+            sampled_to_rgb(&[300.0, 0.5, 900.0, 0.5])
         );
-        let y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-        assert!((y - 1.0).abs() < 0.03, "{y}");
+        assert_eq!(
+            repeated_wavelength(&[500.0, 1.0, 400.0, 2.0, 500.0, 3.0]),
+            Some(500.0)
+        );
+        assert_eq!(repeated_wavelength(&[500.0, 1.0, 400.0, 1.0]), None);
     }
 
     #[test]

@@ -2,9 +2,10 @@
 //! cameras, film, filters, samplers, integrators, materials, textures, lights and
 //! shapes. Every lookup marks its parameter used.
 
-use super::color::{blackbody_to_rgb, sampled_to_rgb, xyz_to_rgb};
+use super::color::{blackbody_to_rgb, repeated_wavelength, sampled_to_rgb, xyz_to_rgb};
 use super::meshfile::{read_gltf, read_obj};
 use super::ply::{read_ply, PlyMesh};
+use super::spd;
 use super::Ctx;
 use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::{resolve, Name};
@@ -64,20 +65,63 @@ fn point3(p: &ParamList, name: &str, def: DVec3) -> DVec3 {
         .unwrap_or(def)
 }
 
-/// A spectrum-typed parameter as linear RGB (`None` for spectrum file names, with a warning).
+/// A spectrum-typed parameter as linear RGB (`None` for a type that is not a spectrum).
 pub(super) fn spectrum_value(ctx: &mut Ctx, q: &Param) -> Option<Vec3> {
     let v = q.nums();
     match q.ty {
         ParamType::Rgb => Some(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)),
         ParamType::Xyz => Some(xyz_to_rgb(v[0], v[1], v[2])),
         ParamType::Blackbody => Some(blackbody_to_rgb(v[0], v[1])),
-        ParamType::Spectrum if !q.strs().is_empty() => {
-            ctx.warn(q.values_loc, format!("spectrum file \"{}\" for \"{}\": spectrum files are not supported by pbrs; the default is used", q.strs()[0], q.name), "spectrum file not read");
-            None
+        ParamType::Spectrum if !q.strs().is_empty() => Some(spectrum_file(ctx, q)),
+        ParamType::Spectrum => {
+            if let Some(l) = repeated_wavelength(v) {
+                ctx.warn(q.values_loc, format!("\"{}\": wavelength {l} nm is given twice (pbrt-v3 stops on a failed check here): read as a step", q.name), "repeated wavelength");
+            }
+            Some(sampled_to_rgb(v))
         }
-        ParamType::Spectrum => Some(sampled_to_rgb(v)),
         _ => None,
     }
+}
+
+/// A spectrum file named by `q` (pbrt-v3 `AddSampledSpectrumFiles`): read once
+/// per scene through `ctx.loader`, relative to the top-level file's directory.
+/// A file that cannot be read, or that holds no pair, gives black, as in
+/// pbrt-v3; problems inside it are warnings at the parameter.
+fn spectrum_file(ctx: &mut Ctx, q: &Param) -> Vec3 {
+    let name = &q.strs()[0];
+    let path = resolve(&ctx.base_dir, name);
+    if let Some(&c) = ctx.spectra.get(&path) {
+        return c;
+    }
+    let shown = path.display().to_string();
+    let rgb = match ctx.loader.load(&path) {
+        Err(e) => {
+            ctx.warn(
+                q.values_loc,
+                format!("cannot read spectrum file \"{shown}\" for \"{}\": {e}: black is used (as pbrt-v3)", q.name),
+                "spectrum file not read",
+            );
+            Vec3::ZERO
+        }
+        Ok(bytes) => {
+            let file = spd::parse(&String::from_utf8_lossy(&bytes));
+            for n in &file.notes {
+                ctx.warn(
+                    q.values_loc,
+                    format!("spectrum file \"{shown}\": {n}"),
+                    "in this spectrum file",
+                );
+            }
+            if file.pairs.is_empty() {
+                ctx.warn(q.values_loc, format!("spectrum file \"{shown}\" for \"{}\" holds no (wavelength, value) pair: black is used", q.name), "empty spectrum file");
+            } else if let Some(l) = repeated_wavelength(&file.pairs) {
+                ctx.warn(q.values_loc, format!("spectrum file \"{shown}\": wavelength {l} nm is given twice (pbrt-v3 stops on a failed check here): read as a step"), "repeated wavelength");
+            }
+            sampled_to_rgb(&file.pairs)
+        }
+    };
+    ctx.spectra.insert(path, rgb);
+    rgb
 }
 
 pub(super) fn find_spectrum<'a>(p: &'a ParamList, name: &str) -> Option<&'a Param> {
@@ -85,9 +129,10 @@ pub(super) fn find_spectrum<'a>(p: &'a ParamList, name: &str) -> Option<&'a Para
         .items
         .iter()
         .find(|q| q.name == name && q.ty.is_spectrum())?;
-    // One spectrum: one triple for rgb/xyz, one pair for blackbody, any pairs for spectrum.
+    // One spectrum: one triple for rgb/xyz, one pair for blackbody, any pairs
+    // or one file name for spectrum (several files are several spectra).
     let single = match q.ty {
-        ParamType::Spectrum => true,
+        ParamType::Spectrum => q.strs().len() <= 1,
         _ => q.count() == 1,
     };
     if single {

@@ -6,7 +6,7 @@
 use super::color::sampled_to_rgb;
 use super::entities::{find_spectrum, float_opt, one, spectrum_value, TexValue, Textures};
 use super::state::closest_name;
-use super::Ctx;
+use super::{Ctx, DeclaredKind};
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::Loc;
 use crate::render::materials::{self, MaterialKind, Support, MATERIALS};
@@ -143,18 +143,19 @@ pub struct NamedRef {
     pub loc: Loc,
 }
 
-/// Builds a material: its description, the kind's name for the summary,
+/// Builds a material: its description, its declared kind for the summary,
 /// and the named materials it refers to (for the caller to resolve).
 pub fn material(
     ctx: &mut Ctx,
     spec: &MaterialSpec,
     l: &Lookup,
-) -> (MaterialDesc, &'static str, Vec<NamedRef>) {
+) -> (MaterialDesc, DeclaredKind, Vec<NamedRef>) {
     let what = match &spec.name {
         Some(n) => format!("named material \"{n}\""),
         None => format!("Material \"{}\"", spec.ty),
     };
     let matte = materials::kind("matte").expect("matte is in the table");
+    let mut declared = None;
     let kind: &'static MaterialKind = match materials::kind(&spec.ty) {
         Some(k) => match k.support {
             Support::Supported => k,
@@ -178,7 +179,7 @@ pub fn material(
                         kind: "matte",
                         params,
                     },
-                    "matte",
+                    DeclaredKind::Table(k.name),
                     Vec::new(),
                 );
             }
@@ -194,16 +195,14 @@ pub fn material(
                 None => String::new(),
             };
             ctx.warn(spec.loc, format!("{what}: unknown material type \"{}\"{hint}: using \"matte\" with its parameters (as pbrt-v3)", spec.ty), "unknown material type");
+            declared = Some(DeclaredKind::Unknown(spec.ty.clone()));
             matte
         }
     };
     let (params, refs) = read_params(ctx, kind.params, l);
-    // Rough glass comes with the microfacet lobes; until then, say so.
-    if kind.name == "glass" {
-        let ur = params.float_tex("uroughness").and_then(|t| t.as_constant());
-        let vr = params.float_tex("vroughness").and_then(|t| t.as_constant());
-        if ur.unwrap_or(0.0) != 0.0 || vr.unwrap_or(0.0) != 0.0 {
-            ctx.warn(spec.loc, format!("{what}: rough glass (uroughness {ur:?}, vroughness {vr:?}) is not supported by pbrs yet: treated as smooth glass"), "rough glass");
+    if kind.name == "disney" {
+        for msg in materials::Disney::load_warnings(&params) {
+            ctx.warn(spec.loc, format!("{what}: {msg}"), "disney");
         }
     }
     (
@@ -211,7 +210,7 @@ pub fn material(
             kind: kind.name,
             params,
         },
-        kind.name,
+        declared.unwrap_or(DeclaredKind::Table(kind.name)),
         refs,
     )
 }

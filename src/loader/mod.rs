@@ -3,29 +3,35 @@
 //! - [`state`]: the walk over statements with pbrt-v3's graphics state.
 //! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
-//! - [`color`]: spectra to linear RGB; [`ply`]: the PLY reader for `plymesh`.
+//! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
+//!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`.
 //! - [`image`]: image files for textures and lights, read once per scene.
 //! - [`summary`]: what `pbrs --check` prints.
 
+pub mod cie1931;
 pub mod color;
 pub mod entities;
 pub mod image;
 pub mod material;
 pub mod meshfile;
 pub mod ply;
+pub mod reference;
+pub mod spd;
 pub mod state;
 pub mod summary;
 
-use crate::lang::params::ParamList;
+use crate::lang::params::{Param, ParamList};
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
 use crate::lang::{Diags, Loc, SourceMap};
-use crate::scene::SceneDescription;
+use crate::scene::{ParamKind, ParamSpec, SceneDescription};
+use glam::Vec3;
 use miette::Severity;
+use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-pub use summary::Summary;
+pub use summary::{DeclaredKind, Summary};
 
 /// A scene that loaded, with its warnings and a summary for `--check`.
 pub struct LoadedScene {
@@ -58,6 +64,9 @@ pub struct Ctx {
     pub loader: Box<dyn FileLoader>,
     /// Images read so far (each file is read once).
     pub images: image::ImageCache,
+    /// Spectrum files read so far, by resolved path, as RGB (pbrt-v3 reads
+    /// each file once: `cachedSpectra`).
+    pub spectra: HashMap<PathBuf, Vec3>,
 }
 
 impl Ctx {
@@ -85,6 +94,19 @@ impl Ctx {
     }
 
     pub fn report_unused_except(&mut self, p: &ParamList, what: &str, except: &[&str]) {
+        self.report_unused_with_specs(p, what, except, &[]);
+    }
+
+    /// [`Ctx::report_unused_except`] for an entity kind with a `ParamSpec`
+    /// list: the warning's help says which type a known name takes, or
+    /// which known name is close ("did you mean").
+    pub fn report_unused_with_specs(
+        &mut self,
+        p: &ParamList,
+        what: &str,
+        except: &[&str],
+        specs: &[ParamSpec],
+    ) {
         for q in p.unused() {
             if except.contains(&q.name.as_str()) {
                 continue;
@@ -98,10 +120,74 @@ impl Ctx {
                     q.type_name, q.name
                 ),
                 "unused parameter",
-                None,
+                unused_hint(q, specs),
             );
             self.diags.warnings.push(r);
         }
+    }
+}
+
+/// The parameter types a spec accepts, the one to suggest first.
+fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
+    match kind {
+        ParamKind::FloatTexture(_) => &["float", "texture"],
+        ParamKind::SpectrumTexture(_) => {
+            &["rgb", "color", "xyz", "blackbody", "spectrum", "texture"]
+        }
+        ParamKind::Float(_) => &["float"],
+        ParamKind::Bool(_) => &["bool"],
+        ParamKind::String(_) | ParamKind::NamedMaterial | ParamKind::FourierFile => &["string"],
+        ParamKind::Unsupported(_) => &[],
+    }
+}
+
+/// Why an unused parameter was not read, when its kind's specs tell.
+fn unused_hint(q: &Param, specs: &[ParamSpec]) -> Option<String> {
+    let accepts = |s: &ParamSpec| accepted_types(s.kind).contains(&q.type_name);
+    if let Some(s) = specs.iter().find(|s| s.name == q.name) {
+        let types = accepted_types(s.kind);
+        if accepts(s) {
+            let n = q.count();
+            return (n != 1).then(|| format!("\"{}\" takes one value; {n} were given", q.name));
+        }
+        let forms: Vec<String> = types
+            .iter()
+            .filter(|t| **t != "color")
+            .map(|t| format!("\"{t} {}\"", q.name))
+            .collect();
+        let list = match forms.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => return None,
+        };
+        return Some(format!(
+            "\"{}\" is a {} parameter, not \"{}\": write {list}",
+            q.name,
+            kind_name(s.kind),
+            q.type_name
+        ));
+    }
+    let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
+    let close = state::closest_name(&q.name, &names)?;
+    let s = specs.iter().find(|s| s.name == close)?;
+    let ty = if accepts(s) {
+        q.type_name
+    } else {
+        accepted_types(s.kind).first()?
+    };
+    Some(format!("did you mean \"{ty} {close}\"?"))
+}
+
+fn kind_name(kind: ParamKind) -> &'static str {
+    match kind {
+        ParamKind::FloatTexture(_) => "float texture",
+        ParamKind::SpectrumTexture(_) => "spectrum texture",
+        ParamKind::Float(_) => "float",
+        ParamKind::Bool(_) => "bool",
+        ParamKind::String(_) => "string",
+        ParamKind::NamedMaterial => "named-material",
+        ParamKind::FourierFile => "file-name",
+        ParamKind::Unsupported(_) => "ignored",
     }
 }
 
@@ -172,6 +258,7 @@ fn load(
         base_dir,
         loader,
         images: Default::default(),
+        spectra: HashMap::new(),
     };
     if !ctx.diags.errors.is_empty() {
         return Err(LoadFailure {

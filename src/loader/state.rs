@@ -7,6 +7,8 @@ use super::material::{self, Lookup, MaterialSpec};
 use super::Ctx;
 use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
 use crate::lang::Loc;
+use crate::render::bxdf::MAX_BXDFS;
+use crate::render::materials::Material;
 use crate::scene::*;
 use glam::{DMat4, DVec3, DVec4};
 use std::collections::{HashMap, HashSet};
@@ -99,7 +101,9 @@ pub struct Builder<'s, 'c> {
     world_seen: bool,
     world_ended: bool,
     pub scene_materials: Vec<MaterialDesc>,
-    pub material_kinds: Vec<&'static str>,
+    pub material_kinds: Vec<super::DeclaredKind>,
+    /// The most lobes each scene material can add to a BSDF.
+    material_lobes: Vec<usize>,
     pub shapes: Vec<ShapeDesc>,
     pub lights: Vec<LightDesc>,
     pub scene_objects: Vec<ObjectDesc>,
@@ -146,6 +150,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             world_ended: false,
             scene_materials: Vec::new(),
             material_kinds: Vec::new(),
+            material_lobes: Vec::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
             scene_objects: Vec::new(),
@@ -728,14 +733,38 @@ impl<'s, 'c> Builder<'s, 'c> {
                         }
                     }
                 }
-                self.ctx
-                    .report_unused_except(p, &format!("Material \"{}\"", spec.ty), &["type"]);
+                // Hints only for a known kind: an unknown one is read as a
+                // matte, whose names would mislead.
+                let specs = crate::render::materials::kind(&spec.ty).map_or(&[][..], |k| k.params);
+                self.ctx.report_unused_with_specs(
+                    p,
+                    &format!("Material \"{}\"", spec.ty),
+                    &["type"],
+                    specs,
+                );
             }
         }
-        let key = format!("{desc:?}");
+        // The declared kind is part of the key: a substituted material stays
+        // apart from a matte of the same Kd, so that the summary counts it.
+        let key = format!("{kind:?}{desc:?}");
         let id = match self.material_keys.get(&key) {
             Some(&id) => id,
             None => {
+                let lobes_of =
+                    |id: MaterialId| self.material_lobes.get(id.0 as usize).copied().unwrap_or(0);
+                let lobes = Material::new(&desc).max_lobes(&lobes_of);
+                if lobes > MAX_BXDFS {
+                    let what = match &spec.name {
+                        Some(n) => format!("named material \"{n}\""),
+                        None => format!("Material \"{}\"", spec.ty),
+                    };
+                    self.ctx.warn(
+                        spec.loc,
+                        format!("{what}: up to {lobes} lobes, more than the {MAX_BXDFS} a BSDF holds (pbrt-v3 aborts there): lobes beyond {MAX_BXDFS} are dropped"),
+                        "too many lobes",
+                    );
+                }
+                self.material_lobes.push(lobes);
                 self.scene_materials.push(desc);
                 self.material_kinds.push(kind);
                 let id = MaterialId((self.scene_materials.len() - 1) as u32);

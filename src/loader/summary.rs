@@ -1,5 +1,6 @@
 //! The summary `pbrs --check` prints: options and counts by type.
 
+use crate::render::materials::{self, Support};
 use crate::scene::*;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -22,8 +23,12 @@ pub struct Summary {
     pub area_lights: usize,
     /// Lights other than area lights, by type.
     pub lights_by_type: BTreeMap<&'static str, usize>,
-    /// Materials built (distinct), by type.
+    /// Materials built (distinct), by the type declared for them, a name in
+    /// `render::materials::MATERIALS` (an unsupported type counts under its
+    /// own name, though it is rendered as a matte).
     pub materials_by_type: BTreeMap<&'static str, usize>,
+    /// Materials of types pbrs does not know (read as mattes), by type.
+    pub unknown_materials: BTreeMap<String, usize>,
     pub objects: usize,
     pub object_shapes: usize,
     pub object_triangles: usize,
@@ -34,7 +39,7 @@ pub struct Summary {
 impl Summary {
     pub fn of(
         scene: &SceneDescription,
-        material_kinds: &[&'static str],
+        material_kinds: &[DeclaredKind],
         warnings: usize,
     ) -> Summary {
         let mut s = Summary {
@@ -118,7 +123,10 @@ impl Summary {
             *s.lights_by_type.entry(k).or_default() += 1;
         }
         for k in material_kinds {
-            *s.materials_by_type.entry(k).or_default() += 1;
+            match k {
+                DeclaredKind::Table(k) => *s.materials_by_type.entry(k).or_default() += 1,
+                DeclaredKind::Unknown(k) => *s.unknown_materials.entry(k.clone()).or_default() += 1,
+            }
         }
         s.objects = scene.objects.len();
         for o in &scene.objects {
@@ -132,6 +140,15 @@ impl Summary {
         s.instances = scene.instances.len();
         s
     }
+}
+
+/// The type a built material was declared with.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum DeclaredKind {
+    /// A kind of `render::materials::MATERIALS`.
+    Table(&'static str),
+    /// A type pbrs does not know (built as a matte).
+    Unknown(String),
 }
 
 fn geometry_name(g: &Geometry) -> &'static str {
@@ -180,12 +197,45 @@ impl fmt::Display for Summary {
             self.area_lights,
             by_type(&self.lights_by_type)
         )?;
-        writeln!(
-            f,
-            "materials:  {} ({})",
-            self.materials_by_type.values().sum::<usize>(),
-            by_type(&self.materials_by_type)
-        )?;
+        let mut kinds: Vec<String> = self
+            .materials_by_type
+            .iter()
+            .map(|(k, v)| format!("{v} {k}"))
+            .collect();
+        kinds.extend(
+            self.unknown_materials
+                .iter()
+                .map(|(k, v)| format!("{v} \"{k}\" (unknown)")),
+        );
+        let total = self.materials_by_type.values().sum::<usize>()
+            + self.unknown_materials.values().sum::<usize>();
+        let kinds = if kinds.is_empty() {
+            "none".to_string()
+        } else {
+            kinds.join(", ")
+        };
+        writeln!(f, "materials:  {total} ({kinds})")?;
+        for k in self.materials_by_type.keys() {
+            if let Some(Support::Unsupported(why)) = materials::kind(k).map(|m| m.support) {
+                writeln!(
+                    f,
+                    "            {k}: not supported by pbrs ({why}), rendered as matte"
+                )?;
+            }
+        }
+        if !self.unknown_materials.is_empty() {
+            let names: Vec<String> = self
+                .unknown_materials
+                .keys()
+                .map(|k| format!("\"{k}\""))
+                .collect();
+            writeln!(
+                f,
+                "            {}: unknown material type{}, read as matte (as pbrt-v3)",
+                names.join(", "),
+                if names.len() == 1 { "" } else { "s" }
+            )?;
+        }
         if self.objects > 0 || self.instances > 0 {
             writeln!(
                 f,

@@ -6,7 +6,7 @@ use crate::render::accel::{Geometry, Instance, Object};
 use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
-use crate::render::materials::Material;
+use crate::render::materials::{link_materials, Material};
 use crate::render::shapes::{Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -28,7 +28,8 @@ pub struct RenderScene {
 
 impl RenderScene {
     pub fn new(desc: &SceneDescription) -> RenderScene {
-        let materials: Vec<Material> = desc.materials.iter().map(Material::new).collect();
+        let mut materials: Vec<Material> = desc.materials.iter().map(Material::new).collect();
+        link_materials(&mut materials);
         let mut meshes = Vec::new();
         let mut spheres = Vec::new();
         let mut area: Vec<(AreaShape, AreaLightDesc)> = Vec::new();

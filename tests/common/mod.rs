@@ -201,10 +201,18 @@ pub fn average(images: &[Image]) -> Image {
     out
 }
 
-/// The materials of `Material {decl}` (and of named materials it refers
-/// to), loaded through the real scene loader; the first is the statement's.
-pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
-    let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n");
+/// The materials of `Material {decl}` (after the named materials it refers
+/// to, in the scene's order, linked as the renderer links them) and the
+/// index of the statement's own, loaded through the real scene loader.
+///
+/// `decl` may start with other statements (`MakeNamedMaterial` lines): then
+/// its last line is a whole `Material` statement.
+pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usize) {
+    let text = if decl.contains('\n') {
+        format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd\n")
+    } else {
+        format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd\n")
+    };
     let l = pbrs::loader::load_scene_str(&text, &repo().join("mem.pbrt"))
         .unwrap_or_else(|f| panic!("{decl}: {:?}", f.errors));
     let first = l.scene.shapes[0].material.0 as usize;
@@ -214,8 +222,8 @@ pub fn materials_of(decl: &str) -> Vec<pbrs::render::materials::Material> {
         .iter()
         .map(pbrs::render::materials::Material::new)
         .collect();
-    m.swap(0, first);
-    m
+    pbrs::render::materials::link_materials(&mut m);
+    (m, first)
 }
 
 /// The BSDF of `Material {decl}` at a point with normals +z and, when the
@@ -225,7 +233,7 @@ pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::material
     use pbrs::render::accel::SurfaceHit;
     use pbrs::render::materials::{BsdfContext, ShadingContext};
     use pbrs::render::shapes::{DiffGeom, SurfacePoint};
-    let materials = materials_of(decl);
+    let (materials, first) = materials_of(decl);
     let hit = SurfaceHit {
         point: SurfacePoint {
             p: Vec3::ZERO,
@@ -248,7 +256,7 @@ pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::material
         materials: &materials,
         multiple_lobes,
     };
-    materials[0].bsdf(
+    materials[first].bsdf(
         &ShadingContext {
             hit: &hit,
             geom: &geom,

@@ -1,6 +1,7 @@
 //! Fresnel reflectance: dielectric (pbrt-v3 `FrDielectric`), conductor
 //! (`FrConductor`, per RGB channel), and the `Fresnel` choices lobes hold.
 
+use super::DisneyFresnel;
 use glam::Vec3;
 
 /// Fresnel reflectance of a dielectric interface (pbrt-v3's FrDielectric).
@@ -61,6 +62,8 @@ pub enum Fresnel {
     Dielectric { eta_i: f32, eta_t: f32 },
     /// `FresnelConductor(eta_i, eta_t, k)`.
     Conductor { eta_i: Vec3, eta_t: Vec3, k: Vec3 },
+    /// The Disney material's specular Fresnel (`DisneyFresnel`).
+    Disney(DisneyFresnel),
 }
 
 impl Fresnel {
@@ -74,6 +77,7 @@ impl Fresnel {
             Fresnel::Conductor { eta_i, eta_t, k } => {
                 fr_conductor(cos_theta_i.abs(), eta_i, eta_t, k)
             }
+            Fresnel::Disney(d) => d.evaluate(cos_theta_i),
         }
     }
 }

@@ -10,14 +10,27 @@
 //! `BSDF` with `Add` and no allocation per hit.
 
 mod bsdf;
+mod disney;
 mod fresnel;
+mod fresnel_blend;
 mod lambertian;
+mod microfacet;
+mod microfacet_lobes;
 mod oren_nayar;
 mod specular;
 
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
+pub use disney::{
+    fr_schlick, gtr1, schlick_r0_from_eta, schlick_weight, DisneyClearcoat, DisneyDiffuse,
+    DisneyFakeSS, DisneyFresnel, DisneyMicrofacet, DisneyRetro, DisneySheen,
+};
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
+pub use fresnel_blend::FresnelBlend;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
+pub use microfacet::{
+    roughness_to_alpha, Beckmann, MicrofacetDistribution, MicrofacetModel, TrowbridgeReitz,
+};
+pub use microfacet_lobes::{MicrofacetReflection, MicrofacetTransmission};
 pub use oren_nayar::OrenNayar;
 pub use specular::{refract, FresnelSpecular, SpecularReflection, SpecularTransmission};
 
@@ -168,6 +181,14 @@ bxdfs! {
     SpecularReflection(SpecularReflection),
     SpecularTransmission(SpecularTransmission),
     FresnelSpecular(FresnelSpecular),
+    MicrofacetReflection(MicrofacetReflection),
+    MicrofacetTransmission(MicrofacetTransmission),
+    FresnelBlend(FresnelBlend),
+    DisneyDiffuse(DisneyDiffuse),
+    DisneyFakeSS(DisneyFakeSS),
+    DisneyRetro(DisneyRetro),
+    DisneySheen(DisneySheen),
+    DisneyClearcoat(DisneyClearcoat),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry

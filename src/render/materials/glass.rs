@@ -11,13 +11,18 @@
 //! | `remaproughness` | bool | true | map roughness to α as pbrt-v3's `RoughnessToAlpha` |
 //! | `bumpmap` | float texture | | not evaluated yet (warning) |
 //!
-//! Smooth glass under the path tracer is one FresnelSpecular lobe; under
-//! directlighting and whitted a specular reflection and a specular
-//! transmission lobe (pbrt-v3's `allowMultipleLobes`).
+//! Smooth glass (both roughnesses 0) under the path tracer is one
+//! FresnelSpecular lobe; under directlighting and whitted a specular
+//! reflection and a specular transmission lobe (pbrt-v3's
+//! `allowMultipleLobes`). Rough glass is a Trowbridge–Reitz microfacet
+//! reflection with `FresnelDielectric(1, eta)` and a microfacet transmission
+//! from 1 into `eta`, anisotropic when the roughnesses differ. Each
+//! reflection or transmission lobe only if Kr or Kt is not black.
 
-use super::{BsdfContext, Material, MaterialKind, ShadingContext, Support};
+use super::{trowbridge_reitz, BsdfContext, Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{
-    Bsdf, Fresnel, FresnelSpecular, SpecularReflection, SpecularTransmission,
+    Bsdf, Fresnel, FresnelSpecular, MicrofacetReflection, MicrofacetTransmission,
+    SpecularReflection, SpecularTransmission,
 };
 use crate::scene::{FloatTex, ParamSpec, ParamValues, SpectrumTex};
 use glam::Vec3;
@@ -69,10 +74,21 @@ impl Glass {
         }
     }
 
+    pub fn anisotropic(&self) -> bool {
+        super::may_differ(&self.u_roughness, &self.v_roughness)
+    }
+
     pub fn needs_geom(&self) -> bool {
         self.kr.as_constant().is_none()
             || self.kt.as_constant().is_none()
             || self.eta.as_constant().is_none()
+            || self.u_roughness.as_constant().is_none()
+            || self.v_roughness.as_constant().is_none()
+            || self.anisotropic()
+    }
+
+    pub fn max_lobes(&self) -> usize {
+        2
     }
 
     #[inline]
@@ -84,23 +100,23 @@ impl Glass {
         if r == Vec3::ZERO && t == Vec3::ZERO {
             return;
         }
-        // Rough glass comes with the microfacet lobes.
-        if ctx.multiple_lobes {
-            bsdf.add(FresnelSpecular {
-                r,
-                t,
-                eta_a: 1.0,
-                eta_b: eta,
-            });
-        } else {
-            if r != Vec3::ZERO {
-                bsdf.add(SpecularReflection {
+        let (u, v) = (self.u_roughness.eval(sc), self.v_roughness.eval(sc));
+        let fresnel = Fresnel::Dielectric {
+            eta_i: 1.0,
+            eta_t: eta,
+        };
+        if u == 0.0 && v == 0.0 {
+            if ctx.multiple_lobes {
+                bsdf.add(FresnelSpecular {
                     r,
-                    fresnel: Fresnel::Dielectric {
-                        eta_i: 1.0,
-                        eta_t: eta,
-                    },
+                    t,
+                    eta_a: 1.0,
+                    eta_b: eta,
                 });
+                return;
+            }
+            if r != Vec3::ZERO {
+                bsdf.add(SpecularReflection { r, fresnel });
             }
             if t != Vec3::ZERO {
                 bsdf.add(SpecularTransmission {
@@ -109,6 +125,23 @@ impl Glass {
                     eta_b: eta,
                 });
             }
+            return;
+        }
+        let distribution = trowbridge_reitz(u, v, self.remap_roughness);
+        if r != Vec3::ZERO {
+            bsdf.add(MicrofacetReflection {
+                r,
+                distribution,
+                fresnel,
+            });
+        }
+        if t != Vec3::ZERO {
+            bsdf.add(MicrofacetTransmission {
+                t,
+                distribution,
+                eta_a: 1.0,
+                eta_b: eta,
+            });
         }
     }
 }

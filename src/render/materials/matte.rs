@@ -43,6 +43,10 @@ impl Matte {
         self.kd.as_constant().is_none() || self.sigma.as_constant().is_none()
     }
 
+    pub fn max_lobes(&self) -> usize {
+        super::may_scatter(&self.kd) as usize
+    }
+
     #[inline]
     pub fn scatter(&self, sc: &ShadingContext, bsdf: &mut Bsdf) {
         let r = self.kd.eval(sc).max(Vec3::ZERO);

@@ -39,6 +39,10 @@ impl Mirror {
         self.kr.as_constant().is_none()
     }
 
+    pub fn max_lobes(&self) -> usize {
+        super::may_scatter(&self.kr) as usize
+    }
+
     #[inline]
     pub fn scatter(&self, sc: &ShadingContext, bsdf: &mut Bsdf) {
         let r = self.kr.eval(sc).max(Vec3::ZERO);

@@ -7,19 +7,34 @@
 //! `ComputeScatteringFunctions`). [`Material`] is the closed set; it only
 //! delegates to the files.
 
+mod disney;
 mod glass;
 mod matte;
+mod metal;
 mod mirror;
+mod mix;
+mod plastic;
+mod substrate;
+mod translucent;
+mod uber;
 
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
+pub use disney::Disney;
 pub use glass::Glass;
 pub use matte::Matte;
+pub use metal::Metal;
 pub use mirror::Mirror;
+pub use mix::Mix;
+pub use plastic::Plastic;
+pub use substrate::Substrate;
+pub use translucent::Translucent;
+pub use uber::Uber;
 
 use crate::render::accel::SurfaceHit;
+use crate::render::bxdf::{roughness_to_alpha, MicrofacetDistribution, TrowbridgeReitz};
 use crate::render::geometry::Frame;
 use crate::render::shapes::DiffGeom;
-use crate::scene::{MaterialDesc, ParamSpec, ParamValues};
+use crate::scene::{FloatTex, MaterialDesc, MaterialId, ParamSpec, ParamValues, SpectrumTex};
 
 /// Whether pbrs renders a material kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,8 +59,15 @@ pub struct MaterialKind {
 /// `MakeMaterial`.
 pub static MATERIALS: &[MaterialKind] = &[
     matte::KIND,
-    mirror::KIND,
+    plastic::KIND,
+    translucent::KIND,
     glass::KIND,
+    mirror::KIND,
+    mix::KIND,
+    metal::KIND,
+    substrate::KIND,
+    uber::KIND,
+    disney::KIND,
     NONE_KIND,
     unsupported(
         "subsurface",
@@ -104,15 +126,23 @@ pub struct BsdfContext<'a> {
 #[derive(Clone, Debug)]
 pub enum Material {
     Matte(Matte),
-    Mirror(Mirror),
+    Plastic(Plastic),
+    Translucent(Translucent),
     Glass(Glass),
+    Mirror(Mirror),
+    Mix(Mix),
+    Metal(Metal),
+    Substrate(Substrate),
+    Uber(Uber),
+    Disney(Disney),
     /// `Material "none"`: no BSDF.
     None,
 }
 
 impl Material {
     /// Builds the material from its description (the kind must be in
-    /// [`MATERIALS`]; the loader guarantees it).
+    /// [`MATERIALS`]; the loader guarantees it). A `mix` needs
+    /// [`link_materials`] afterwards.
     pub fn new(desc: &MaterialDesc) -> Material {
         match kind(desc.kind) {
             Some(k) => (k.build)(&desc.params),
@@ -131,8 +161,15 @@ impl Material {
     pub fn needs_geom(&self) -> bool {
         match self {
             Material::Matte(m) => m.needs_geom(),
-            Material::Mirror(m) => m.needs_geom(),
+            Material::Plastic(m) => m.needs_geom(),
+            Material::Translucent(m) => m.needs_geom(),
             Material::Glass(m) => m.needs_geom(),
+            Material::Mirror(m) => m.needs_geom(),
+            Material::Mix(m) => m.needs_geom,
+            Material::Metal(m) => m.needs_geom(),
+            Material::Substrate(m) => m.needs_geom(),
+            Material::Uber(m) => m.needs_geom(),
+            Material::Disney(m) => m.needs_geom(),
             Material::None => false,
         }
     }
@@ -141,7 +178,36 @@ impl Material {
     /// follows the shading dp/du (else any frame around the normal does).
     pub fn anisotropic(&self) -> bool {
         match self {
-            Material::Matte(_) | Material::Mirror(_) | Material::Glass(_) | Material::None => false,
+            Material::Glass(m) => m.anisotropic(),
+            Material::Mix(m) => m.anisotropic,
+            Material::Metal(m) => m.anisotropic(),
+            Material::Substrate(m) => m.anisotropic(),
+            Material::Uber(m) => m.anisotropic(),
+            Material::Disney(m) => m.anisotropic(),
+            Material::Matte(_)
+            | Material::Plastic(_)
+            | Material::Translucent(_)
+            | Material::Mirror(_)
+            | Material::None => false,
+        }
+    }
+
+    /// The most lobes the material can add to a BSDF, given that count for
+    /// the materials a `mix` refers to (pbrt-v3 aborts beyond
+    /// [`crate::render::bxdf::MAX_BXDFS`]; the loader warns).
+    pub fn max_lobes(&self, lobes_of: &dyn Fn(MaterialId) -> usize) -> usize {
+        match self {
+            Material::Matte(m) => m.max_lobes(),
+            Material::Plastic(m) => m.max_lobes(),
+            Material::Translucent(m) => m.max_lobes(),
+            Material::Glass(m) => m.max_lobes(),
+            Material::Mirror(m) => m.max_lobes(),
+            Material::Mix(m) => m.max_lobes(lobes_of),
+            Material::Metal(m) => m.max_lobes(),
+            Material::Substrate(m) => m.max_lobes(),
+            Material::Uber(m) => m.max_lobes(),
+            Material::Disney(m) => m.max_lobes(),
+            Material::None => 0,
         }
     }
 
@@ -157,13 +223,63 @@ impl Material {
     #[inline]
     pub fn bsdf_into(&self, sc: &ShadingContext, ctx: &BsdfContext, out: &mut Bsdf) {
         out.reset(shading_frame(sc, self.anisotropic()), sc.hit.point.n);
+        self.scatter(sc, ctx, out);
+    }
+
+    /// Adds the material's lobes to `bsdf` and sets its η (the frame is
+    /// the caller's; a `mix` adds both materials' lobes to one BSDF).
+    #[inline]
+    pub fn scatter(&self, sc: &ShadingContext, ctx: &BsdfContext, bsdf: &mut Bsdf) {
         match self {
-            Material::Matte(m) => m.scatter(sc, out),
-            Material::Mirror(m) => m.scatter(sc, out),
-            Material::Glass(m) => m.scatter(sc, ctx, out),
+            Material::Matte(m) => m.scatter(sc, bsdf),
+            Material::Plastic(m) => m.scatter(sc, bsdf),
+            Material::Translucent(m) => m.scatter(sc, bsdf),
+            Material::Glass(m) => m.scatter(sc, ctx, bsdf),
+            Material::Mirror(m) => m.scatter(sc, bsdf),
+            Material::Mix(m) => m.scatter(sc, ctx, bsdf),
+            Material::Metal(m) => m.scatter(sc, bsdf),
+            Material::Substrate(m) => m.scatter(sc, bsdf),
+            Material::Uber(m) => m.scatter(sc, bsdf),
+            Material::Disney(m) => m.scatter(sc, bsdf),
             Material::None => {}
         }
     }
+}
+
+/// Lets each `mix` learn what its materials need (anisotropy, differential
+/// geometry). The loader puts a mix after the materials it refers to.
+pub fn link_materials(materials: &mut [Material]) {
+    for i in 0..materials.len() {
+        let (before, rest) = materials.split_at_mut(i);
+        if let Material::Mix(m) = &mut rest[0] {
+            m.link(before);
+        }
+    }
+}
+
+/// pbrt-v3's Trowbridge–Reitz distribution of a material: roughness along
+/// dp/du and dp/dv, remapped to α by `RoughnessToAlpha` if asked.
+#[inline]
+pub fn trowbridge_reitz(u: f32, v: f32, remap: bool) -> MicrofacetDistribution {
+    let (ax, ay) = if remap {
+        (roughness_to_alpha(u), roughness_to_alpha(v))
+    } else {
+        (u, v)
+    };
+    TrowbridgeReitz::new(ax, ay).into()
+}
+
+/// True unless both roughness textures are the same constant.
+fn may_differ(u: &FloatTex, v: &FloatTex) -> bool {
+    match (u.as_constant(), v.as_constant()) {
+        (Some(a), Some(b)) => a != b,
+        _ => true,
+    }
+}
+
+/// True unless the weight is a constant that clamps to black.
+fn may_scatter(t: &SpectrumTex) -> bool {
+    t.as_constant().is_none_or(|c| c.max_element() > 0.0)
 }
 
 /// The shading frame of a hit: z is the shading normal; x is the shading

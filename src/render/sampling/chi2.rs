@@ -34,6 +34,12 @@ pub struct Chi2Config {
     pub min_expected: f64,
     /// Seed of the PCG32 stream that drives `sample`.
     pub seed: u64,
+    /// Absolute error allowed in each cell's integrated probability; `None`:
+    /// 1e-9 × the cell's area. Peaked densities (glossy lobes) need a
+    /// looser bound to integrate in reasonable time: an error well below
+    /// `sqrt(p / sample_count)` for a cell of probability `p` does not move
+    /// the statistic.
+    pub cell_tolerance: Option<f64>,
 }
 
 impl Default for Chi2Config {
@@ -44,6 +50,7 @@ impl Default for Chi2Config {
             sample_count: 1_000_000,
             min_expected: 5.0,
             seed: 0,
+            cell_tolerance: None,
         }
     }
 }
@@ -165,7 +172,7 @@ pub fn chi2_sphere(
         for ip in 0..np {
             let p0 = 2.0 * PI * ip as f64 / np as f64;
             let p1 = 2.0 * PI * (ip + 1) as f64 / np as f64;
-            expected[it * np + ip] = integrate_2d(&f, t0, t1, p0, p1);
+            expected[it * np + ip] = integrate_2d(&f, t0, t1, p0, p1, cfg.cell_tolerance);
         }
     }
     finish(observed, expected, invalid, rejected, (nt, np), cfg)
@@ -206,7 +213,7 @@ pub fn chi2_square(
         for iy in 0..ny {
             let y0 = iy as f64 / ny as f64;
             let y1 = (iy + 1) as f64 / ny as f64;
-            expected[ix * ny + iy] = integrate_2d(&f, x0, x1, y0, y1);
+            expected[ix * ny + iy] = integrate_2d(&f, x0, x1, y0, y1, cfg.cell_tolerance);
         }
     }
     finish(observed, expected, invalid, rejected, (nx, ny), cfg)
@@ -270,12 +277,22 @@ fn finish(
 }
 
 /// ∫∫ f(x, y) dy dx over a rectangle: adaptive Simpson in both directions,
-/// each started from 4 panels so narrow features are not missed.
-fn integrate_2d(f: &impl Fn(f64, f64) -> f64, x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
+/// each started from 4 panels so narrow features are not missed, to the
+/// absolute error `tolerance` (default 1e-9 × area).
+fn integrate_2d(
+    f: &impl Fn(f64, f64) -> f64,
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    tolerance: Option<f64>,
+) -> f64 {
     let area = (x1 - x0) * (y1 - y0);
-    let eps = 1e-9 * area.max(1e-12) / (x1 - x0);
+    let tol = tolerance.unwrap_or(1e-9 * area.max(1e-12));
+    // The inner integrals' errors add up over the outer interval.
+    let eps = tol / (x1 - x0);
     let inner = |x: f64| integrate_1d(&|y| f(x, y), y0, y1, eps, 14);
-    integrate_1d(&inner, x0, x1, 1e-9 * area.max(1e-12), 14)
+    integrate_1d(&inner, x0, x1, tol, 14)
 }
 
 fn integrate_1d(f: &impl Fn(f64) -> f64, a: f64, b: f64, eps: f64, depth: u32) -> f64 {
@@ -416,10 +433,10 @@ mod tests {
     fn integrator_handles_discontinuities() {
         // Indicator of the triangle x + y < 1 over the unit square: 1/2.
         let f = |x: f64, y: f64| if x + y < 1.0 { 1.0 } else { 0.0 };
-        let v = integrate_2d(&f, 0.0, 1.0, 0.0, 1.0);
+        let v = integrate_2d(&f, 0.0, 1.0, 0.0, 1.0, None);
         assert!((v - 0.5).abs() < 1e-5, "{v}");
         let g = |t: f64, _p: f64| t.sin();
-        let v = integrate_2d(&g, 0.0, PI, 0.0, 2.0 * PI);
+        let v = integrate_2d(&g, 0.0, PI, 0.0, 2.0 * PI, None);
         assert!((v - 4.0 * PI).abs() < 1e-9, "{v}");
     }
 }

@@ -1,0 +1,214 @@
+//! The parts of `grammar/REFERENCE.md` written from the tables, so that the
+//! reference cannot drift from what the loader reads: the material section
+//! comes from [`MATERIALS`] (every kind, its parameters, their types and
+//! pbrt-v3's defaults). `tests/lang_grammar.rs` checks that the committed file
+//! holds exactly what [`materials_section`] writes, and rewrites it when
+//! `PBRS_WRITE_REFERENCE=1` is set.
+
+use super::color::sampled_to_rgb;
+use crate::render::materials::{MaterialKind, Support, MATERIALS};
+use crate::scene::{ParamKind, ParamSpec, Range, SpectrumDefault};
+use std::fmt::Write;
+
+/// The line that opens the generated material section.
+pub const MATERIALS_BEGIN: &str = "<!-- BEGIN generated from render::materials::MATERIALS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+/// The line that closes it.
+pub const MATERIALS_END: &str = "<!-- END generated materials -->";
+
+/// Every material type pbrt-v3's `MakeMaterial` knows (`""` aside), for
+/// naming the ones the table does not have yet.
+pub const PBRT_V3_MATERIALS: &[&str] = &[
+    "matte",
+    "plastic",
+    "translucent",
+    "glass",
+    "mirror",
+    "hair",
+    "disney",
+    "mix",
+    "metal",
+    "substrate",
+    "uber",
+    "subsurface",
+    "kdsubsurface",
+    "fourier",
+    "none",
+];
+
+/// The material section, between its markers (both included), from the table.
+pub fn materials_section() -> String {
+    let mut out = String::new();
+    out.push_str(MATERIALS_BEGIN);
+    out.push('\n');
+    let (supported, unsupported): (Vec<&MaterialKind>, Vec<&MaterialKind>) = MATERIALS
+        .iter()
+        .partition(|k| k.support == Support::Supported);
+    for k in &supported {
+        write_kind(&mut out, k);
+    }
+    if !unsupported.is_empty() {
+        out.push_str("\n### Known to pbrt-v3, not rendered by pbrs\n\n");
+        out.push_str("A warning names the reason; the material is replaced by a `matte` with the material's `Kd` (else 0.5), and its other parameters are not reported as unused.\n\n");
+        out.push_str("| type | why |\n|---|---|\n");
+        for k in &unsupported {
+            if let Support::Unsupported(why) = k.support {
+                let _ = writeln!(out, "| `{}` | {} |", k.name, cell(why));
+            }
+        }
+    }
+    let missing: Vec<String> = PBRT_V3_MATERIALS
+        .iter()
+        .filter(|n| !MATERIALS.iter().any(|k| k.name == **n))
+        .map(|n| format!("`{n}`"))
+        .collect();
+    out.push_str("\n### Other types\n\n");
+    if !missing.is_empty() {
+        let _ = writeln!(
+            out,
+            "pbrt-v3 types pbrs does not know yet: {}. These and any other unknown type give a warning (with a \"did you mean\" when a known type is close) and are read as a `matte` with the material's parameters, as pbrt-v3 does for an unknown type.",
+            missing.join(", ")
+        );
+    } else {
+        out.push_str("An unknown type gives a warning (with a \"did you mean\" when a known type is close) and is read as a `matte` with the material's parameters, as pbrt-v3 does.\n");
+    }
+    out.push('\n');
+    out.push_str(MATERIALS_END);
+    out.push('\n');
+    out
+}
+
+fn write_kind(out: &mut String, k: &MaterialKind) {
+    let title = if k.name == "none" {
+        "`none` (or `\"\"`)".to_string()
+    } else {
+        format!("`{}`", k.name)
+    };
+    let _ = write!(out, "\n### {title}\n\n{}\n", sentence(k.doc));
+    if k.params.is_empty() {
+        out.push_str("\nNo parameters.\n");
+        return;
+    }
+    out.push_str("\n| parameter | type | default | meaning |\n|---|---|---|---|\n");
+    for p in k.params {
+        let (ty, default) = describe(p);
+        let meaning = match p.kind {
+            ParamKind::Unsupported(why) => format!("warning: {why}"),
+            _ => p.doc.to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "| `{}` | {ty} | {default} | {} |",
+            p.name,
+            cell(&meaning)
+        );
+    }
+}
+
+/// The type column and the default column of one parameter.
+pub fn describe(p: &ParamSpec) -> (String, String) {
+    let nonneg = if p.range == Range::NonNegative {
+        ", ≥ 0 (else warning, 0)"
+    } else {
+        ""
+    };
+    let (ty, default) = match p.kind {
+        ParamKind::FloatTexture(d) => ("float texture".to_string(), d.map(num)),
+        ParamKind::SpectrumTexture(d) => ("spectrum texture".to_string(), d.map(spectrum)),
+        ParamKind::Float(d) => ("float".to_string(), Some(num(d))),
+        ParamKind::Bool(d) => ("bool".to_string(), Some(format!("`{d}`"))),
+        ParamKind::String(d) => ("string".to_string(), Some(format!("`\"{d}\"`"))),
+        ParamKind::NamedMaterial => ("string: a named material".to_string(), None),
+        ParamKind::FourierFile => ("string: a `.bsdf` file".to_string(), None),
+        ParamKind::Unsupported(_) => ("any".to_string(), None),
+    };
+    (
+        format!("{ty}{nonneg}"),
+        default.unwrap_or_else(|| "—".into()),
+    )
+}
+
+fn num(v: f32) -> String {
+    format!("{v}")
+}
+
+fn spectrum(d: SpectrumDefault) -> String {
+    match d {
+        SpectrumDefault::Rgb([r, g, b]) if r == g && g == b => num(r),
+        SpectrumDefault::Rgb([r, g, b]) => format!("rgb {} {} {}", num(r), num(g), num(b)),
+        SpectrumDefault::Sampled { lambda, values } => {
+            let pairs: Vec<f64> = lambda
+                .iter()
+                .zip(values)
+                .flat_map(|(&l, &v)| [l as f64, v as f64])
+                .collect();
+            let c = sampled_to_rgb(&pairs);
+            format!(
+                "measured spectrum, {} samples (rgb {:.4} {:.4} {:.4})",
+                lambda.len(),
+                c.x,
+                c.y,
+                c.z
+            )
+        }
+    }
+}
+
+/// A doc string as a sentence: capitalised, with a full stop.
+fn sentence(s: &str) -> String {
+    let mut c = s.chars();
+    let mut out = match c.next() {
+        Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+        None => String::new(),
+    };
+    if !out.ends_with('.') {
+        out.push('.');
+    }
+    out
+}
+
+/// Text safe inside a Markdown table cell.
+fn cell(s: &str) -> String {
+    s.replace('|', "\\|").replace('\n', " ")
+}
+
+/// `doc` with its generated material section replaced by `section`, or
+/// `None` when the markers are missing or out of order.
+pub fn splice(doc: &str, section: &str) -> Option<String> {
+    let begin = doc.find(MATERIALS_BEGIN)?;
+    let end = doc[begin..].find(MATERIALS_END)? + begin + MATERIALS_END.len();
+    let end = if doc[end..].starts_with('\n') {
+        end + 1
+    } else {
+        end
+    };
+    Some(format!("{}{section}{}", &doc[..begin], &doc[end..]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_kind_and_parameter_is_listed() {
+        let s = materials_section();
+        for k in MATERIALS {
+            assert!(s.contains(&format!("`{}`", k.name)), "{}", k.name);
+            for p in k.params {
+                assert!(s.contains(&format!("| `{}` |", p.name)), "{}", p.name);
+            }
+        }
+        assert!(s.contains("| `Kd` | spectrum texture | 0.5 |"), "{s}");
+        assert!(s.contains("| `sigma` | float texture, ≥ 0"), "{s}");
+    }
+
+    #[test]
+    fn splice_replaces_only_the_section() {
+        let doc = format!("a\n{MATERIALS_BEGIN}\nold\n{MATERIALS_END}\nb\n");
+        assert_eq!(splice(&doc, "NEW\n").as_deref(), Some("a\nNEW\nb\n"));
+        assert_eq!(splice("no markers", "x"), None);
+        assert_eq!(
+            splice(&format!("{MATERIALS_END}\n{MATERIALS_BEGIN}"), "x"),
+            None
+        );
+    }
+}
