@@ -98,6 +98,42 @@ const EXPECT: &[Expect] = &[
         materials: &[("matte", 2)],
         lines: &["objects:    1 (1 shapes, 43534 triangles), 100 instances"],
     },
+    Expect {
+        file: "materials-a.pbrt",
+        warnings: &[],
+        shapes: 9,
+        triangles: 12,
+        area_lights: 1,
+        materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
+        lines: &[
+            "shapes:     9 (3 sphere, 6 trianglemesh)",
+            "integrator: path, maxdepth 8, rrthreshold 1, light samples spatial",
+        ],
+    },
+    Expect {
+        file: "materials-direct.pbrt",
+        warnings: &[],
+        shapes: 9,
+        triangles: 12,
+        area_lights: 1,
+        materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
+        lines: &[
+            "shapes:     9 (3 sphere, 6 trianglemesh)",
+            "integrator: directlighting, maxdepth 5, strategy all",
+        ],
+    },
+    Expect {
+        file: "materials-whitted.pbrt",
+        warnings: &[],
+        shapes: 9,
+        triangles: 12,
+        area_lights: 1,
+        materials: &[("matte", 4), ("metal", 1), ("plastic", 1), ("substrate", 1)],
+        lines: &[
+            "shapes:     9 (3 sphere, 6 trianglemesh)",
+            "integrator: whitted, maxdepth 5",
+        ],
+    },
 ];
 
 fn scenes_dir() -> std::path::PathBuf {

@@ -363,8 +363,7 @@ fn rough_glass_lobes() {
     assert!(transmitted > 400, "{transmitted}");
 }
 
-const NAMED: &str = "\"matte\"
-MakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [0.8 0 0]
+const NAMED: &str = "MakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [0.8 0 0]
 MakeNamedMaterial \"coat\" \"string type\" \"plastic\"
 MakeNamedMaterial \"clear\" \"string type\" \"glass\" \"float index\" 1.7
 MakeNamedMaterial \"brushed\" \"string type\" \"metal\" \"float uroughness\" 0.05 \"float vroughness\" 0.3
@@ -429,7 +428,7 @@ Material \"mix\" \"string namedmaterial1\" \"inner\" \"string namedmaterial2\" \
         assert!((a - w).abs() < 1e-6, "{s:?} vs {want:?}");
     }
     assert!(!warnings_of(&format!(
-        "WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd"
+        "WorldBegin\nMaterial \"matte\"\n{decl}\nShape \"sphere\"\nWorldEnd"
     ))
     .contains("lobes"));
 }
@@ -438,7 +437,7 @@ Material \"mix\" \"string namedmaterial1\" \"inner\" \"string namedmaterial2\" \
 fn mix_beyond_eight_lobes_warns_and_drops() {
     // uber with opacity, Kr and Kt has 5 lobes: two of them are 10.
     let decl = format!("{NAMED}Material \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"full\" \"rgb amount\" [0.3 0.3 0.3]");
-    let text = format!("WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd");
+    let text = format!("WorldBegin\nMaterial \"matte\"\n{decl}\nShape \"sphere\"\nWorldEnd");
     let w = warnings_of(&text);
     assert!(
         w.contains("mem.pbrt:8:") && w.contains("up to 10 lobes, more than the 8 a BSDF holds"),
@@ -452,7 +451,7 @@ fn mix_beyond_eight_lobes_warns_and_drops() {
 Material \"mix\" \"string namedmaterial1\" \"inner\" \"string namedmaterial2\" \"full\""
     );
     let w = warnings_of(&format!(
-        "WorldBegin\nMaterial {decl}\nShape \"sphere\"\nWorldEnd"
+        "WorldBegin\nMaterial \"matte\"\n{decl}\nShape \"sphere\"\nWorldEnd"
     ));
     assert!(
         w.contains("mem.pbrt:9:") && w.contains("up to 11 lobes"),
@@ -461,7 +460,7 @@ Material \"mix\" \"string namedmaterial1\" \"inner\" \"string namedmaterial2\" \
     assert_eq!(w.matches("lobes, more than").count(), 1, "{w}");
     // Within 8 (5 + 2): no warning.
     let w = warnings_of(&format!(
-        "WorldBegin\nMaterial {NAMED}Material \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"coat\"\nShape \"sphere\"\nWorldEnd"
+        "WorldBegin\nMaterial \"matte\"\n{NAMED}Material \"mix\" \"string namedmaterial1\" \"full\" \"string namedmaterial2\" \"coat\"\nShape \"sphere\"\nWorldEnd"
     ));
     assert!(!w.contains("lobes"), "{w}");
 }
