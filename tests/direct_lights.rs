@@ -188,7 +188,7 @@ fn at(p: Vec3) -> SurfacePoint {
 #[test]
 fn area_light_sampling_matches_its_density() {
     let sc = scene("scenes/analytic/lights.pbrt");
-    let find = |f: &dyn Fn(&Light) -> bool| *sc.lights.iter().find(|l| f(l)).unwrap();
+    let find = |f: &dyn Fn(&Light) -> bool| sc.lights.iter().find(|l| f(l)).unwrap().clone();
     let sphere = find(&|l| {
         matches!(
             l,
@@ -199,13 +199,18 @@ fn area_light_sampling_matches_its_density() {
         )
     });
     let cases = [
-        ("sphere from outside", sphere, Vec3::new(0.3, 0.2, -0.4)),
+        (
+            "sphere from outside",
+            sphere.clone(),
+            Vec3::new(0.3, 0.2, -0.4),
+        ),
         ("sphere from inside", sphere, Vec3::new(0.1, -1.2, 0.15)),
     ];
     // Seen from outside, pbrt-v3's Sphere::Pdf returns the cone density for
     // any direction (callers only use it for rays that hit the light), so
     // the density tested is restricted to the subtended cone.
     let (centre, radius) = (Vec3::new(0.0, -1.0, 0.0), 0.5f32);
+    let n_cases = cases.len();
     for (k, (name, light, p)) in cases.into_iter().enumerate() {
         let r = at(p);
         let in_cone = |wi: Vec3| {
@@ -237,7 +242,7 @@ fn area_light_sampling_matches_its_density() {
             res.pdf_integral
         );
         assert!(
-            res.passed(sidak_significance(0.01, cases.len())),
+            res.passed(sidak_significance(0.01, n_cases)),
             "{name}: {res}"
         );
     }

@@ -262,18 +262,35 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
             })
         }
         "infinite" | "exinfinite" => {
-            let l = spectrum(ctx, p, "L", Vec3::ONE) * light_scale(ctx, p);
+            // pbrt-v3 reads `scale` as a spectrum only: "float scale" stays unused.
+            let l = spectrum(ctx, p, "L", Vec3::ONE) * spectrum(ctx, p, "scale", Vec3::ONE);
             let (ns, _) = int(p, "nsamples", 1);
             let (n, _) = int(p, "samples", ns);
-            if let Some((map, loc)) = string(p, "mapname") {
-                if !map.is_empty() {
-                    ctx.warn(loc, format!("environment map \"{map}\" is not supported by pbrs: the infinite light has the constant radiance L"), "map not loaded");
+            let image = match string(p, "mapname") {
+                Some((map, loc)) if !map.is_empty() => {
+                    // Raw values: pbrt-v3's infinite light does not sRGB-decode.
+                    Some(super::image::load_image(ctx, loc, map, Decode::Raw)?)
                 }
-            }
+                _ => None,
+            };
+            let sampling = match string(p, "sampling") {
+                None | Some(("map", _)) => EnvSampling::Map,
+                Some(("uniform", _)) => EnvSampling::Uniform,
+                Some((other, loc)) => {
+                    ctx.warn(
+                        loc,
+                        format!("unknown infinite light sampling \"{other}\" (pbrs has \"map\" and \"uniform\"): \"map\" is used"),
+                        "unknown sampling",
+                    );
+                    EnvSampling::Map
+                }
+            };
             Some(LightDesc::Infinite {
                 radiance: l,
+                image,
                 light_to_world: ctm,
                 n_samples: n.clamp(1, MAX_SAMPLES) as u32,
+                sampling,
             })
         }
         other => {

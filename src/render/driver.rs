@@ -188,12 +188,21 @@ fn render_tile(
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
     let lens = scene.camera.uses_lens();
+    // pbrt-v3 scales camera ray differentials by 1/√spp. Rays carry them
+    // only in scenes whose materials can use them.
+    let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();
+    let differentials = scene.differentials;
     for pixel in bounds.iter() {
         for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
             let cs = sampler.camera_sample(pixel, lens);
-            let ray = scene.camera.generate_ray(&cs);
-            let mut l = integrator.li(ray, scene, &mut sampler, &mut scratch);
+            let (ray, diff) = if differentials {
+                let (ray, d) = scene.camera.generate_ray_differential(&cs, diff_scale);
+                (ray, Some(d))
+            } else {
+                (scene.camera.generate_ray(&cs), None)
+            };
+            let mut l = integrator.li(ray, diff, scene, &mut sampler, &mut scratch);
             // pbrt-v3: samples with NaN, infinite or negative radiance are
             // zeroed (their weight is kept) and counted.
             if l.is_nan() {

@@ -5,7 +5,7 @@
 use crate::render::accel::{Geometry, Instance, Object};
 use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
-use crate::render::lights::{AreaShape, Light, TriangleCache};
+use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
 use crate::render::shapes::{AlphaMask, Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
@@ -22,6 +22,9 @@ pub struct RenderScene {
     /// Indices of infinite lights (seen by rays that escape).
     pub infinite_lights: Vec<u32>,
     pub camera: Camera,
+    /// Camera rays carry differentials (some material reads the
+    /// differential geometry, so textures can filter and bump maps step).
+    pub differentials: bool,
     /// What was built and what was skipped, for `--stats`.
     pub notes: Vec<String>,
 }
@@ -191,14 +194,21 @@ impl RenderScene {
                 },
                 LightDesc::Infinite {
                     radiance,
+                    ref image,
+                    light_to_world,
                     n_samples,
-                    ..
+                    sampling,
                 } => {
                     infinite_lights.push(lights.len() as u32);
                     Light::Infinite {
-                        l: radiance,
                         n_samples,
                         scene_radius,
+                        map: Arc::new(EnvMap::new(
+                            image.as_deref(),
+                            radiance,
+                            light_to_world,
+                            sampling,
+                        )),
                     }
                 }
             };
@@ -230,6 +240,7 @@ impl RenderScene {
         }
         let camera = Camera::new(&desc.camera, desc.film.xresolution, desc.film.yresolution);
         let material_needs_geom = materials.iter().map(Material::needs_geom).collect();
+        let differentials = materials.iter().any(|m| m.needs_geom());
         RenderScene {
             geometry,
             materials,
@@ -237,6 +248,7 @@ impl RenderScene {
             lights,
             infinite_lights,
             camera,
+            differentials,
             notes,
         }
     }

@@ -252,11 +252,26 @@ pub enum LightDesc {
     /// `direction` is the world-space direction the light travels *from*
     /// (pbrt's `from - to`, transformed), normalised.
     Distant { radiance: Vec3, direction: DVec3 },
+    /// pbrt-v3's `InfiniteAreaLight`: `radiance` is `L`·`scale`; `image`
+    /// the lat-long map as read (raw values, top row = light-space +z),
+    /// multiplied by `radiance` when the light is built.
     Infinite {
         radiance: Vec3,
+        image: Option<Arc<RgbImage>>,
         light_to_world: DMat4,
         n_samples: u32,
+        sampling: EnvSampling,
     },
+}
+
+/// How an infinite light samples directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvSampling {
+    /// pbrt-v3's: the map's luminance times sin θ.
+    Map,
+    /// Uniformly over the sphere: the pbrs extension `"string sampling"
+    /// "uniform"`, to compare against importance sampling.
+    Uniform,
 }
 
 #[derive(Clone, Debug)]

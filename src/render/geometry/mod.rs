@@ -13,7 +13,7 @@ pub use bounds::{Bounds2i, Bounds3};
 pub use frame::Frame;
 pub use ray::{
     offset_ray_origin, spawn_ray, spawn_ray_from_to, spawn_ray_to, spawn_ray_to_point, Ray,
-    SHADOW_EPSILON,
+    RayDiff, SHADOW_EPSILON,
 };
 
 use glam::Vec3;

@@ -27,6 +27,31 @@ impl Ray {
     }
 }
 
+/// The two neighbouring rays of pbrt-v3's `RayDifferential`: where the
+/// ray would start and go for a film position one pixel over in x and in
+/// y. Kept beside a [`Ray`] (not in it) so that rays without differentials,
+/// the vast majority, stay small.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayDiff {
+    pub rx_o: Vec3,
+    pub rx_d: Vec3,
+    pub ry_o: Vec3,
+    pub ry_d: Vec3,
+}
+
+impl RayDiff {
+    /// pbrt-v3's `ScaleDifferentials`: the offsets from `ray` times `s`.
+    #[inline]
+    pub fn scaled(&self, ray: &Ray, s: f32) -> RayDiff {
+        RayDiff {
+            rx_o: ray.o + (self.rx_o - ray.o) * s,
+            ry_o: ray.o + (self.ry_o - ray.o) * s,
+            rx_d: ray.d + (self.rx_d - ray.d) * s,
+            ry_d: ray.d + (self.ry_d - ray.d) * s,
+        }
+    }
+}
+
 /// pbrt-v3's OffsetRayOrigin: push `p` past its error box along `n`, on the
 /// side `w` points to, then round away from the surface.
 #[inline(always)]

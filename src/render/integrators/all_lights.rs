@@ -181,7 +181,7 @@ pub(super) fn sample_all_lights_packed(
                                 Vec3::ZERO
                             }
                         }
-                        None => scene.lights[light_index as usize].le_escaped(),
+                        None => scene.lights[light_index as usize].le(wi),
                     };
                     ld += f * li * weight / pdf_b[lane];
                 }

@@ -3,7 +3,7 @@
 //! one, specular lobes followed recursively) and `whitted`.
 
 use crate::render::accel::{Hit, SurfaceHit};
-use crate::render::geometry::{spawn_ray, Ray};
+use crate::render::geometry::{spawn_ray, Ray, RayDiff};
 use crate::render::lights::{
     pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
 };
@@ -40,6 +40,9 @@ impl RayCounts {
 #[derive(Clone, Copy, Debug)]
 struct Work {
     ray: Ray,
+    /// The ray's differentials, if it carries them (camera rays and their
+    /// specular bounces, as pbrt-v3's SpecularReflect/SpecularTransmit).
+    diff: Option<RayDiff>,
     beta: Vec3,
     depth: u32,
     pass: u32,
@@ -174,11 +177,13 @@ impl Integrator {
         }
     }
 
-    /// Radiance arriving at the camera along `ray`.
+    /// Radiance arriving at the camera along `ray`, with its differentials
+    /// if it has them.
     #[inline]
     pub fn li(
         &self,
         ray: Ray,
+        diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
@@ -190,6 +195,7 @@ impl Integrator {
                 lights,
             } => path_li(
                 ray,
+                diff,
                 scene,
                 sampler,
                 scratch,
@@ -198,7 +204,7 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.specular_tree_li(ray, scene, sampler, scratch)
+                self.specular_tree_li(ray, diff, scene, sampler, scratch)
             }
         }
     }
@@ -213,6 +219,7 @@ impl Integrator {
     fn specular_tree_li(
         &self,
         ray: Ray,
+        diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
@@ -221,6 +228,7 @@ impl Integrator {
         stack.clear();
         stack.push(Work {
             ray,
+            diff,
             beta: Vec3::ONE,
             depth: 0,
             pass: 0,
@@ -230,7 +238,7 @@ impl Integrator {
         while let Some(w) = stack.pop() {
             scratch.counts.closest += 1;
             let Some(hit) = scene.geometry.intersect(&w.ray) else {
-                l += w.beta * escaped(scene);
+                l += w.beta * escaped(scene, w.ray.d);
                 continue;
             };
             let mut s = scene.geometry.surface(&hit);
@@ -238,8 +246,10 @@ impl Integrator {
             if material.is_none() {
                 if w.pass < MAX_PASS_THROUGH {
                     let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                    // A spawned ray has no differentials (pbrt-v3's SpawnRay).
                     stack.push(Work {
                         ray,
+                        diff: None,
                         pass: w.pass + 1,
                         ..w
                     });
@@ -247,7 +257,31 @@ impl Integrator {
                 continue;
             }
             let wo = -w.ray.d;
-            shade(scene, &hit, &mut s, material, false, &mut bsdf);
+            let with_diff = |s: &SurfaceHit, d: &RayDiff| {
+                let mut g = scene.geometry.diff_geom(&hit, s);
+                g.compute_differentials(s.point.p, s.point.n, d);
+                g
+            };
+            // A material that reads the geometry gets it with the ray's
+            // differentials; otherwise it is computed only if specular
+            // children will carry differentials.
+            let mut geom = w
+                .diff
+                .as_ref()
+                .filter(|_| scene.material_needs_geom[s.material as usize])
+                .map(|d| with_diff(&s, d));
+            shade_geom(
+                scene,
+                &hit,
+                &mut s,
+                material,
+                false,
+                geom.as_ref(),
+                &mut bsdf,
+            );
+            if geom.is_none() && bsdf.has_specular() {
+                geom = w.diff.as_ref().map(|d| with_diff(&s, d));
+            }
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
                 Integrator::Direct {
@@ -322,8 +356,18 @@ impl Integrator {
                         if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
                             let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                             let beta = w.beta * bs.f * cos / bs.pdf;
+                            let diff = match (&w.diff, &geom) {
+                                (Some(d), Some(g)) if i == 0 => {
+                                    Some(g.reflected(s.point.p, s.point.ns, wo, bs.wi, d))
+                                }
+                                (Some(d), Some(g)) => Some(
+                                    g.transmitted(s.point.p, s.point.ns, wo, bs.wi, bsdf.eta, d),
+                                ),
+                                _ => None,
+                            };
                             children[i] = Some(Work {
                                 ray,
+                                diff,
                                 beta,
                                 depth: w.depth + 1,
                                 pass: 0,
@@ -341,9 +385,8 @@ impl Integrator {
 }
 
 /// The BSDF of `material` at a hit, built into `bsdf`, with the hit's
-/// differential geometry computed only if the material uses it. The hit's
-/// shading normal becomes the BSDF's (a bump map changes it; pbrt-v3's
-/// integrators then use the bumped `shading.n`).
+/// differential geometry (and its screen-space derivatives when the ray
+/// has differentials) computed only if the material uses it.
 #[inline(always)]
 fn shade<'a>(
     scene: &'a RenderScene,
@@ -351,13 +394,41 @@ fn shade<'a>(
     s: &mut SurfaceHit,
     material: &'a Material,
     multiple_lobes: bool,
+    diff: Option<&RayDiff>,
+    bsdf: &mut Bsdf<'a>,
+) {
+    let geom = match diff {
+        Some(d) if scene.material_needs_geom[s.material as usize] => {
+            let mut g = scene.geometry.diff_geom(hit, s);
+            g.compute_differentials(s.point.p, s.point.n, d);
+            Some(g)
+        }
+        _ => None,
+    };
+    shade_geom(scene, hit, s, material, multiple_lobes, geom.as_ref(), bsdf);
+}
+
+/// `shade` with the hit's differential geometry, if already computed. The
+/// hit's shading normal becomes the BSDF's (a bump map changes it; pbrt-v3's
+/// integrators then use the bumped `shading.n`).
+#[inline(always)]
+fn shade_geom<'a>(
+    scene: &'a RenderScene,
+    hit: &Hit,
+    s: &mut SurfaceHit,
+    material: &'a Material,
+    multiple_lobes: bool,
+    geom: Option<&DiffGeom>,
     bsdf: &mut Bsdf<'a>,
 ) {
     let ctx = BsdfContext {
         materials: &scene.materials,
         multiple_lobes,
     };
-    if scene.material_needs_geom[s.material as usize] {
+    let needs_geom = scene.material_needs_geom[s.material as usize];
+    if let Some(geom) = geom.filter(|_| needs_geom) {
+        material.bsdf_into(&ShadingContext { hit: s, geom }, &ctx, bsdf);
+    } else if needs_geom {
         let geom = scene.geometry.diff_geom(hit, s);
         material.bsdf_into(
             &ShadingContext {
@@ -386,13 +457,13 @@ fn emitted(scene: &RenderScene, s: &SurfaceHit, wo: Vec3) -> Vec3 {
     }
 }
 
-/// Radiance of rays that leave the scene.
+/// Radiance of rays with direction `d` that leave the scene.
 #[inline]
-fn escaped(scene: &RenderScene) -> Vec3 {
+fn escaped(scene: &RenderScene, d: Vec3) -> Vec3 {
     scene
         .infinite_lights
         .iter()
-        .map(|&i| scene.lights[i as usize].le_escaped())
+        .map(|&i| scene.lights[i as usize].le(d))
         .sum()
 }
 
@@ -410,8 +481,10 @@ fn escaped(scene: &RenderScene) -> Vec3 {
 /// each direction sum to one, so the expected image is pbrt-v3's; the path
 /// lengths covered are the same (emission is collected at depth `maxdepth`,
 /// next-event estimation happens below it).
+#[allow(clippy::too_many_arguments)]
 fn path_li(
     mut ray: Ray,
+    diff: Option<RayDiff>,
     scene: &RenderScene,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
@@ -422,6 +495,9 @@ fn path_li(
     let mut l = Vec3::ZERO;
     let mut bsdf = Bsdf::empty();
     let mut beta = Vec3::ONE;
+    // Only the camera ray has differentials: pbrt-v3's path tracer spawns
+    // every later ray without them, specular bounces included.
+    let mut diff = diff;
     let mut specular_bounce = false;
     let mut eta_scale = 1.0f32;
     let mut bounces = 0u32;
@@ -436,7 +512,7 @@ fn path_li(
         let Some(hit) = hit else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
-                let le = light.le_escaped();
+                let le = light.le(ray.d);
                 let w = match prev {
                     Some(r) if !specular_bounce => {
                         bsdf_mis_weight(scene, lights, &r, i, ray.d, bsdf_pdf)
@@ -472,9 +548,19 @@ fn path_li(
                 break;
             }
             ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            diff = None;
             continue;
         }
-        shade(scene, &hit, &mut s, material, true, &mut bsdf);
+        shade(
+            scene,
+            &hit,
+            &mut s,
+            material,
+            true,
+            diff.as_ref(),
+            &mut bsdf,
+        );
+        diff = None;
         if bsdf.has_non_specular() {
             l += beta * sample_light_mis(scene, &s, &bsdf, wo, sampler, scratch, lights);
         }
@@ -718,7 +804,7 @@ fn estimate_direct(
                             Vec3::ZERO
                         }
                     }
-                    None => light.le_escaped(),
+                    None => light.le(bs.wi),
                 };
                 ld += f * li * weight / bs.pdf;
             }

@@ -1,19 +1,22 @@
 //! Lights: diffuse area lights (one per triangle, as pbrt-v3, or per sphere),
-//! point, spot, distant and constant infinite lights; and the distributions
-//! that choose which light to sample.
+//! point, spot, distant and infinite lights (constant or an environment
+//! map, [`infinite`]); and the distributions that choose which light to
+//! sample.
 
 mod distribution;
+pub mod infinite;
 mod pack;
 
 pub use distribution::{LightSampler, LightSamplerKind};
+pub use infinite::{EnvMap, EnvSampling};
 pub use pack::{dot3, lane3, pack_triangle_lights, splat3, TriangleLightPack, Vec3x4};
 
 use crate::render::accel::Geometry;
 use crate::render::geometry::{luminance, spawn_ray, spawn_ray_to, spawn_ray_to_point, Frame, Ray};
-use crate::render::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
 use crate::render::shapes::{sample_triangle_point, SurfacePoint};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 /// The shape an area light sits on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -139,7 +142,7 @@ impl TriangleCache {
     }
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Light {
     Area {
         shape: AreaShape,
@@ -167,9 +170,9 @@ pub enum Light {
         scene_radius: f32,
     },
     Infinite {
-        l: Vec3,
         n_samples: u32,
         scene_radius: f32,
+        map: Arc<EnvMap>,
     },
 }
 
@@ -220,10 +223,12 @@ impl Light {
             } => intensity * 2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total)),
             Light::Distant {
                 l, scene_radius, ..
-            }
-            | Light::Infinite {
-                l, scene_radius, ..
             } => l * PI * scene_radius * scene_radius,
+            Light::Infinite {
+                scene_radius,
+                ref map,
+                ..
+            } => map.power_radiance() * PI * scene_radius * scene_radius,
         };
         luminance(p).max(0.0)
     }
@@ -237,11 +242,12 @@ impl Light {
         }
     }
 
-    /// Radiance arriving along a ray that escapes the scene.
+    /// Radiance arriving along a ray with direction `d` that escapes the
+    /// scene (pbrt-v3's `Le`).
     #[inline]
-    pub fn le_escaped(&self) -> Vec3 {
-        match *self {
-            Light::Infinite { l, .. } => l,
+    pub fn le(&self, d: Vec3) -> Vec3 {
+        match self {
+            Light::Infinite { map, .. } => map.le(d),
             _ => Vec3::ZERO,
         }
     }
@@ -388,14 +394,14 @@ impl Light {
                     shadow: spawn_ray_to_point(r.p, r.p_error, r.n, far),
                 })
             }
-            Light::Infinite { l, .. } => {
-                let wi = uniform_sample_sphere(u);
+            Light::Infinite { ref map, .. } => {
+                let (wi, li, pdf) = map.sample(u)?;
                 // Anything in the way occludes an infinitely distant light.
                 let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
                 Some(LightSample {
-                    li: l,
+                    li,
                     wi,
-                    pdf: uniform_sphere_pdf(),
+                    pdf,
                     shadow,
                 })
             }
@@ -409,7 +415,7 @@ impl Light {
     pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
         match *self {
             Light::Area { .. } => self.pdf_li_ray(r, &spawn_ray(r.p, r.p_error, r.n, wi), geom),
-            Light::Infinite { .. } => uniform_sphere_pdf(),
+            Light::Infinite { ref map, .. } => map.pdf(wi),
             _ => 0.0,
         }
     }
@@ -432,7 +438,7 @@ impl Light {
                     }
                 }
             }
-            Light::Infinite { .. } => uniform_sphere_pdf(),
+            Light::Infinite { ref map, .. } => map.pdf(ray.d),
             _ => 0.0,
         }
     }
