@@ -105,7 +105,7 @@ pub fn spawn_ray(p: Vec3, p_error: Vec3, n: Vec3, d: Vec3) -> Ray {
 }
 
 /// A shadow ray between two surface points, both ends offset off their surfaces.
-#[inline]
+#[inline(always)]
 pub fn spawn_ray_to(p0: Vec3, e0: Vec3, n0: Vec3, p1: Vec3, e1: Vec3, n1: Vec3) -> Ray {
     spawn_ray_from_to(offset_ray_origin(p0, e0, n0, p1 - p0), p1, e1, n1)
 }

@@ -47,7 +47,7 @@ impl Matte {
         super::may_scatter(&self.kd) as usize
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn scatter(&self, sc: &ShadingContext, bsdf: &mut Bsdf) {
         let r = self.kd.eval(sc).max(Vec3::ZERO);
         let sigma = self.sigma.eval(sc).clamp(0.0, 90.0);
