@@ -39,7 +39,7 @@ impl BxdfModel for LambertianTransmission {
     fn f(&self, _wo: Vec3, _wi: Vec3) -> Vec3 {
         self.t * FRAC_1_PI
     }
-    #[inline(always)]
+    #[inline]
     fn sample_f(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
         let mut wi = cosine_sample_hemisphere(u);
         if wo.z > 0.0 {

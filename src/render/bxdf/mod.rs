@@ -107,7 +107,7 @@ pub trait BxdfModel {
     fn f(&self, wo: Vec3, wi: Vec3) -> Vec3;
     /// Samples `wi` given `wo`; the default is pbrt-v3's cosine-weighted
     /// hemisphere on `wo`'s side.
-    #[inline]
+    #[inline(always)]
     fn sample_f(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
         let mut wi = cosine_sample_hemisphere(u);
         if wo.z < 0.0 {
