@@ -31,7 +31,7 @@ fn expected_power(l: &Light) -> f64 {
     match *l {
         Light::Point { intensity, .. } => 4.0 * PI * intensity.x as f64,
         Light::Area {
-            shape: AreaShape::Sphere(_),
+            shape: AreaShape::Quadric(_),
             ..
         } => 4.0 * (4.0 * PI * 0.25) * PI,
         Light::Area {
@@ -193,7 +193,7 @@ fn area_light_sampling_matches_its_density() {
         matches!(
             l,
             Light::Area {
-                shape: AreaShape::Sphere(_),
+                shape: AreaShape::Quadric(_),
                 ..
             }
         )

@@ -517,13 +517,35 @@ fn sphere_parameters() {
     assert_eq!((radius, z_min, z_max, phi_max), (2.0, -1.0, 2.0, 360.0));
 }
 
+/// `disk` with pbrt-v3's defaults; an empty one is skipped with a warning, a
+/// negative inner radius is taken as 0.
+#[test]
+fn disk_parameters_and_bad_disks() {
+    let s = load("WorldBegin\nShape \"disk\"\nShape \"disk\" \"float radius\" 2 \"float innerradius\" 3\nShape \"disk\" \"float innerradius\" -1 \"float height\" 0.5 \"float phimax\" 400\nWorldEnd");
+    assert_eq!(s.scene.shapes.len(), 2);
+    let disk = |i: usize| match s.scene.shapes[i].geometry {
+        Geometry::Disk {
+            height,
+            radius,
+            inner_radius,
+            phi_max,
+        } => (height, radius, inner_radius, phi_max),
+        _ => panic!(),
+    };
+    assert_eq!(disk(0), (0.0, 1.0, 0.0, 360.0));
+    assert_eq!(disk(1), (0.5, 1.0, 0.0, 360.0));
+    let w = warnings(&s);
+    assert!(w.contains("mem.pbrt:3:7: disk with an empty extent"), "{w}");
+    assert!(w.contains("innerradius -1 is negative"), "{w}");
+}
+
 #[test]
 fn unsupported_shapes_and_directives_warn_and_load() {
-    let s = load("WorldBegin\nShape \"disk\" \"float radius\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"ptex\"\nShape \"sphere\"\nWorldEnd");
+    let s = load("WorldBegin\nShape \"cone\" \"float radius\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"ptex\"\nShape \"sphere\"\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 1);
     let w = warnings(&s);
     assert!(
-        w.contains("mem.pbrt:2:7: shape \"disk\" is not supported by pbrs: skipped"),
+        w.contains("mem.pbrt:2:7: shape \"cone\" is not supported by pbrs: skipped"),
         "{w}"
     );
     assert!(w.contains("did you mean \"cylinder\""), "{w}");

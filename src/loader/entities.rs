@@ -313,7 +313,6 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
 
 const OTHER_SHAPES: &[&str] = &[
     "cylinder",
-    "disk",
     "cone",
     "paraboloid",
     "hyperboloid",
@@ -374,6 +373,7 @@ pub fn geometry(
                 phi_max: phimax as f32,
             })
         }
+        "disk" => disk(ctx, name, p),
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
         "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
         other => {
@@ -385,11 +385,18 @@ pub fn geometry(
                     "shape skipped",
                 );
             } else {
-                let all: Vec<&str> = ["sphere", "trianglemesh", "plymesh", "objmesh", "gltfmesh"]
-                    .iter()
-                    .chain(OTHER_SHAPES)
-                    .copied()
-                    .collect();
+                let all: Vec<&str> = [
+                    "sphere",
+                    "disk",
+                    "trianglemesh",
+                    "plymesh",
+                    "objmesh",
+                    "gltfmesh",
+                ]
+                .iter()
+                .chain(OTHER_SHAPES)
+                .copied()
+                .collect();
                 let hint = super::state::closest_name(other, &all)
                     .map(|c| format!(" (did you mean \"{c}\"?)"))
                     .unwrap_or_default();
@@ -402,6 +409,47 @@ pub fn geometry(
             None
         }
     }
+}
+
+/// pbrt-v3's `disk` (`height` 0, `radius` 1, `innerradius` 0, `phimax` 360).
+fn disk(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+    let loc_of = |k: &str| p.get(k).map(|q| q.values_loc).unwrap_or(name.loc);
+    let height = float(p, "height", 0.0);
+    let radius = float(p, "radius", 1.0);
+    let mut inner = float(p, "innerradius", 0.0);
+    let phimax = float(p, "phimax", 360.0).clamp(0.0, 360.0);
+    let fits = |v: f64| (v as f32).is_finite();
+    if radius.is_nan() || radius <= 0.0 || !fits(radius) || !fits(height) || !fits(inner) {
+        ctx.error(
+            loc_of("radius"),
+            format!("disk radius {radius} (height {height}, innerradius {inner}) is not a positive 32-bit float"),
+            "bad disk",
+            None,
+        );
+        return None;
+    }
+    if inner < 0.0 {
+        ctx.warn(
+            loc_of("innerradius"),
+            format!("disk innerradius {inner} is negative: 0 is used"),
+            "negative innerradius",
+        );
+        inner = 0.0;
+    }
+    if inner >= radius || phimax <= 0.0 {
+        ctx.warn(
+            name.loc,
+            format!("disk with an empty extent (innerradius {inner} >= radius {radius}, or phimax 0): skipped"),
+            "empty disk",
+        );
+        return None;
+    }
+    Some(Geometry::Disk {
+        height: height as f32,
+        radius: radius as f32,
+        inner_radius: inner as f32,
+        phi_max: phimax as f32,
+    })
 }
 
 /// `plymesh`, and the pbrs extensions `objmesh` and `gltfmesh`: a mesh read

@@ -160,13 +160,14 @@ fn geometry_name(g: &Geometry) -> &'static str {
     match g {
         Geometry::TriangleMesh(_) => "trianglemesh",
         Geometry::Sphere { .. } => "sphere",
+        Geometry::Disk { .. } => "disk",
     }
 }
 
 fn triangles(g: &Geometry) -> usize {
     match g {
         Geometry::TriangleMesh(m) => m.triangle_count(),
-        Geometry::Sphere { .. } => 0,
+        Geometry::Sphere { .. } | Geometry::Disk { .. } => 0,
     }
 }
 

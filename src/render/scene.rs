@@ -7,7 +7,7 @@ use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
-use crate::render::shapes::{AlphaMask, Sphere, TriangleMesh};
+use crate::render::shapes::{AlphaMask, Disk, Quadric, Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::sync::Arc;
@@ -34,7 +34,7 @@ impl RenderScene {
         let mut materials: Vec<Material> = desc.materials.iter().map(Material::new).collect();
         link_materials(&mut materials);
         let mut meshes = Vec::new();
-        let mut spheres = Vec::new();
+        let mut quadrics = Vec::new();
         let mut area: Vec<(AreaShape, AreaLightDesc)> = Vec::new();
         let mut notes = Vec::new();
 
@@ -58,26 +58,13 @@ impl RenderScene {
                     }
                     meshes.push(tm);
                 }
-                &scene::Geometry::Sphere {
-                    radius,
-                    z_min,
-                    z_max,
-                    phi_max,
-                } => {
-                    let mut sp = Sphere::new(
-                        radius,
-                        z_min,
-                        z_max,
-                        phi_max,
-                        to_world,
-                        s.reverse_orientation,
-                        s.material.0,
-                    );
+                g => {
+                    let mut q = quadric(g, to_world, s).expect("not a mesh");
                     if let Some(a) = emit {
-                        sp.light = Some(area.len() as u32);
-                        area.push((AreaShape::Sphere(spheres.len() as u32), a));
+                        q.set_light(Some(area.len() as u32));
+                        area.push((AreaShape::Quadric(quadrics.len() as u32), a));
                     }
-                    spheres.push(sp);
+                    quadrics.push(q);
                 }
             }
         };
@@ -120,7 +107,7 @@ impl RenderScene {
             .iter()
             .filter(|s| s.area_light.is_some())
             .count();
-        let geometry = Geometry::with_instances(meshes, spheres, instances);
+        let geometry = Geometry::with_instances(meshes, quadrics, instances);
         if geometry.degenerate_triangles > 0 {
             notes.push(format!(
                 "{} zero-area triangles left out of the BVH",
@@ -137,11 +124,11 @@ impl RenderScene {
             .map(|&(shape, a)| {
                 let area = match shape {
                     AreaShape::Triangle { mesh, tri } => geometry.meshes[mesh as usize].area(tri),
-                    AreaShape::Sphere(i) => geometry.spheres[i as usize].area(),
+                    AreaShape::Quadric(i) => geometry.quadrics[i as usize].area(),
                 };
                 let tri = match shape {
                     AreaShape::Triangle { mesh, tri } => TriangleCache::new(&geometry, mesh, tri),
-                    AreaShape::Sphere(_) => TriangleCache::default(),
+                    AreaShape::Quadric(_) => TriangleCache::default(),
                 };
                 Light::Area {
                     shape,
@@ -219,10 +206,10 @@ impl RenderScene {
             notes.push(format!("{zero} lights of zero power are never sampled"));
         }
         notes.push(format!(
-            "built: {} triangles in {} meshes, {} spheres, BVH over {} primitives in {:.1} ms; {} lights ({} area lights from {} emissive shapes)",
+            "built: {} triangles in {} meshes, {} quadrics, BVH over {} primitives in {:.1} ms; {} lights ({} area lights from {} emissive shapes)",
             geometry.meshes.iter().map(|m| m.triangle_count() as u64).sum::<u64>(),
             geometry.meshes.len(),
-            geometry.spheres.len(),
+            geometry.quadrics.len(),
             geometry.primitive_count(),
             geometry.build_time.as_secs_f64() * 1e3,
             lights.len(),
@@ -258,27 +245,44 @@ impl RenderScene {
 /// never set inside objects (pbrt-v3 ignores them there).
 fn object(obj: &scene::ObjectDesc) -> Object {
     let mut meshes = Vec::new();
-    let mut spheres = Vec::new();
+    let mut quadrics = Vec::new();
     for s in &obj.shapes {
         match &s.geometry {
             scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, s.object_to_world, s)),
-            &scene::Geometry::Sphere {
-                radius,
-                z_min,
-                z_max,
-                phi_max,
-            } => spheres.push(Sphere::new(
-                radius,
-                z_min,
-                z_max,
-                phi_max,
-                s.object_to_world,
-                s.reverse_orientation,
-                s.material.0,
-            )),
+            g => quadrics.extend(quadric(g, s.object_to_world, s)),
         }
     }
-    Object::new(meshes, spheres)
+    Object::new(meshes, quadrics)
+}
+
+/// An analytic shape in the space `to_world` maps to (`None` for meshes).
+fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadric> {
+    let (reverse, material) = (s.reverse_orientation, s.material.0);
+    Some(match *g {
+        scene::Geometry::TriangleMesh(_) => return None,
+        scene::Geometry::Sphere {
+            radius,
+            z_min,
+            z_max,
+            phi_max,
+        } => Quadric::Sphere(Sphere::new(
+            radius, z_min, z_max, phi_max, to_world, reverse, material,
+        )),
+        scene::Geometry::Disk {
+            height,
+            radius,
+            inner_radius,
+            phi_max,
+        } => Quadric::Disk(Disk::new(
+            height,
+            radius,
+            inner_radius,
+            phi_max,
+            to_world,
+            reverse,
+            material,
+        )),
+    })
 }
 
 /// Transform an object-space mesh to world space (positions in f64 before

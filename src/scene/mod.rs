@@ -217,6 +217,14 @@ pub enum Geometry {
         /// Degrees, (0, 360].
         phi_max: f32,
     },
+    /// pbrt-v3's `disk`: 0 <= inner_radius < radius.
+    Disk {
+        height: f32,
+        radius: f32,
+        inner_radius: f32,
+        /// Degrees, (0, 360].
+        phi_max: f32,
+    },
 }
 
 /// Triangle mesh data in object space, shared between shapes and instances.

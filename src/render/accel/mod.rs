@@ -2,7 +2,7 @@
 //! ([`bvh4`]), with closest-hit and occlusion queries, in two levels.
 //!
 //! - The scene level: one BVH over the world-space primitives (triangles of
-//!   meshes, spheres) and over the world bounds of object instances.
+//!   meshes, quadrics) and over the world bounds of object instances.
 //! - The object level: one BVH per instanced object, over its primitives in
 //!   the object's own space. An instance is a transform and an object index, so
 //!   a thousand instances of an object cost a thousand transforms, not a
@@ -16,7 +16,7 @@
 mod bvh4;
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
-use crate::render::shapes::{intersect_triangle, DiffGeom, Sphere, SurfacePoint, TriangleMesh};
+use crate::render::shapes::{intersect_triangle, DiffGeom, Quadric, SurfacePoint, TriangleMesh};
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
@@ -24,13 +24,13 @@ use obvhs::BvhBuildParams;
 use std::sync::Arc;
 use std::time::Duration;
 
-const SPHERE_TAG: u32 = u32::MAX;
+const QUADRIC_TAG: u32 = u32::MAX;
 const INSTANCE_TAG: u32 = u32::MAX - 1;
 /// `Hit::instance` for a hit on world-space geometry.
 const NO_INSTANCE: u32 = u32::MAX;
 
-/// A primitive: triangle `index` of mesh `mesh`, sphere `index` when
-/// `mesh == SPHERE_TAG`, or instance `index` when `mesh == INSTANCE_TAG`.
+/// A primitive: triangle `index` of mesh `mesh`, quadric `index` when
+/// `mesh == QUADRIC_TAG`, or instance `index` when `mesh == INSTANCE_TAG`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PrimRef {
     mesh: u32,
@@ -41,9 +41,9 @@ impl PrimRef {
     pub fn triangle(mesh: u32, tri: u32) -> Self {
         Self { mesh, index: tri }
     }
-    pub fn sphere(i: u32) -> Self {
+    pub fn quadric(i: u32) -> Self {
         Self {
-            mesh: SPHERE_TAG,
+            mesh: QUADRIC_TAG,
             index: i,
         }
     }
@@ -68,7 +68,7 @@ pub struct Hit {
 #[derive(Clone, Copy, Debug)]
 enum HitLocal {
     Bary([f32; 3]),
-    SpherePoint(DVec3),
+    QuadricPoint(DVec3),
 }
 
 /// Everything a surface hit needs for shading.
@@ -93,17 +93,17 @@ struct Level {
 /// An object definition, built once and shared by all its instances.
 pub struct Object {
     meshes: Vec<TriangleMesh>,
-    spheres: Vec<Sphere>,
+    quadrics: Vec<Quadric>,
     level: Level,
 }
 
 impl Object {
     /// Builds the object's BVH over its shapes (given in object space).
-    pub fn new(meshes: Vec<TriangleMesh>, spheres: Vec<Sphere>) -> Object {
-        let level = Level::build(&meshes, &spheres, &[]);
+    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<Quadric>) -> Object {
+        let level = Level::build(&meshes, &quadrics, &[]);
         Object {
             meshes,
-            spheres,
+            quadrics,
             level,
         }
     }
@@ -124,7 +124,7 @@ impl Object {
         Shapes {
             level: &self.level,
             meshes: &self.meshes,
-            spheres: &self.spheres,
+            quadrics: &self.quadrics,
         }
     }
 }
@@ -274,7 +274,7 @@ impl Level {
     /// Builds the BVH (in parallel, with obvhs's PLOC builder) over the shapes
     /// and the given extra boxes (instances). Zero-area triangles are left
     /// out; an empty level builds no BVH at all.
-    fn build(meshes: &[TriangleMesh], spheres: &[Sphere], extra: &[Bounds3]) -> Level {
+    fn build(meshes: &[TriangleMesh], quadrics: &[Quadric], extra: &[Bounds3]) -> Level {
         let mut prims = Vec::new();
         let mut aabbs = Vec::new();
         let mut bounds = Bounds3::EMPTY;
@@ -291,13 +291,13 @@ impl Level {
                 aabbs.push(Aabb::new(b.min.into(), b.max.into()));
             }
         }
-        for (si, s) in spheres.iter().enumerate() {
+        for (si, s) in quadrics.iter().enumerate() {
             let b = s.bounds();
-            if !(b.min.is_finite() && b.max.is_finite()) || s.radius <= 0.0 || !s.is_invertible() {
+            if !(b.min.is_finite() && b.max.is_finite() && s.is_valid()) {
                 continue;
             }
             bounds = bounds.union(&b);
-            prims.push(PrimRef::sphere(si as u32));
+            prims.push(PrimRef::quadric(si as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
         for (ii, b) in extra.iter().enumerate() {
@@ -312,10 +312,10 @@ impl Level {
             None
         } else {
             // Triangles of meshes with alpha masks are left to the
-            // callbacks (like spheres), so that only they pay for the test.
+            // callbacks (like quadrics), so that only they pay for the test.
             let (bvh, order) = Bvh4::build(&aabbs, build_params(aabbs.len()), |i| {
                 let p = prims[i];
-                (p.mesh != SPHERE_TAG
+                (p.mesh != QUADRIC_TAG
                     && p.mesh != INSTANCE_TAG
                     && meshes[p.mesh as usize].alpha.is_none())
                 .then(|| meshes[p.mesh as usize].vertices(p.index))
@@ -337,7 +337,7 @@ impl Level {
 struct Shapes<'a> {
     level: &'a Level,
     meshes: &'a [TriangleMesh],
-    spheres: &'a [Sphere],
+    quadrics: &'a [Quadric],
 }
 
 impl Shapes<'_> {
@@ -350,19 +350,19 @@ impl Shapes<'_> {
         mut instance_hit: impl FnMut(u32, f32) -> Option<Hit>,
     ) -> Option<Hit> {
         let bvh = self.level.bvh.as_ref()?;
-        // Spheres and instances found so far (triangles come back as values).
+        // Quadrics and instances found so far (triangles come back as values).
         let mut other: Option<Hit> = None;
         let found = bvh.closest(ray, ray.t_max, |pos, t_max| {
             let prim = self.level.prims[pos as usize];
             let h = if prim.mesh == INSTANCE_TAG {
                 instance_hit(prim.index, t_max)
-            } else if prim.mesh == SPHERE_TAG {
-                let s = &self.spheres[prim.index as usize];
+            } else if prim.mesh == QUADRIC_TAG {
+                let s = &self.quadrics[prim.index as usize];
                 s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
                     t,
                     prim,
                     instance: NO_INSTANCE,
-                    local: HitLocal::SpherePoint(p),
+                    local: HitLocal::QuadricPoint(p),
                 })
             } else {
                 self.alpha_triangle(ray, prim, t_max, false)
@@ -393,8 +393,8 @@ impl Shapes<'_> {
             let prim = self.level.prims[pos as usize];
             if prim.mesh == INSTANCE_TAG {
                 instance_hit(prim.index)
-            } else if prim.mesh == SPHERE_TAG {
-                self.spheres[prim.index as usize]
+            } else if prim.mesh == QUADRIC_TAG {
+                self.quadrics[prim.index as usize]
                     .intersect(ray.o, ray.d, ray.t_max)
                     .is_some()
             } else {
@@ -424,7 +424,7 @@ impl Shapes<'_> {
     fn diff_geom(&self, prim: PrimRef, local: HitLocal, ns: Vec3) -> DiffGeom {
         match local {
             HitLocal::Bary(b) => self.meshes[prim.mesh as usize].diff_geom(prim.index, b, ns),
-            HitLocal::SpherePoint(p) => self.spheres[prim.index as usize].diff_geom(p),
+            HitLocal::QuadricPoint(p) => self.quadrics[prim.index as usize].diff_geom(p),
         }
     }
 
@@ -442,13 +442,13 @@ impl Shapes<'_> {
                     m.n.is_some(),
                 )
             }
-            HitLocal::SpherePoint(p) => {
-                let s = &self.spheres[prim.index as usize];
+            HitLocal::QuadricPoint(p) => {
+                let s = &self.quadrics[prim.index as usize];
                 (
                     SurfaceHit {
                         point: s.surface_point(p),
-                        material: s.material,
-                        light: s.light,
+                        material: s.material(),
+                        light: s.light(),
                     },
                     false,
                 )
@@ -461,8 +461,8 @@ impl Shapes<'_> {
 pub struct Geometry {
     /// World-space meshes (lights refer to their triangles by index).
     pub meshes: Vec<TriangleMesh>,
-    /// World-space spheres.
-    pub spheres: Vec<Sphere>,
+    /// World-space quadrics (spheres, disks).
+    pub quadrics: Vec<Quadric>,
     top: Level,
     instances: Vec<Instance>,
     /// World bounds of everything, instances included.
@@ -475,15 +475,15 @@ pub struct Geometry {
 
 impl Geometry {
     /// Builds the scene-level BVH over world-space shapes alone.
-    pub fn new(meshes: Vec<TriangleMesh>, spheres: Vec<Sphere>) -> Geometry {
-        Geometry::with_instances(meshes, spheres, Vec::new())
+    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<Quadric>) -> Geometry {
+        Geometry::with_instances(meshes, quadrics, Vec::new())
     }
 
     /// Builds the scene-level BVH over world-space shapes and instances (whose
     /// objects were built before). Instances of empty objects are dropped.
     pub fn with_instances(
         meshes: Vec<TriangleMesh>,
-        spheres: Vec<Sphere>,
+        quadrics: Vec<Quadric>,
         instances: Vec<Instance>,
     ) -> Geometry {
         let start = std::time::Instant::now();
@@ -492,7 +492,7 @@ impl Geometry {
             .filter(|i| !i.object.is_empty())
             .collect();
         let boxes: Vec<Bounds3> = instances.iter().map(Instance::world_bounds).collect();
-        let top = Level::build(&meshes, &spheres, &boxes);
+        let top = Level::build(&meshes, &quadrics, &boxes);
         let mut degenerate = top.degenerate;
         let mut seen: Vec<*const Object> = Vec::new();
         for i in &instances {
@@ -504,7 +504,7 @@ impl Geometry {
         }
         Geometry {
             meshes,
-            spheres,
+            quadrics,
             bounds: top.bounds,
             top,
             instances,
@@ -517,7 +517,7 @@ impl Geometry {
         Shapes {
             level: &self.top,
             meshes: &self.meshes,
-            spheres: &self.spheres,
+            quadrics: &self.quadrics,
         }
     }
 

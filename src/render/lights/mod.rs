@@ -21,8 +21,12 @@ use std::sync::Arc;
 /// The shape an area light sits on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AreaShape {
-    Triangle { mesh: u32, tri: u32 },
-    Sphere(u32),
+    Triangle {
+        mesh: u32,
+        tri: u32,
+    },
+    /// A sphere, disk or other analytic shape of `Geometry::quadrics`.
+    Quadric(u32),
 }
 
 /// World-space vertices of a triangle light, cached so that sampling it does
@@ -320,8 +324,8 @@ impl Light {
                         let s = geom.meshes[mesh as usize].sample_area(tri, u);
                         crate::render::shapes::to_solid_angle(r.p, s)?
                     }
-                    AreaShape::Sphere(i) => {
-                        geom.spheres[i as usize].sample_from(r.p, r.p_error, r.n, u)?
+                    AreaShape::Quadric(i) => {
+                        geom.quadrics[i as usize].sample_from(r.p, r.p_error, r.n, u)?
                     }
                 };
                 let d = s.point.p - r.p;
@@ -430,11 +434,8 @@ impl Light {
                 let wi = ray.d;
                 match shape {
                     AreaShape::Triangle { .. } => tri.hit_pdf(ray),
-                    AreaShape::Sphere(i) => {
-                        let s = &geom.spheres[i as usize];
-                        s.pdf_from(r.p, r.p_error, r.n, wi, |o, d| {
-                            s.intersect(o, d, f32::INFINITY)
-                        })
+                    AreaShape::Quadric(i) => {
+                        geom.quadrics[i as usize].pdf_from(r.p, r.p_error, r.n, wi)
                     }
                 }
             }

@@ -1,9 +1,13 @@
-//! Shapes in world space: triangle meshes and spheres, with intersection,
+//! Shapes in world space: triangle meshes and quadrics (spheres, disks), with intersection,
 //! surface interactions carrying error bounds, and sampling for area lights.
 
+mod disk;
+mod quadric;
 mod sphere;
 mod triangle;
 
+pub use disk::Disk;
+pub use quadric::Quadric;
 pub use sphere::Sphere;
 pub use sphere::{area_to_solid_angle, to_solid_angle};
 pub use triangle::{
