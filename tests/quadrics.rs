@@ -1,4 +1,4 @@
-//! pbrt-v3's quadrics (so far: `disk`) against analytic answers.
+//! pbrt-v3's quadrics (so far: `disk`, `cylinder`) against analytic answers.
 //!
 //! - intersection: rays through known points hit there (t, point, normal,
 //!   uv); rays through the hole, the cut-out sector, past the rim, parallel
@@ -19,7 +19,7 @@ use pbrs::render::geometry::{offset_ray_origin, Frame};
 use pbrs::render::lights::{AreaShape, Light};
 use pbrs::render::sampling::Pcg32;
 use pbrs::render::scene::RenderScene;
-use pbrs::render::shapes::{Disk, SurfacePoint};
+use pbrs::render::shapes::{Cylinder, Disk, SurfacePoint};
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -282,4 +282,124 @@ fn disk_light_over_a_plane_gives_the_analytic_irradiance() {
     println!("disk light over a plane: relative RMS error {rel:.5}, worst pixel {worst:.4}");
     assert!(rel < 0.01, "relative RMS error {rel}");
     assert!(worst < 0.04, "worst pixel {worst}");
+}
+
+/// Radius 0.5, z in [-1, 2], φmax 300°, moved by (1, 2, 3).
+fn tube() -> Cylinder {
+    Cylinder::new(
+        0.5,
+        -1.0,
+        2.0,
+        300.0,
+        DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0)),
+        false,
+        0,
+    )
+}
+
+#[test]
+fn cylinder_hits_where_the_tube_says() {
+    let c = tube();
+    let off = Vec3::new(1.0, 2.0, 3.0);
+    // From outside along -x at z = 0.5, y = 0.3: hits x = sqrt(0.25 - 0.09) = 0.4.
+    let (t, p) = c
+        .intersect(off + Vec3::new(5.0, 0.3, 0.5), -Vec3::X, f32::INFINITY)
+        .expect("hit");
+    assert!((t - 4.6).abs() < 1e-5, "t {t}");
+    let sp = c.surface_point(p);
+    assert!(
+        (sp.n - Vec3::new(0.8, 0.6, 0.0)).length() < 1e-5,
+        "{}",
+        sp.n
+    );
+    let g = c.diff_geom(p);
+    let phi = 0.6f32.atan2(0.8);
+    assert!((g.uv.x - phi / 300f32.to_radians()).abs() < 1e-5);
+    assert!((g.uv.y - 0.5).abs() < 1e-5);
+    assert!(g.dpdu.cross(g.dpdv).normalize().dot(sp.n) > 0.999);
+    // dn/du = dp/du / radius (the normal turns with φ).
+    assert!((g.dndu - g.dpdu / 0.5).length() < 1e-4);
+    // From the axis (inside), the far side only.
+    let (t, _) = c
+        .intersect(off + Vec3::new(0.0, 0.0, 0.5), Vec3::X, f32::INFINITY)
+        .expect("from inside");
+    assert!((t - 0.5).abs() < 1e-6);
+    // Above zmax, in the cut-out sector (φ = 330°), along the axis: misses.
+    assert!(c
+        .intersect(off + Vec3::new(5.0, 0.3, 2.1), -Vec3::X, f32::INFINITY)
+        .is_none());
+    let (s, co) = 330f32.to_radians().sin_cos();
+    assert!(c
+        .intersect(off + Vec3::new(co, s, 0.0), -Vec3::new(co, s, 0.0), 0.6)
+        .is_none());
+    assert!(c.intersect(off, Vec3::Z, f32::INFINITY).is_none());
+    let want = 3.0 * 0.5 * 300f64.to_radians();
+    assert!((c.area() as f64 - want).abs() < 1e-5 * want);
+}
+
+#[test]
+fn rays_leaving_a_cylinder_do_not_rehit_it_at_any_scale() {
+    let mut rng = Pcg32::with_sequence(8);
+    for scale in [1e-4f64, 1e-2, 1.0, 1e3, 1e5] {
+        let m = DMat4::from_translation(DVec3::new(0.3, -0.2, 0.7) * scale)
+            * DMat4::from_rotation_y(0.4)
+            * DMat4::from_rotation_x(-1.1)
+            * DMat4::from_scale(DVec3::splat(scale));
+        let c = Cylinder::new(1.0, -0.5, 0.5, 360.0, m, false, 0);
+        for i in 0..4000 {
+            let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+            let s = c.sample_area(u).point;
+            // Outwards (any angle) must miss; inwards must hit the far side,
+            // never this side again (t well above the error bound).
+            let f = Frame::from_normal(s.n);
+            let cos = 1e-3 + rng.uniform_f32() * 0.999;
+            let sin = (1.0 - cos * cos).sqrt();
+            let phi = rng.uniform_f32() * std::f32::consts::TAU;
+            let w = f.from_local(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
+            let o = offset_ray_origin(s.p, s.p_error, s.n, w);
+            assert!(
+                c.intersect(o, w, f32::INFINITY).is_none(),
+                "scale {scale}, sample {i}: re-hit going out"
+            );
+            let w_in = -s.n;
+            let o = offset_ray_origin(s.p, s.p_error, s.n, w_in);
+            let (t, _) = c.intersect(o, w_in, f32::INFINITY).expect("far side");
+            assert!(
+                (t as f64 - 2.0 * scale).abs() < 1e-3 * scale,
+                "scale {scale}: t {t}"
+            );
+        }
+    }
+}
+
+#[test]
+fn cylinder_light_sampling_matches_its_density() {
+    let (r, zmin, zmax) = (0.4f64, -0.5f64, 0.3f64);
+    let sc = disk_light_scene(&format!(
+        "Shape \"cylinder\" \"float radius\" [{r}] \"float zmin\" [{zmin}] \"float zmax\" [{zmax}]"
+    ));
+    let light = the_light(&sc);
+    // Object (0, 0, 0) on the axis is world (0, 1, 0).
+    let p = at(Vec3::new(0.0, 1.0, 0.0));
+    let mut rng = Pcg32::with_sequence(12);
+    let n = 400_000;
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+        let s = light.sample_li(&p, u, &sc.geometry).expect("a sample");
+        let pdf = light.pdf_li(&p, s.wi, &sc.geometry);
+        assert!((pdf - s.pdf).abs() <= 1e-3 * s.pdf, "{} vs {pdf}", s.pdf);
+        let inv = 1.0 / s.pdf as f64;
+        sum += inv;
+        sum2 += inv * inv;
+    }
+    let mean = sum / n as f64;
+    let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
+    let omega =
+        2.0 * PI * (zmax / (zmax * zmax + r * r).sqrt() - zmin / (zmin * zmin + r * r).sqrt());
+    println!("cylinder: E[1/pdf] = {mean} ± {se}, solid angle {omega}");
+    assert!(
+        (mean - omega).abs() < 4.0 * se + 1e-4 * omega,
+        "{mean} vs {omega}"
+    );
 }

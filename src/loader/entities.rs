@@ -312,7 +312,6 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
 // ---------------------------------------------------------------- shapes
 
 const OTHER_SHAPES: &[&str] = &[
-    "cylinder",
     "cone",
     "paraboloid",
     "hyperboloid",
@@ -374,6 +373,7 @@ pub fn geometry(
             })
         }
         "disk" => disk(ctx, name, p),
+        "cylinder" => cylinder(ctx, name, p),
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
         "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
         other => {
@@ -388,6 +388,7 @@ pub fn geometry(
                 let all: Vec<&str> = [
                     "sphere",
                     "disk",
+                    "cylinder",
                     "trianglemesh",
                     "plymesh",
                     "objmesh",
@@ -409,6 +410,40 @@ pub fn geometry(
             None
         }
     }
+}
+
+/// pbrt-v3's `cylinder` (`radius` 1, `zmin` -1, `zmax` 1, `phimax` 360).
+fn cylinder(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+    let radius = float(p, "radius", 1.0);
+    let (zmin, zmax) = (float(p, "zmin", -1.0), float(p, "zmax", 1.0));
+    let phimax = float(p, "phimax", 360.0).clamp(0.0, 360.0);
+    let fits = |v: f64| (v as f32).is_finite();
+    if radius.is_nan() || radius <= 0.0 || !fits(radius) || !fits(zmin) || !fits(zmax) {
+        let loc = p.get("radius").map(|q| q.values_loc).unwrap_or(name.loc);
+        ctx.error(
+            loc,
+            format!("cylinder radius {radius} (zmin {zmin}, zmax {zmax}) is not a positive 32-bit float"),
+            "bad cylinder",
+            None,
+        );
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax itself.
+    let (z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z0 >= z1 || phimax <= 0.0 {
+        ctx.warn(
+            name.loc,
+            "cylinder with an empty extent (zmin = zmax or phimax 0): skipped",
+            "empty cylinder",
+        );
+        return None;
+    }
+    Some(Geometry::Cylinder {
+        radius: radius as f32,
+        z_min: z0 as f32,
+        z_max: z1 as f32,
+        phi_max: phimax as f32,
+    })
 }
 
 /// pbrt-v3's `disk` (`height` 0, `radius` 1, `innerradius` 0, `phimax` 360).

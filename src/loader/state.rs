@@ -670,7 +670,9 @@ impl<'s, 'c> Builder<'s, 'c> {
                 texture::shape_alpha(self.ctx, params, "alpha", &g.textures),
                 texture::shape_alpha(self.ctx, params, "shadowalpha", &g.textures),
             ),
-            Geometry::Sphere { .. } | Geometry::Disk { .. } => (None, None),
+            Geometry::Sphere { .. } | Geometry::Disk { .. } | Geometry::Cylinder { .. } => {
+                (None, None)
+            }
         };
         let material = self.material_for_shape(&g.material, params, &g.textures);
         let area_light = area.map(|a| self.area_light(a));

@@ -161,13 +161,14 @@ fn geometry_name(g: &Geometry) -> &'static str {
         Geometry::TriangleMesh(_) => "trianglemesh",
         Geometry::Sphere { .. } => "sphere",
         Geometry::Disk { .. } => "disk",
+        Geometry::Cylinder { .. } => "cylinder",
     }
 }
 
 fn triangles(g: &Geometry) -> usize {
     match g {
         Geometry::TriangleMesh(m) => m.triangle_count(),
-        Geometry::Sphere { .. } | Geometry::Disk { .. } => 0,
+        Geometry::Sphere { .. } | Geometry::Disk { .. } | Geometry::Cylinder { .. } => 0,
     }
 }
 

@@ -7,7 +7,7 @@ use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
-use crate::render::shapes::{AlphaMask, Disk, Quadric, Sphere, TriangleMesh};
+use crate::render::shapes::{AlphaMask, Cylinder, Disk, Quadric, Sphere, TriangleMesh};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::sync::Arc;
@@ -266,6 +266,14 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
             z_max,
             phi_max,
         } => Quadric::Sphere(Sphere::new(
+            radius, z_min, z_max, phi_max, to_world, reverse, material,
+        )),
+        scene::Geometry::Cylinder {
+            radius,
+            z_min,
+            z_max,
+            phi_max,
+        } => Quadric::Cylinder(Cylinder::new(
             radius, z_min, z_max, phi_max, to_world, reverse, material,
         )),
         scene::Geometry::Disk {

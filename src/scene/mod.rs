@@ -217,6 +217,14 @@ pub enum Geometry {
         /// Degrees, (0, 360].
         phi_max: f32,
     },
+    /// pbrt-v3's `cylinder`: z_min < z_max.
+    Cylinder {
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        /// Degrees, (0, 360].
+        phi_max: f32,
+    },
     /// pbrt-v3's `disk`: 0 <= inner_radius < radius.
     Disk {
         height: f32,

@@ -1,11 +1,13 @@
-//! Shapes in world space: triangle meshes and quadrics (spheres, disks), with intersection,
+//! Shapes in world space: triangle meshes and quadrics (spheres, disks, cylinders), with intersection,
 //! surface interactions carrying error bounds, and sampling for area lights.
 
+mod cylinder;
 mod disk;
 mod quadric;
 mod sphere;
 mod triangle;
 
+pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use quadric::Quadric;
 pub use sphere::Sphere;

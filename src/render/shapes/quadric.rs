@@ -2,7 +2,7 @@
 //! only delegates: the BVH holds them as non-triangle primitives, traced by
 //! callback, and area lights sit on them.
 
-use super::{DiffGeom, Disk, ShapeSample, Sphere, SurfacePoint};
+use super::{Cylinder, DiffGeom, Disk, ShapeSample, Sphere, SurfacePoint};
 use crate::render::geometry::Bounds3;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -10,6 +10,7 @@ use glam::{DVec3, Vec2, Vec3};
 pub enum Quadric {
     Sphere(Sphere),
     Disk(Disk),
+    Cylinder(Cylinder),
 }
 
 macro_rules! each {
@@ -17,6 +18,7 @@ macro_rules! each {
         match $self {
             Quadric::Sphere($s) => $e,
             Quadric::Disk($s) => $e,
+            Quadric::Cylinder($s) => $e,
         }
     };
 }
@@ -49,6 +51,7 @@ impl Quadric {
         match self {
             Quadric::Sphere(s) => s.radius > 0.0 && s.is_invertible(),
             Quadric::Disk(d) => d.is_valid(),
+            Quadric::Cylinder(c) => c.is_valid(),
         }
     }
 
@@ -74,6 +77,7 @@ impl Quadric {
         match self {
             Quadric::Sphere(s) => s.sample_from(p, p_error, n, u),
             Quadric::Disk(d) => d.sample_from(p, u),
+            Quadric::Cylinder(c) => c.sample_from(p, u),
         }
     }
 
@@ -85,6 +89,7 @@ impl Quadric {
                 s.pdf_from(p, p_error, n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
             }
             Quadric::Disk(d) => d.pdf_from(p, p_error, n, wi),
+            Quadric::Cylinder(c) => c.pdf_from(p, p_error, n, wi),
         }
     }
 }
