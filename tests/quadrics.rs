@@ -1,4 +1,5 @@
-//! pbrt-v3's quadrics (so far: `disk`, `cylinder`) against analytic answers.
+//! pbrt-v3's `disk` and `cylinder` against analytic answers (cones, paraboloids
+//! and hyperboloids: tests/quadric_surfaces.rs).
 //!
 //! - intersection: rays through known points hit there (t, point, normal,
 //!   uv); rays through the hole, the cut-out sector, past the rim, parallel

@@ -311,15 +311,27 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
 
 // ---------------------------------------------------------------- shapes
 
-const OTHER_SHAPES: &[&str] = &[
+const OTHER_SHAPES: &[&str] = &["curve", "heightfield", "loopsubdiv", "nurbs"];
+
+/// The shapes pbrs builds (pbrt-v3's, and the mesh-file extensions).
+const SHAPES: &[&str] = &[
+    "sphere",
+    "disk",
+    "cylinder",
     "cone",
     "paraboloid",
     "hyperboloid",
-    "curve",
-    "heightfield",
-    "loopsubdiv",
-    "nurbs",
+    "trianglemesh",
+    "plymesh",
+    "objmesh",
+    "gltfmesh",
 ];
+
+/// True for shapes pbrs skips as unsupported or unknown (an invalid shape of
+/// a supported type got an error or warning of its own).
+pub fn is_unsupported_shape(name: &str) -> bool {
+    !SHAPES.contains(&name)
+}
 
 /// The geometry of a `Shape`, or `None` (unsupported: warning; invalid: error).
 pub fn geometry(
@@ -374,6 +386,9 @@ pub fn geometry(
         }
         "disk" => disk(ctx, name, p),
         "cylinder" => cylinder(ctx, name, p),
+        "cone" => cone(ctx, name, p),
+        "paraboloid" => paraboloid(ctx, name, p),
+        "hyperboloid" => hyperboloid(ctx, name, p),
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
         "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
         other => {
@@ -385,19 +400,7 @@ pub fn geometry(
                     "shape skipped",
                 );
             } else {
-                let all: Vec<&str> = [
-                    "sphere",
-                    "disk",
-                    "cylinder",
-                    "trianglemesh",
-                    "plymesh",
-                    "objmesh",
-                    "gltfmesh",
-                ]
-                .iter()
-                .chain(OTHER_SHAPES)
-                .copied()
-                .collect();
+                let all: Vec<&str> = SHAPES.iter().chain(OTHER_SHAPES).copied().collect();
                 let hint = super::state::closest_name(other, &all)
                     .map(|c| format!(" (did you mean \"{c}\"?)"))
                     .unwrap_or_default();
@@ -443,6 +446,177 @@ fn cylinder(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
         z_min: z0 as f32,
         z_max: z1 as f32,
         phi_max: phimax as f32,
+    })
+}
+
+/// `phimax` clamped to [0, 360] as pbrt-v3; `None` (with a warning) at 0.
+fn phi_max(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<f32> {
+    let phimax = float(p, "phimax", 360.0);
+    let clamped = if phimax.is_nan() {
+        0.0
+    } else {
+        phimax.clamp(0.0, 360.0)
+    };
+    if clamped <= 0.0 {
+        let loc = p.get("phimax").map(|q| q.values_loc).unwrap_or(name.loc);
+        ctx.warn(
+            loc,
+            format!(
+                "{} with phimax {phimax}: an empty surface, skipped",
+                name.value
+            ),
+            "phimax must be > 0",
+        );
+        return None;
+    }
+    Some(clamped as f32)
+}
+
+/// An error unless every value is a finite 32-bit float and `positive` ones
+/// are > 0.
+fn check_floats(ctx: &mut Ctx, name: &Name, p: &ParamList, values: &[(&str, f64, bool)]) -> bool {
+    for &(k, v, positive) in values {
+        let ok = (v as f32).is_finite() && (!positive || v > 0.0);
+        if !ok {
+            let loc = p.get(k).map(|q| q.values_loc).unwrap_or(name.loc);
+            let what = if positive {
+                "a positive 32-bit float"
+            } else {
+                "a finite 32-bit float"
+            };
+            ctx.error(
+                loc,
+                format!("{} {k} {v} is not {what}", name.value),
+                format!("bad {k}"),
+                None,
+            );
+            return false;
+        }
+    }
+    true
+}
+
+/// pbrt-v3's `cone` (`radius` 1, `height` 1, `phimax` 360).
+fn cone(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+    let radius = float(p, "radius", 1.0);
+    let height = float(p, "height", 1.0);
+    if !check_floats(
+        ctx,
+        name,
+        p,
+        &[("radius", radius, true), ("height", height, true)],
+    ) {
+        return None;
+    }
+    Some(Geometry::Cone {
+        radius: radius as f32,
+        height: height as f32,
+        phi_max: phi_max(ctx, name, p)?,
+    })
+}
+
+/// pbrt-v3's `paraboloid` (`radius` 1, `zmin` 0, `zmax` 1, `phimax` 360).
+fn paraboloid(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+    let radius = float(p, "radius", 1.0);
+    let (zmin, zmax) = (float(p, "zmin", 0.0), float(p, "zmax", 1.0));
+    if !check_floats(
+        ctx,
+        name,
+        p,
+        &[
+            ("radius", radius, true),
+            ("zmin", zmin, false),
+            ("zmax", zmax, false),
+        ],
+    ) {
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax; its surface x² + y² = r² z / zmax has
+    // points only where z / zmax >= 0.
+    let (mut z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z1 <= 0.0 {
+        let loc = p.get("zmax").map(|q| q.values_loc).unwrap_or(name.loc);
+        ctx.error(
+            loc,
+            format!(
+                "paraboloid zmax {z1} is not positive (the paraboloid opens upwards from z = 0)"
+            ),
+            "zmax must be > 0",
+            None,
+        );
+        return None;
+    }
+    if z0 < 0.0 {
+        let loc = p.get("zmin").map(|q| q.values_loc).unwrap_or(name.loc);
+        ctx.warn(
+            loc,
+            format!("paraboloid zmin {z0} is below its apex at z = 0: 0 is used (the surface has no points below)"),
+            "negative zmin",
+        );
+        z0 = 0.0;
+    }
+    if z0 >= z1 {
+        ctx.warn(
+            name.loc,
+            format!("paraboloid with zmin = zmax = {z1}: an empty surface, skipped"),
+            "empty paraboloid",
+        );
+        return None;
+    }
+    Some(Geometry::Paraboloid {
+        radius: radius as f32,
+        z_min: z0 as f32,
+        z_max: z1 as f32,
+        phi_max: phi_max(ctx, name, p)?,
+    })
+}
+
+/// pbrt-v3's `hyperboloid` (`p1` 0 0 0, `p2` 1 1 1, `phimax` 360).
+fn hyperboloid(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+    let p1 = point3(p, "p1", DVec3::ZERO);
+    let p2 = point3(p, "p2", DVec3::ONE);
+    let loc = p
+        .get("p1")
+        .or_else(|| p.get("p2"))
+        .map(|q| q.values_loc)
+        .unwrap_or(name.loc);
+    if !(p1.as_vec3().is_finite() && p2.as_vec3().is_finite()) {
+        ctx.error(
+            loc,
+            "hyperboloid p1/p2 are not finite 32-bit floats",
+            "bad point",
+            None,
+        );
+        return None;
+    }
+    let (p1, p2) = (p1.as_vec3(), p2.as_vec3());
+    let bad = |why: &str| {
+        format!(
+            "hyperboloid p1 [{} {} {}], p2 [{} {} {}]: {why}",
+            p1.x, p1.y, p1.z, p2.x, p2.y, p2.z
+        )
+    };
+    if p1.z == p2.z {
+        ctx.error(loc, bad("p1 and p2 are at the same height, so they define no hyperboloid (pbrt-v3 divides by zero); use a disk for an annulus"), "p1.z = p2.z", None);
+        return None;
+    }
+    let Some((a, c)) =
+        crate::render::shapes::hyperboloid_coefficients(p1.as_dvec3(), p2.as_dvec3())
+    else {
+        ctx.error(loc, bad("the line through them meets the z axis, which makes a cone, not a hyperboloid (pbrt-v3 never finishes building it); use a cone"), "no hyperboloid", None);
+        return None;
+    };
+    let (z0, z1) = (p1.z.min(p2.z) as f64, p1.z.max(p2.z) as f64);
+    let rho2 = |z: f64| (1.0 + c * z * z) / a;
+    let inside = z0 < 0.0 && z1 > 0.0;
+    if !(rho2(z0) > 0.0 && rho2(z1) > 0.0 && (!inside || rho2(0.0) > 0.0)) {
+        ctx.error(loc, bad("the implicit surface pbrt-v3 fits to them has no points at some heights between p1 and p2 (not a hyperboloid of one sheet there)"), "not a hyperboloid", None);
+        return None;
+    }
+    Some(Geometry::Hyperboloid {
+        p1,
+        p2,
+        phi_max: phi_max(ctx, name, p)?,
     })
 }
 

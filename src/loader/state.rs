@@ -653,12 +653,8 @@ impl<'s, 'c> Builder<'s, 'c> {
         }
         let geometry = entities::geometry(self.ctx, name, params, &mut self.meshes);
         let Some(geometry) = geometry else {
-            if matches!(
-                name.value.as_str(),
-                "sphere" | "trianglemesh" | "plymesh" | "objmesh" | "gltfmesh"
-            ) {
-                // An error was reported.
-            } else {
+            // Otherwise an error or an empty-shape warning was reported.
+            if entities::is_unsupported_shape(&name.value) {
                 self.unsupported_shapes += 1;
             }
             params.mark_all_used();
@@ -670,9 +666,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 texture::shape_alpha(self.ctx, params, "alpha", &g.textures),
                 texture::shape_alpha(self.ctx, params, "shadowalpha", &g.textures),
             ),
-            Geometry::Sphere { .. } | Geometry::Disk { .. } | Geometry::Cylinder { .. } => {
-                (None, None)
-            }
+            _ => (None, None),
         };
         let material = self.material_for_shape(&g.material, params, &g.textures);
         let area_light = area.map(|a| self.area_light(a));

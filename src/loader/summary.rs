@@ -162,13 +162,16 @@ fn geometry_name(g: &Geometry) -> &'static str {
         Geometry::Sphere { .. } => "sphere",
         Geometry::Disk { .. } => "disk",
         Geometry::Cylinder { .. } => "cylinder",
+        Geometry::Cone { .. } => "cone",
+        Geometry::Paraboloid { .. } => "paraboloid",
+        Geometry::Hyperboloid { .. } => "hyperboloid",
     }
 }
 
 fn triangles(g: &Geometry) -> usize {
     match g {
         Geometry::TriangleMesh(m) => m.triangle_count(),
-        Geometry::Sphere { .. } | Geometry::Disk { .. } | Geometry::Cylinder { .. } => 0,
+        _ => 0,
     }
 }
 

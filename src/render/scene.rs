@@ -7,7 +7,9 @@ use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
-use crate::render::shapes::{AlphaMask, Cylinder, Disk, Quadric, Sphere, TriangleMesh};
+use crate::render::shapes::{
+    AlphaMask, Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Quadric, Sphere, TriangleMesh,
+};
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::sync::Arc;
@@ -275,6 +277,24 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
             phi_max,
         } => Quadric::Cylinder(Cylinder::new(
             radius, z_min, z_max, phi_max, to_world, reverse, material,
+        )),
+        scene::Geometry::Cone {
+            radius,
+            height,
+            phi_max,
+        } => Quadric::Cone(Cone::new(
+            radius, height, phi_max, to_world, reverse, material,
+        )),
+        scene::Geometry::Paraboloid {
+            radius,
+            z_min,
+            z_max,
+            phi_max,
+        } => Quadric::Paraboloid(Paraboloid::new(
+            radius, z_min, z_max, phi_max, to_world, reverse, material,
+        )),
+        scene::Geometry::Hyperboloid { p1, p2, phi_max } => Quadric::Hyperboloid(Hyperboloid::new(
+            p1, p2, phi_max, to_world, reverse, material,
         )),
         scene::Geometry::Disk {
             height,

@@ -225,6 +225,28 @@ pub enum Geometry {
         /// Degrees, (0, 360].
         phi_max: f32,
     },
+    /// pbrt-v3's `cone`: radius > 0, height > 0.
+    Cone {
+        radius: f32,
+        height: f32,
+        /// Degrees, (0, 360].
+        phi_max: f32,
+    },
+    /// pbrt-v3's `paraboloid`: radius > 0, 0 <= z_min < z_max.
+    Paraboloid {
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        /// Degrees, (0, 360].
+        phi_max: f32,
+    },
+    /// pbrt-v3's `hyperboloid` through p1 and p2 (checked to have one).
+    Hyperboloid {
+        p1: glam::Vec3,
+        p2: glam::Vec3,
+        /// Degrees, (0, 360].
+        phi_max: f32,
+    },
     /// pbrt-v3's `disk`: 0 <= inner_radius < radius.
     Disk {
         height: f32,

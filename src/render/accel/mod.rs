@@ -16,7 +16,9 @@
 mod bvh4;
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
-use crate::render::shapes::{intersect_triangle, DiffGeom, Quadric, SurfacePoint, TriangleMesh};
+use crate::render::shapes::{
+    intersect_triangle, DiffGeom, Quadric, QuadricHit, SurfacePoint, TriangleMesh,
+};
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
@@ -68,7 +70,7 @@ pub struct Hit {
 #[derive(Clone, Copy, Debug)]
 enum HitLocal {
     Bary([f32; 3]),
-    QuadricPoint(DVec3),
+    Quadric(QuadricHit),
 }
 
 /// Everything a surface hit needs for shading.
@@ -362,7 +364,7 @@ impl Shapes<'_> {
                     t,
                     prim,
                     instance: NO_INSTANCE,
-                    local: HitLocal::QuadricPoint(p),
+                    local: HitLocal::Quadric(p),
                 })
             } else {
                 self.alpha_triangle(ray, prim, t_max, false)
@@ -424,7 +426,7 @@ impl Shapes<'_> {
     fn diff_geom(&self, prim: PrimRef, local: HitLocal, ns: Vec3) -> DiffGeom {
         match local {
             HitLocal::Bary(b) => self.meshes[prim.mesh as usize].diff_geom(prim.index, b, ns),
-            HitLocal::QuadricPoint(p) => self.quadrics[prim.index as usize].diff_geom(p),
+            HitLocal::Quadric(p) => self.quadrics[prim.index as usize].diff_geom(p),
         }
     }
 
@@ -442,7 +444,7 @@ impl Shapes<'_> {
                     m.n.is_some(),
                 )
             }
-            HitLocal::QuadricPoint(p) => {
+            HitLocal::Quadric(p) => {
                 let s = &self.quadrics[prim.index as usize];
                 (
                     SurfaceHit {

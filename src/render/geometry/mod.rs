@@ -6,6 +6,7 @@
 //! normal and rounded away from the surface. There is no fixed epsilon.
 
 mod bounds;
+pub mod efloat;
 mod frame;
 mod ray;
 

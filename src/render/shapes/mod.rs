@@ -1,15 +1,21 @@
-//! Shapes in world space: triangle meshes and quadrics (spheres, disks, cylinders), with intersection,
+//! Shapes in world space: triangle meshes and quadrics (spheres, disks, cylinders, cones, paraboloids, hyperboloids), with intersection,
 //! surface interactions carrying error bounds, and sampling for area lights.
 
+mod cone;
 mod cylinder;
 mod disk;
+mod hyperboloid;
+mod paraboloid;
 mod quadric;
 mod sphere;
 mod triangle;
 
+pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
-pub use quadric::Quadric;
+pub use hyperboloid::{hyperboloid_coefficients, Hyperboloid};
+pub use paraboloid::Paraboloid;
+pub use quadric::{Placement, Quadric, QuadricHit};
 pub use sphere::Sphere;
 pub use sphere::{area_to_solid_angle, to_solid_angle};
 pub use triangle::{

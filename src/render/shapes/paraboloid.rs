@@ -1,0 +1,216 @@
+//! pbrt-v3's `paraboloid`: x² + y² = `radius`² · z / `zmax` of its object
+//! space (radius `radius` at z = `zmax`, apex at the origin) for z in
+//! [`zmin`, `zmax`] and φ in [0, `phimax`]; open at the top. Its normal
+//! points away from the axis (and down).
+//!
+//! | parameter | type  | pbrt-v3 default |
+//! |-----------|-------|-----------------|
+//! | `radius`  | float | 1               |
+//! | `zmin`    | float | 0               |
+//! | `zmax`    | float | 1               |
+//! | `phimax`  | float | 360 (degrees)   |
+//!
+//! Ray tests are pbrt-v3's: f32 in object space with running error bounds
+//! (`EFloat`), as the cone's (see there). u = φ/φmax,
+//! v = (z − zmin)/(zmax − zmin), derivatives as pbrt-v3's
+//! `Paraboloid::Intersect`. pbrt-v3 cannot sample paraboloids, so a
+//! paraboloid area light is a pbrs extension: uniform by area (the area
+//! above z grows as (4cz + 1)^{3/2}, inverted in closed form), with the
+//! exact world-area density.
+
+use super::quadric::{pbrt_closest, phi_f32, phi_of, solid_angle_pdf, weingarten, Placement};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};
+use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct Paraboloid {
+    pub radius: f64,
+    pub z_min: f64,
+    pub z_max: f64,
+    /// Radians.
+    pub phi_max: f64,
+    pub place: Placement,
+    pub material: u32,
+    pub light: Option<u32>,
+    /// (4c·zmin + 1)^{3/2} and (4c·zmax + 1)^{3/2}, c = zmax / radius².
+    a_min: f64,
+    a_max: f64,
+    obj_area: f64,
+    area: f32,
+}
+
+impl Paraboloid {
+    /// The loader ensures 0 <= z_min < z_max and radius > 0.
+    pub fn new(
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        phi_max_deg: f32,
+        object_to_world: DMat4,
+        reverse: bool,
+        material: u32,
+    ) -> Paraboloid {
+        let r = radius.abs() as f64;
+        let (z0, z1) = (z_min.min(z_max) as f64, z_min.max(z_max) as f64);
+        let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
+        let place = Placement::new(object_to_world, reverse);
+        let c = z1 / (r * r);
+        let (a_min, a_max) = (
+            (4.0 * c * z0 + 1.0).powf(1.5),
+            (4.0 * c * z1 + 1.0).powf(1.5),
+        );
+        let obj_area = phi_max / (12.0 * c * c) * (a_max - a_min);
+        Paraboloid {
+            radius: r,
+            z_min: z0,
+            z_max: z1,
+            phi_max,
+            area: place.world_area(obj_area),
+            place,
+            material,
+            light: None,
+            a_min,
+            a_max,
+            obj_area,
+        }
+    }
+
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    pub fn is_valid(&self) -> bool {
+        self.place.is_valid()
+            && self.radius > 0.0
+            && self.z_max > self.z_min
+            && self.z_min >= 0.0
+            && self.area > 0.0
+            && self.area.is_finite()
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        let r = self.radius;
+        self.place
+            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+    }
+
+    /// c = zmax / radius²: the surface is c (x² + y²) = z.
+    #[inline]
+    fn c(&self) -> f64 {
+        self.z_max / (self.radius * self.radius)
+    }
+
+    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Paraboloid::Intersect`
+    /// computes it (f32 with running error bounds).
+    #[inline]
+    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, Vec3, Vec3)> {
+        let (o, d) = transform_ray(&self.place.world_to_object_f32, o, d);
+        let (r, z0, z1) = (self.radius as f32, self.z_min as f32, self.z_max as f32);
+        let k = EFloat::exact(z1) / (EFloat::exact(r) * EFloat::exact(r));
+        let [ox, oy, oz] = o;
+        let [dx, dy, dz] = d;
+        let a = k * (dx * dx + dy * dy);
+        let b = 2.0 * k * (dx * ox + dy * oy) - dz;
+        let c = k * (ox * ox + oy * oy) - oz;
+        let phi_max = self.phi_max as f32;
+        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
+            p.z < z0 || p.z > z1 || phi_f32(p) > phi_max
+        })
+    }
+
+    #[inline]
+    fn tangents(&self, p: DVec3) -> (DVec3, DVec3) {
+        let (pm, dz) = (self.phi_max, self.z_max - self.z_min);
+        (
+            DVec3::new(-pm * p.y, pm * p.x, 0.0),
+            dz * DVec3::new(p.x / (2.0 * p.z), p.y / (2.0 * p.z), 1.0),
+        )
+    }
+
+    /// Outward object normal: ∂p/∂u × ∂p/∂v as pbrt-v3 (the implicit
+    /// gradient at the apex, where that is undefined).
+    #[inline]
+    fn normal_obj(&self, p: DVec3) -> DVec3 {
+        let (dpdu, dpdv) = self.tangents(p);
+        let n = dpdu.cross(dpdv);
+        if n.is_finite() && n.length_squared() > 0.0 {
+            n
+        } else {
+            let k = self.c();
+            DVec3::new(2.0 * k * p.x, 2.0 * k * p.y, -1.0)
+        }
+    }
+
+    pub fn surface_point(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
+        self.place.surface_point(p_obj, self.normal_obj(p_obj), err)
+    }
+
+    pub fn diff_geom(&self, p: DVec3) -> DiffGeom {
+        let (pm, dz) = (self.phi_max, self.z_max - self.z_min);
+        let u = phi_of(p) / pm;
+        let v = (p.z - self.z_min) / dz;
+        let (dpdu, dpdv) = self.tangents(p);
+        let d2uu = -pm * pm * DVec3::new(p.x, p.y, 0.0);
+        let d2uv = dz * pm * DVec3::new(-p.y / (2.0 * p.z), p.x / (2.0 * p.z), 0.0);
+        let d2vv = -dz * dz * DVec3::new(p.x / (4.0 * p.z * p.z), p.y / (4.0 * p.z * p.z), 0.0);
+        let (dndu, dndv) = weingarten(dpdu, dpdv, d2uu, d2uv, d2vv);
+        let (dpdu, dpdv) = (self.place.vector(dpdu), self.place.vector(dpdv));
+        let (dndu, dndv) = (
+            self.place.normal_derivative(dndu),
+            self.place.normal_derivative(dndv),
+        );
+        DiffGeom {
+            uv: Vec2::new(u as f32, v as f32),
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            shading_dndu: dndu,
+            shading_dndv: dndv,
+            ..DiffGeom::ZERO
+        }
+    }
+
+    #[inline]
+    pub fn area_density(&self, p_obj: DVec3) -> f32 {
+        (1.0 / (self.obj_area * self.place.area_scale(self.normal_obj(p_obj)))) as f32
+    }
+
+    /// Uniform by area.
+    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+        let k = self.c();
+        let a = self.a_min + (self.a_max - self.a_min) * u.x as f64;
+        let z = ((a.powf(2.0 / 3.0) - 1.0) / (4.0 * k)).clamp(self.z_min, self.z_max);
+        let phi = self.phi_max * u.y as f64;
+        let rho = (z / k).sqrt();
+        let p_obj = DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
+        ShapeSample {
+            point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
+            pdf: self.area_density(p_obj),
+        }
+    }
+
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        super::to_solid_angle(p, self.sample_area(u))
+    }
+
+    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        let o = offset_ray_origin(p, p_error, n, wi);
+        match self.intersect(o, wi, f32::INFINITY) {
+            Some((_, q, err)) => {
+                let q = q.as_dvec3();
+                solid_angle_pdf(
+                    p,
+                    &self.surface_point(q, err.as_dvec3()),
+                    wi,
+                    self.area_density(q),
+                )
+            }
+            None => 0.0,
+        }
+    }
+}
