@@ -318,9 +318,6 @@ const OTHER_SHAPES: &[&str] = &[
     "paraboloid",
     "hyperboloid",
     "curve",
-    "heightfield",
-    "loopsubdiv",
-    "nurbs",
 ];
 
 /// The geometry of a `Shape`, or `None` (unsupported: warning; invalid: error).
@@ -376,6 +373,7 @@ pub fn geometry(
         }
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
         "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
+        "loopsubdiv" | "nurbs" | "heightfield" => super::refine::shape(ctx, name, p),
         other => {
             p.mark_all_used();
             if OTHER_SHAPES.contains(&other) {
@@ -388,6 +386,7 @@ pub fn geometry(
                 let all: Vec<&str> = ["sphere", "trianglemesh", "plymesh", "objmesh", "gltfmesh"]
                     .iter()
                     .chain(OTHER_SHAPES)
+                    .chain(super::refine::REFINED_SHAPES)
                     .copied()
                     .collect();
                 let hint = super::state::closest_name(other, &all)
