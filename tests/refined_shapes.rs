@@ -364,32 +364,26 @@ fn loop_unused_vertices_are_left_out_with_a_warning() {
 
 // ---------------------------------------------------------------- nurbs
 
-fn nurbs(
-    nu: usize,
-    uorder: usize,
-    uknots: &[f64],
-    nv: usize,
-    vorder: usize,
-    vknots: &[f64],
-    points: &str,
-    extra: &str,
-) -> String {
+/// One direction of a patch: control points, order, knots.
+type Dir<'a> = (usize, usize, &'a [f64]);
+
+fn nurbs(u: Dir, v: Dir, points: &str, extra: &str) -> String {
     format!(
-        "Shape \"nurbs\" \"integer nu\" [ {nu} ] \"integer uorder\" [ {uorder} ] \"float uknots\" [ {} ] \"integer nv\" [ {nv} ] \"integer vorder\" [ {vorder} ] \"float vknots\" [ {} ] {points} {extra}",
-        nums(uknots),
-        nums(vknots)
+        "Shape \"nurbs\" \"integer nu\" [ {} ] \"integer uorder\" [ {} ] \"float uknots\" [ {} ] \"integer nv\" [ {} ] \"integer vorder\" [ {} ] \"float vknots\" [ {} ] {points} {extra}",
+        u.0,
+        u.1,
+        nums(u.2),
+        v.0,
+        v.1,
+        nums(v.2)
     )
 }
 
 /// A bilinear patch of four coplanar corners on z = 0.3x − 0.2y + 1.
 fn plane_patch(extra: &str) -> String {
     nurbs(
-        2,
-        2,
-        &[0.0, 0.0, 1.0, 1.0],
-        2,
-        2,
-        &[0.0, 0.0, 1.0, 1.0],
+        (2, 2, &[0.0, 0.0, 1.0, 1.0]),
+        (2, 2, &[0.0, 0.0, 1.0, 1.0]),
         "\"point P\" [ 0 0 1   2 0.5 1.5   -0.5 1 0.65   1.5 2.5 0.95 ]",
         extra,
     )
@@ -457,12 +451,8 @@ fn quarter_cylinder(extra: &str) -> String {
     let w = std::f64::consts::FRAC_1_SQRT_2;
     let row = |z: f64| format!("1 0 {z} 1   {w} {w} {} {w}   0 1 {z} 1", z * w);
     nurbs(
-        3,
-        3,
-        &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
-        2,
-        2,
-        &[0.0, 0.0, 1.0, 1.0],
+        (3, 3, &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]),
+        (2, 2, &[0.0, 0.0, 1.0, 1.0]),
         &format!("\"float Pw\" [ {}   {} ]", row(0.0), row(2.0)),
         extra,
     )
@@ -508,12 +498,8 @@ fn nurbs_cubic_bezier_patch_matches_bernstein() {
     }
     let k = [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
     let m = mesh(&nurbs(
-        4,
-        4,
-        &k,
-        4,
-        4,
-        &k,
+        (4, 4, &k),
+        (4, 4, &k),
         &format!("\"point P\" [ {} ]", nums(&pts)),
         "",
     ));
@@ -525,9 +511,9 @@ fn nurbs_cubic_bezier_patch_matches_bernstein() {
         let uv = m.uvs.as_ref().unwrap()[k].as_dvec2();
         let (bu, bv) = (b(uv.x), b(uv.y));
         let mut want = DVec3::ZERO;
-        for j in 0..4 {
-            for i in 0..4 {
-                want += bu[i] * bv[j] * DVec3::new(i as f64, j as f64, h(i, j));
+        for (j, bj) in bv.iter().enumerate() {
+            for (i, bi) in bu.iter().enumerate() {
+                want += bi * bj * DVec3::new(i as f64, j as f64, h(i, j));
             }
         }
         assert!(close(*p, want, 1e-6), "{p} vs {want}");
@@ -540,24 +526,24 @@ fn nurbs_bad_input_is_an_error() {
     let p4 = "\"point P\" [ 0 0 0 1 0 0 0 1 0 1 1 0 ]";
     let cases: Vec<(String, &str)> = vec![
         (
-            nurbs(2, 2, &[0.0, 0.0, 1.0], 2, 2, &k2, p4, ""),
+            nurbs((2, 2, &[0.0, 0.0, 1.0]), (2, 2, &k2), p4, ""),
             "knots",
         ),
-        (nurbs(2, 2, &k2, 2, 2, &k2, "\"point P\" [ 0 0 0 1 0 0 0 1 0 ]", ""), "nu × nv"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, "\"float Pw\" [ 0 0 0 1 1 0 0 1 0 1 0 1 1 1 0 ]", ""), "multiple of 4"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, "\"float Pw\" [ 0 0 0 1 1 0 0 1 0 1 0 1 ]", ""), "nu × nv"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, "\"float Pw\" [ 0 0 0 1 1 0 0 1 0 1 0 0 1 1 0 1 ]", ""), "positive"),
-        (nurbs(2, 1, &[0.0, 0.0, 1.0], 2, 2, &k2, p4, ""), "orders 2 to"),
-        (nurbs(2, 3, &[0.0, 0.0, 0.0, 1.0, 1.0], 2, 2, &k2, p4, ""), "fewer control points"),
-        (nurbs(2, 2, &[0.0, 1.0, 0.5, 1.0], 2, 2, &k2, p4, ""), "decreases"),
-        (nurbs(2, 2, &[0.0, 0.5, 0.5, 1.0], 2, 2, &k2, p4, ""), "empty"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, p4, "\"float u0\" [ 0.5 ] \"float u1\" [ 0.5 ]"), "empty"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, p4, "\"float u1\" [ 1.5 ]"), "outside"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, p4, "\"float v0\" [ -0.1 ]"), "outside"),
-        (nurbs(2, 2, &[0.0, 0.0, 1.0, 1e39], 2, 2, &k2, p4, ""), "finite"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, "\"point P\" [ 0 0 0 1 0 0 0 1 0 1 1 1e39 ]", ""), "finite"),
-        (nurbs(2, 2, &k2, 2, 2, &k2, "", ""), "\"point P\" or \"float Pw\""),
-        (nurbs(100, 100, &(0..200).map(|i| i as f64).collect::<Vec<_>>(), 2, 2, &k2, p4, ""), "orders 2 to"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), "\"point P\" [ 0 0 0 1 0 0 0 1 0 ]", ""), "nu × nv"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), "\"float Pw\" [ 0 0 0 1 1 0 0 1 0 1 0 1 1 1 0 ]", ""), "multiple of 4"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), "\"float Pw\" [ 0 0 0 1 1 0 0 1 0 1 0 1 ]", ""), "nu × nv"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), "\"float Pw\" [ 0 0 0 1 1 0 0 1 0 1 0 0 1 1 0 1 ]", ""), "positive"),
+        (nurbs((2, 1, &[0.0, 0.0, 1.0]), (2, 2, &k2), p4, ""), "orders 2 to"),
+        (nurbs((2, 3, &[0.0, 0.0, 0.0, 1.0, 1.0]), (2, 2, &k2), p4, ""), "fewer control points"),
+        (nurbs((2, 2, &[0.0, 1.0, 0.5, 1.0]), (2, 2, &k2), p4, ""), "decreases"),
+        (nurbs((2, 2, &[0.0, 0.5, 0.5, 1.0]), (2, 2, &k2), p4, ""), "empty"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), p4, "\"float u0\" [ 0.5 ] \"float u1\" [ 0.5 ]"), "empty"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), p4, "\"float u1\" [ 1.5 ]"), "outside"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), p4, "\"float v0\" [ -0.1 ]"), "outside"),
+        (nurbs((2, 2, &[0.0, 0.0, 1.0, 1e39]), (2, 2, &k2), p4, ""), "finite"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), "\"point P\" [ 0 0 0 1 0 0 0 1 0 1 1 1e39 ]", ""), "finite"),
+        (nurbs((2, 2, &k2), (2, 2, &k2), "", ""), "\"point P\" or \"float Pw\""),
+        (nurbs((100, 100, &(0..200).map(|i| i as f64).collect::<Vec<_>>()), (2, 2, &k2), p4, ""), "orders 2 to"),
         (
             "Shape \"nurbs\" \"integer nu\" [ 2 ] \"integer uorder\" [ 2 ] \"float uknots\" [ 0 0 1 1 ]".into(),
             "\"integer nv\"",
@@ -579,12 +565,8 @@ fn nurbs_bad_input_is_an_error() {
 fn nurbs_degenerate_edge_gives_zero_normals_not_nan() {
     // All four v = 0 control points at one spot: ∂p/∂u vanishes along that edge.
     let m = mesh(&nurbs(
-        2,
-        2,
-        &[0.0, 0.0, 1.0, 1.0],
-        2,
-        2,
-        &[0.0, 0.0, 1.0, 1.0],
+        (2, 2, &[0.0, 0.0, 1.0, 1.0]),
+        (2, 2, &[0.0, 0.0, 1.0, 1.0]),
         "\"point P\" [ 0 0 1  0 0 1  -1 1 0  1 1 0 ]",
         "",
     ));
@@ -710,4 +692,29 @@ fn refined_shapes_render_finite_with_the_expected_mean() {
             "{name}"
         );
     }
+}
+
+#[test]
+fn nurbs_empty_first_knot_span_is_evaluated_at_its_right() {
+    // Knots 0 0 0 1 1 (order 2, three points): the first span of the domain
+    // is empty (pbrt-v3 divides by zero there); the curve runs from the
+    // second control point to the third.
+    let m = mesh(&nurbs(
+        (3, 2, &[0.0, 0.0, 0.0, 1.0, 1.0]),
+        (2, 2, &[0.0, 0.0, 1.0, 1.0]),
+        "\"point P\" [ 5 5 5  0 0 0  1 0 0   5 5 6  0 1 0  1 1 0 ]",
+        "",
+    ));
+    assert!(m.positions.iter().all(|p| p.is_finite()));
+    assert!(
+        close(m.positions[0], DVec3::ZERO, 1e-6),
+        "{}",
+        m.positions[0]
+    );
+    assert!(
+        close(m.positions[29], DVec3::X, 1e-6),
+        "{}",
+        m.positions[29]
+    );
+    assert!(close(m.positions[899], DVec3::new(1.0, 1.0, 0.0), 1e-6));
 }
