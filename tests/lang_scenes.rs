@@ -137,6 +137,20 @@ const EXPECT: &[Expect] = &[
             "integrator: whitted, maxdepth 5",
         ],
     },
+    Expect {
+        // heightfield 11·9·2, Loop grid 32·16, Loop octahedron 8·64, two
+        // NURBS 2·29·29 each, ground 2.
+        file: "refined-shapes.pbrt",
+        warnings: &[],
+        shapes: 6,
+        triangles: 198 + 512 + 512 + 2 * 1682 + 2,
+        area_lights: 0,
+        materials: &[("matte", 2), ("plastic", 4)],
+        lines: &[
+            "shapes:     6 (6 trianglemesh)",
+            "lights:     2 (0 area-light shapes; 1 distant, 1 infinite)",
+        ],
+    },
 ];
 
 fn scenes_dir() -> std::path::PathBuf {

@@ -311,7 +311,7 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
 
 // ---------------------------------------------------------------- shapes
 
-const OTHER_SHAPES: &[&str] = &["curve", "heightfield", "loopsubdiv", "nurbs"];
+const OTHER_SHAPES: &[&str] = &["curve"];
 
 /// The shapes pbrs builds (pbrt-v3's, and the mesh-file extensions).
 const SHAPES: &[&str] = &[
@@ -330,7 +330,7 @@ const SHAPES: &[&str] = &[
 /// True for shapes pbrs skips as unsupported or unknown (an invalid shape of
 /// a supported type got an error or warning of its own).
 pub fn is_unsupported_shape(name: &str) -> bool {
-    !SHAPES.contains(&name)
+    !SHAPES.contains(&name) && !super::refine::REFINED_SHAPES.contains(&name)
 }
 
 /// The geometry of a `Shape`, or `None` (unsupported: warning; invalid: error).
@@ -391,6 +391,7 @@ pub fn geometry(
         "hyperboloid" => hyperboloid(ctx, name, p),
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
         "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
+        "loopsubdiv" | "nurbs" | "heightfield" => super::refine::shape(ctx, name, p),
         other => {
             p.mark_all_used();
             if OTHER_SHAPES.contains(&other) {
@@ -400,7 +401,12 @@ pub fn geometry(
                     "shape skipped",
                 );
             } else {
-                let all: Vec<&str> = SHAPES.iter().chain(OTHER_SHAPES).copied().collect();
+                let all: Vec<&str> = SHAPES
+                    .iter()
+                    .chain(OTHER_SHAPES)
+                    .chain(super::refine::REFINED_SHAPES)
+                    .copied()
+                    .collect();
                 let hint = super::state::closest_name(other, &all)
                     .map(|c| format!(" (did you mean \"{c}\"?)"))
                     .unwrap_or_default();

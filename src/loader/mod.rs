@@ -5,7 +5,8 @@
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
 //! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
 //!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`;
-//!   [`fourier`]: the tabulated BSDF reader for the `fourier` material.
+//!   [`fourier`]: the tabulated BSDF reader for the `fourier` material;
+//!   [`refine`]: `loopsubdiv`, `nurbs` and `heightfield` as triangle meshes.
 //! - [`image`]: image files for textures and lights, read once per scene.
 //! - [`summary`]: what `pbrs --check` prints.
 
@@ -18,6 +19,7 @@ pub mod material;
 pub mod meshfile;
 pub mod ply;
 pub mod reference;
+pub mod refine;
 pub mod spd;
 pub mod state;
 pub mod summary;

@@ -660,8 +660,11 @@ impl<'s, 'c> Builder<'s, 'c> {
             params.mark_all_used();
             return None;
         };
-        // pbrt-v3 reads alpha textures for triangle meshes only.
+        // pbrt-v3 reads alpha textures for triangle meshes only (and passes
+        // none to the meshes it refines from other shapes).
+        let refined = crate::loader::refine::REFINED_SHAPES.contains(&name.value.as_str());
         let (alpha, shadow_alpha) = match geometry {
+            Geometry::TriangleMesh(_) if refined => (None, None),
             Geometry::TriangleMesh(_) => (
                 texture::shape_alpha(self.ctx, params, "alpha", &g.textures),
                 texture::shape_alpha(self.ctx, params, "shadowalpha", &g.textures),
