@@ -15,6 +15,7 @@ fn film_desc(w: u32, h: u32, crop: [f32; 4]) -> FilmDesc {
         filename: "out.exr".into(),
         scale: 1.0,
         max_sample_luminance: f32::INFINITY,
+        diagonal: 35.0,
     }
 }
 

@@ -15,6 +15,7 @@ fn film_desc(w: u32, h: u32) -> FilmDesc {
         filename: "out.pfm".into(),
         scale: 1.0,
         max_sample_luminance: f32::INFINITY,
+        diagonal: 35.0,
     }
 }
 

@@ -95,7 +95,10 @@ fn defaults_without_options() {
         fov,
         focal_distance,
         ..
-    } = s.camera.kind;
+    } = s.camera.kind
+    else {
+        panic!("not perspective")
+    };
     assert_eq!((fov, focal_distance), (90.0, 1e6));
 }
 
@@ -238,14 +241,18 @@ fn camera_coordinate_system_and_world_reset() {
         panic!()
     };
     assert!(close(position, DVec3::new(0.0, 0.0, -5.0)));
-    let CameraKind::Perspective { fov, .. } = s.camera.kind;
+    let CameraKind::Perspective { fov, .. } = s.camera.kind else {
+        panic!("not perspective")
+    };
     assert_eq!(fov, 45.0);
 }
 
 #[test]
 fn halffov_and_named_coordinate_systems() {
     let s = load("Camera \"perspective\" \"float halffov\" 30\nWorldBegin\nTranslate 1 2 3\nCoordinateSystem \"here\"\nIdentity\nCoordSysTransform \"here\"\nShape \"sphere\"\nCoordSysTransform \"nowhere\"\nWorldEnd");
-    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind;
+    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind else {
+        panic!("not perspective")
+    };
     assert_eq!(fov, 60.0);
     assert!(close(
         s.scene.shapes[0]
@@ -557,7 +564,9 @@ fn unsupported_shapes_and_directives_warn_and_load() {
 fn phase_rules() {
     let s = load("Shape \"sphere\"\nWorldBegin\nCamera \"perspective\" \"float fov\" 10\nShape \"sphere\"\nWorldEnd\nWorldBegin\nShape \"sphere\"\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 1);
-    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind;
+    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind else {
+        panic!("not perspective")
+    };
     assert_eq!(fov, 90.0);
     let w = warnings(&s);
     assert!(

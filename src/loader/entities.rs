@@ -897,100 +897,14 @@ fn triangle_mesh(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> 
 
 type Ent<'a> = Option<(&'a Name, &'a ParamList)>;
 
-pub fn camera(ctx: &mut Ctx, c: Option<((&Name, &ParamList), DMat4)>) -> CameraDesc {
-    let empty = ParamList::default();
-    let ((name, p), ctm) = match c {
-        Some(x) => x,
-        None => return default_camera(),
-    };
-    let mut camera_to_world = ctm.inverse();
-    if !camera_to_world.is_finite() || ctm.determinant().abs() < 1e-300 {
-        ctx.error(
-            name.loc,
-            "the camera transform (the CTM at Camera) is singular: it cannot be inverted",
-            "this Camera",
-            None,
-        );
-        camera_to_world = DMat4::IDENTITY;
-    }
-    let p = match name.value.as_str() {
-        "perspective" => p,
-        "orthographic" | "realistic" | "environment" => {
-            p.mark_all_used();
-            ctx.warn(name.loc, format!("camera \"{}\" is not supported by pbrs: a perspective camera with default parameters is used", name.value), "substituted by perspective");
-            &empty
-        }
-        other => {
-            ctx.error(name.loc, format!("unknown camera \"{other}\" (pbrt-v3 has perspective, orthographic, realistic, environment)"), "unknown camera", None);
-            p.mark_all_used();
-            &empty
-        }
-    };
-    let mut fov = float(p, "fov", 90.0);
-    let half = float(p, "halffov", -1.0);
-    if half > 0.0 {
-        fov = 2.0 * half;
-    }
-    if !(fov > 0.0 && fov < 180.0) {
-        let loc = p.get("fov").map(|q| q.values_loc).unwrap_or(name.loc);
-        ctx.error(
-            loc,
-            format!("field of view {fov} is outside (0, 180) degrees"),
-            "bad fov",
-            None,
-        );
-        fov = 90.0;
-    }
-    let lens_radius = float(p, "lensradius", 0.0) as f32;
-    let focal_distance = float(p, "focaldistance", 1e6) as f32;
-    let frame_aspect_ratio = float_opt(p, "frameaspectratio").map(|(v, _)| v as f32);
-    let screen_window = match p
-        .items
-        .iter()
-        .find(|q| q.name == "screenwindow" && q.ty == ParamType::Float)
-    {
-        Some(q) => {
-            q.used.set(true);
-            let v = q.nums();
-            if v.len() == 4 {
-                Some([v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32])
-            } else {
-                ctx.warn(
-                    q.values_loc,
-                    format!(
-                        "\"screenwindow\" needs 4 values, found {}: ignored",
-                        v.len()
-                    ),
-                    "expected 4 values",
-                );
-                None
-            }
-        }
-        None => None,
-    };
-    let mut open = float(p, "shutteropen", 0.0) as f32;
-    let mut close = float(p, "shutterclose", 1.0) as f32;
-    if close < open {
-        ctx.warn(
-            name.loc,
-            "shutterclose < shutteropen: swapped (as pbrt-v3)",
-            "shutter",
-        );
-        std::mem::swap(&mut open, &mut close);
-    }
-    ctx.report_unused(p, &format!("Camera \"{}\"", name.value));
-    CameraDesc {
-        camera_to_world,
-        kind: CameraKind::Perspective {
-            fov: fov as f32,
-            lens_radius,
-            focal_distance,
-            frame_aspect_ratio,
-            screen_window,
-        },
-        shutter_open: open,
-        shutter_close: close,
-    }
+/// The `Camera` directive (see `loader/camera.rs`); `film` gives the
+/// realistic camera its sensor size.
+pub fn camera(
+    ctx: &mut Ctx,
+    c: Option<((&Name, &ParamList), DMat4)>,
+    film: &FilmDesc,
+) -> CameraDesc {
+    super::camera::camera(ctx, c, film)
 }
 
 pub fn default_camera() -> CameraDesc {
@@ -1098,7 +1012,7 @@ pub fn film(ctx: &mut Ctx, f: Ent) -> FilmDesc {
         .map(|(s, _)| s.to_string())
         .unwrap_or_else(|| "pbrt.exr".into());
     let scale = float(p, "scale", 1.0) as f32;
-    float(p, "diagonal", 35.0);
+    let diagonal = float(p, "diagonal", 35.0) as f32;
     let max_sample_luminance = float(p, "maxsampleluminance", f64::INFINITY) as f32;
     if let Some((name, _)) = f {
         ctx.report_unused(p, &format!("Film \"{}\"", name.value));
@@ -1110,6 +1024,7 @@ pub fn film(ctx: &mut Ctx, f: Ent) -> FilmDesc {
         filename: PathBuf::from(filename),
         scale,
         max_sample_luminance,
+        diagonal,
     }
 }
 

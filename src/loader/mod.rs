@@ -10,6 +10,7 @@
 //! - [`image`]: image files for textures and lights, read once per scene.
 //! - [`summary`]: what `pbrs --check` prints.
 
+pub mod camera;
 pub mod cie1931;
 pub mod color;
 pub mod entities;

@@ -832,11 +832,13 @@ impl<'s, 'c> Builder<'s, 'c> {
                 _ => None,
             })
         };
+        // The film first: the realistic camera needs its size.
+        let film = entities::film(self.ctx, ent(self.film));
         let camera = entities::camera(
             self.ctx,
             self.camera.and_then(|(i, m)| ent(Some(i)).map(|e| (e, m))),
+            &film,
         );
-        let film = entities::film(self.ctx, ent(self.film));
         let filter = entities::filter(self.ctx, ent(self.filter));
         let sampler = entities::sampler(self.ctx, ent(self.sampler));
         let integrator = entities::integrator(self.ctx, ent(self.integrator));

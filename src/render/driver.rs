@@ -196,13 +196,20 @@ fn render_tile(
         for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
             let cs = sampler.camera_sample(pixel, lens);
-            let (ray, diff) = if differentials {
-                let (ray, d) = scene.camera.generate_ray_differential(&cs, diff_scale);
-                (ray, Some(d))
+            let (ray, diff, weight) = if differentials {
+                let (ray, d, w) = scene.camera.generate_ray_differential(&cs, diff_scale);
+                (ray, Some(d), w)
             } else {
-                (scene.camera.generate_ray(&cs), None)
+                let (ray, w) = scene.camera.generate_ray(&cs);
+                (ray, None, w)
             };
-            let mut l = integrator.li(ray, diff, scene, &mut sampler, &mut scratch);
+            // pbrt-v3 computes no radiance for a sample the lens blocks
+            // (weight 0), but the film still counts its filter weight.
+            let mut l = if weight > 0.0 {
+                integrator.li(ray, diff, scene, &mut sampler, &mut scratch)
+            } else {
+                Vec3::ZERO
+            };
             // pbrt-v3: samples with NaN, infinite or negative radiance are
             // zeroed (their weight is kept) and counted.
             if l.is_nan() {
@@ -215,7 +222,7 @@ fn render_tile(
                 c.negative += 1;
                 l = Vec3::ZERO;
             }
-            tile.add_sample(cs.p_film, l, 1.0);
+            tile.add_sample(cs.p_film, l, weight);
             c.samples += 1;
         }
     }

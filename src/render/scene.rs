@@ -227,7 +227,7 @@ impl RenderScene {
                 instanced_triangles
             ));
         }
-        let camera = Camera::new(&desc.camera, desc.film.xresolution, desc.film.yresolution);
+        let camera = Camera::new(&desc.camera, &desc.film);
         let material_needs_geom = materials.iter().map(Material::needs_geom).collect();
         let differentials = materials.iter().any(|m| m.needs_geom());
         RenderScene {

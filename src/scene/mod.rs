@@ -71,6 +71,45 @@ pub enum CameraKind {
         /// `screenwindow` as [xmin, xmax, ymin, ymax], if given.
         screen_window: Option<[f32; 4]>,
     },
+    Orthographic {
+        lens_radius: f32,
+        focal_distance: f32,
+        frame_aspect_ratio: Option<f32>,
+        screen_window: Option<[f32; 4]>,
+    },
+    /// Latitude-longitude over the whole sphere of directions.
+    Environment,
+    Realistic(RealisticDesc),
+}
+
+/// A lens system read from a lens file and already focused for the scene's
+/// `focusdistance` (pbrt-v3 focuses when the camera is created).
+#[derive(Clone, Debug)]
+pub struct RealisticDesc {
+    /// The lens file as resolved (for messages and `--check`).
+    pub lens_file: PathBuf,
+    /// Interfaces from the front (scene side) to the rear, in metres, with
+    /// the aperture stop set to `aperturediameter` and the last thickness
+    /// (rear element to film) set by focusing.
+    pub interfaces: Vec<LensInterface>,
+    pub simple_weighting: bool,
+    /// Effective focal length of the lens system (thick-lens approximation),
+    /// in metres.
+    pub focal_length: f32,
+}
+
+/// One row of a lens file in pbrt-v3's lens-system space (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LensInterface {
+    /// Signed radius of the spherical interface; 0 for the aperture stop.
+    pub curvature_radius: f32,
+    /// Distance along the axis to the next interface (to the film for the
+    /// last one).
+    pub thickness: f32,
+    /// Index of refraction of the medium behind this interface (towards the
+    /// film); 0 (the stop) and 1 are air.
+    pub eta: f32,
+    pub aperture_radius: f32,
 }
 
 #[derive(Clone, Debug)]
@@ -84,6 +123,9 @@ pub struct FilmDesc {
     pub filename: PathBuf,
     pub scale: f32,
     pub max_sample_luminance: f32,
+    /// Physical film diagonal in millimetres (`diagonal`; the realistic
+    /// camera's sensor size).
+    pub diagonal: f32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

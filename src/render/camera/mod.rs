@@ -1,183 +1,168 @@
-//! The perspective camera with pbrt-v3's raster conventions: `fov` spans the
-//! shorter image axis, raster y runs down, pixel (x, y) covers [x, x+1)×[y, y+1),
-//! and a thin lens when `lensradius` > 0. Ray differentials as pbrt-v3's
-//! `PerspectiveCamera::GenerateRayDifferential`.
+//! Cameras: pbrt-v3's four, one file each, behind a closed enum that only
+//! delegates (one `match` per camera ray, no dynamic dispatch).
+//!
+//! Every camera returns its ray with a weight that the film multiplies the
+//! radiance by (pbrt-v3's `GenerateRay` return value): 1 for the projective
+//! and environment cameras, the lens weighting for the realistic one, 0 for
+//! a sample the lens blocks (its radiance is not computed, but its filter
+//! weight still counts, as pbrt-v3).
+
+mod environment;
+mod orthographic;
+mod perspective;
+pub mod realistic;
+
+pub use environment::EnvironmentCamera;
+pub use orthographic::OrthographicCamera;
+pub use perspective::PerspectiveCamera;
+pub use realistic::RealisticCamera;
 
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
-use crate::render::sampling::concentric_sample_disk;
-use crate::scene::{CameraDesc, CameraKind};
-use glam::{Affine3A, Vec2, Vec3};
+use crate::scene::{CameraDesc, CameraKind, FilmDesc};
+use glam::{Affine3A, Vec2};
 
 #[derive(Clone, Debug)]
-pub struct Camera {
-    camera_to_world: Affine3A,
-    /// Screen window [xmin, xmax, ymin, ymax].
-    screen: [f32; 4],
-    /// Full film resolution (the crop window does not change the mapping).
-    resolution: Vec2,
-    tan_half_fov: f32,
-    lens_radius: f32,
-    focal_distance: f32,
+pub enum Camera {
+    Perspective(PerspectiveCamera),
+    Orthographic(OrthographicCamera),
+    Environment(EnvironmentCamera),
+    Realistic(RealisticCamera),
+}
+
+/// pbrt-v3's default screen window for a frame aspect ratio: the shorter
+/// image axis spans [-1, 1].
+fn screen_window(window: Option<[f32; 4]>, frame: Option<f32>, resolution: Vec2) -> [f32; 4] {
+    let frame = frame.unwrap_or(resolution.x / resolution.y);
+    window.unwrap_or(if frame > 1.0 {
+        [-frame, frame, -1.0, 1.0]
+    } else {
+        [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
+    })
 }
 
 impl Camera {
-    pub fn new(desc: &CameraDesc, xres: u32, yres: u32) -> Camera {
-        let CameraKind::Perspective {
-            fov,
-            lens_radius,
-            focal_distance,
-            frame_aspect_ratio,
-            screen_window,
-        } = desc.kind;
-        let frame = frame_aspect_ratio.unwrap_or(xres as f32 / yres as f32);
-        let screen = screen_window.unwrap_or(if frame > 1.0 {
-            [-frame, frame, -1.0, 1.0]
-        } else {
-            [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
-        });
-        let m = desc.camera_to_world.as_mat4();
-        Camera {
-            camera_to_world: Affine3A::from_mat4(m),
-            screen,
-            resolution: Vec2::new(xres as f32, yres as f32),
-            tan_half_fov: (fov.clamp(1e-6, 179.99).to_radians() * 0.5).tan(),
-            lens_radius,
-            focal_distance,
+    /// The camera for `desc` on `film` (the full resolution: the crop window
+    /// does not change the mapping).
+    pub fn new(desc: &CameraDesc, film: &FilmDesc) -> Camera {
+        let resolution = Vec2::new(film.xresolution as f32, film.yresolution as f32);
+        let to_world = Affine3A::from_mat4(desc.camera_to_world.as_mat4());
+        match &desc.kind {
+            &CameraKind::Perspective {
+                fov,
+                lens_radius,
+                focal_distance,
+                frame_aspect_ratio,
+                screen_window: window,
+            } => Camera::Perspective(PerspectiveCamera::new(
+                to_world,
+                fov,
+                lens_radius,
+                focal_distance,
+                screen_window(window, frame_aspect_ratio, resolution),
+                resolution,
+            )),
+            &CameraKind::Orthographic {
+                lens_radius,
+                focal_distance,
+                frame_aspect_ratio,
+                screen_window: window,
+            } => Camera::Orthographic(OrthographicCamera::new(
+                to_world,
+                lens_radius,
+                focal_distance,
+                screen_window(window, frame_aspect_ratio, resolution),
+                resolution,
+            )),
+            CameraKind::Environment => {
+                Camera::Environment(EnvironmentCamera::new(to_world, resolution))
+            }
+            CameraKind::Realistic(r) => Camera::Realistic(RealisticCamera::new(
+                to_world,
+                r,
+                resolution,
+                film.diagonal,
+                (desc.shutter_open, desc.shutter_close),
+            )),
         }
     }
 
-    /// True if `generate_ray` reads the sample's lens position (a thin lens;
-    /// time is never read: there is no motion blur).
+    /// True if the camera reads the sample's lens position (time is never
+    /// read: there is no motion blur yet).
     #[inline]
     pub fn uses_lens(&self) -> bool {
-        self.lens_radius > 0.0
-    }
-
-    /// Camera-space direction (z = 1) through a film position.
-    #[inline]
-    fn film_dir(&self, cs: &CameraSample) -> Vec3 {
-        let [x0, x1, y0, y1] = self.screen;
-        let sx = x0 + cs.p_film.x / self.resolution.x * (x1 - x0);
-        let sy = y1 - cs.p_film.y / self.resolution.y * (y1 - y0);
-        Vec3::new(sx * self.tan_half_fov, sy * self.tan_half_fov, 1.0)
-    }
-
-    /// The thin-lens ray from lens point `lens` through the point of the
-    /// plane of focus that direction `dir` reaches, in world space.
-    #[inline]
-    fn lens_ray(&self, dir: Vec3, lens: Vec3) -> Ray {
-        let d = dir.normalize();
-        let ft = self.focal_distance / d.z;
-        let focus = d * ft;
-        let d = (focus - lens).normalize();
-        let wo = self.camera_to_world.transform_point3(lens);
-        let wd = self.camera_to_world.transform_vector3(d).normalize();
-        Ray::new(wo, wd)
-    }
-
-    /// The camera ray for a film position (raster coordinates) and lens sample.
-    #[inline]
-    pub fn generate_ray(&self, cs: &CameraSample) -> Ray {
-        let dir = self.film_dir(cs);
-        if self.lens_radius > 0.0 {
-            let lens = self.lens_radius * concentric_sample_disk(cs.p_lens);
-            return self.lens_ray(dir, Vec3::new(lens.x, lens.y, 0.0));
+        match self {
+            Camera::Perspective(c) => c.uses_lens(),
+            Camera::Orthographic(c) => c.uses_lens(),
+            Camera::Environment(_) => false,
+            Camera::Realistic(_) => true,
         }
-        // Pinhole: one normalisation, after the transform (which may scale).
-        let wo = self.camera_to_world.transform_point3(Vec3::ZERO);
-        let wd = self.camera_to_world.transform_vector3(dir).normalize();
-        Ray::new(wo, wd)
     }
 
-    /// `generate_ray` (the same ray, bit for bit) with the differentials of
-    /// a one-pixel step in x and y, scaled by `scale` (pbrt-v3 renders with
-    /// `ScaleDifferentials(1 / √spp)`). With a lens the offset rays start at
-    /// the same lens point and meet the plane of focus where the shifted
-    /// film positions do.
+    /// The camera ray for a film position (raster coordinates) and lens
+    /// sample, and its weight.
     #[inline]
-    pub fn generate_ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff) {
-        let ray = self.generate_ray(cs);
-        let dir = self.film_dir(cs);
-        let [x0, x1, y0, y1] = self.screen;
-        let dx = Vec3::new((x1 - x0) / self.resolution.x * self.tan_half_fov, 0.0, 0.0);
-        let dy = Vec3::new(0.0, -(y1 - y0) / self.resolution.y * self.tan_half_fov, 0.0);
-        let (rx, ry) = if self.lens_radius > 0.0 {
-            let lens = self.lens_radius * concentric_sample_disk(cs.p_lens);
-            let lens = Vec3::new(lens.x, lens.y, 0.0);
-            (self.lens_ray(dir + dx, lens), self.lens_ray(dir + dy, lens))
-        } else {
-            let offset = |d: Vec3| Ray {
-                d: self.camera_to_world.transform_vector3(d).normalize(),
-                ..ray
-            };
-            (offset(dir + dx), offset(dir + dy))
-        };
-        let diff = RayDiff {
-            rx_o: rx.o,
-            rx_d: rx.d,
-            ry_o: ry.o,
-            ry_d: ry.d,
-        };
-        (ray, diff.scaled(&ray, scale))
+    pub fn generate_ray(&self, cs: &CameraSample) -> (Ray, f32) {
+        match self {
+            Camera::Perspective(c) => (c.generate_ray(cs), 1.0),
+            Camera::Orthographic(c) => (c.generate_ray(cs), 1.0),
+            Camera::Environment(c) => (c.generate_ray(cs), 1.0),
+            // The weight depends on the shifted rays too (see realistic.rs).
+            Camera::Realistic(c) => {
+                let (ray, _, w) = c.generate_ray_differential(cs, 1.0);
+                (ray, w)
+            }
+        }
+    }
+
+    /// `generate_ray` (the same ray and weight) with the differentials of a
+    /// one-pixel step in x and y scaled by `scale` (pbrt-v3 renders with
+    /// `ScaleDifferentials(1 / √spp)`).
+    #[inline]
+    pub fn generate_ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
+        match self {
+            Camera::Perspective(c) => {
+                let (r, d) = c.generate_ray_differential(cs, scale);
+                (r, d, 1.0)
+            }
+            Camera::Orthographic(c) => {
+                let (r, d) = c.generate_ray_differential(cs, scale);
+                (r, d, 1.0)
+            }
+            Camera::Environment(c) => {
+                let (r, d) = c.generate_ray_differential(cs, scale);
+                (r, d, 1.0)
+            }
+            Camera::Realistic(c) => c.generate_ray_differential(cs, scale),
+        }
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::DMat4;
-
-    fn camera(lens_radius: f32) -> Camera {
-        let desc = CameraDesc {
-            camera_to_world: DMat4::from_translation(glam::DVec3::new(0.0, 1.0, -5.0))
-                * DMat4::from_rotation_x(0.2)
-                * DMat4::from_scale(glam::DVec3::new(-1.0, 1.0, 1.0)),
-            kind: CameraKind::Perspective {
-                fov: 40.0,
-                lens_radius,
-                focal_distance: 4.0,
-                frame_aspect_ratio: None,
-                screen_window: None,
-            },
-            shutter_open: 0.0,
-            shutter_close: 1.0,
-        };
-        Camera::new(&desc, 64, 48)
-    }
-
-    /// The differentials at scale 1 are the rays of the film positions one
-    /// pixel over; at scale s their offsets are s times as large.
-    #[test]
-    fn differentials_are_the_neighbouring_pixels_rays() {
-        for lens in [0.0, 0.3] {
-            let cam = camera(lens);
-            let cs = CameraSample {
-                p_film: Vec2::new(10.3, 30.7),
-                p_lens: Vec2::new(0.2, 0.9),
-                time: 0.0,
+/// pbrt-v3's base `Camera::GenerateRayDifferential`: each offset ray is the
+/// ray of the film position shifted by 0.05 pixel (or by −0.05 if that one
+/// is blocked), extrapolated to a whole pixel. `None` if both shifts of an
+/// axis are blocked.
+#[inline]
+fn finite_differences(
+    cs: &CameraSample,
+    ray: &Ray,
+    gen: impl Fn(&CameraSample) -> Option<Ray>,
+) -> Option<RayDiff> {
+    let shifted = |step: Vec2| {
+        [0.05f32, -0.05].into_iter().find_map(|eps| {
+            let s = CameraSample {
+                p_film: cs.p_film + step * eps,
+                ..*cs
             };
-            let (ray, d) = cam.generate_ray_differential(&cs, 1.0);
-            let plain = cam.generate_ray(&cs);
-            assert_eq!((ray.o, ray.d), (plain.o, plain.d));
-            let shifted = |dx: f32, dy: f32| {
-                cam.generate_ray(&CameraSample {
-                    p_film: cs.p_film + Vec2::new(dx, dy),
-                    ..cs
-                })
-            };
-            let (rx, ry) = (shifted(1.0, 0.0), shifted(0.0, 1.0));
-            assert!(
-                (d.rx_o - rx.o).length() < 1e-5 && (d.rx_d - rx.d).length() < 1e-5,
-                "{lens}"
-            );
-            assert!(
-                (d.ry_o - ry.o).length() < 1e-5 && (d.ry_d - ry.d).length() < 1e-5,
-                "{lens}"
-            );
-            let (_, half) = cam.generate_ray_differential(&cs, 0.125);
-            let want = ray.d + (rx.d - ray.d) * 0.125;
-            assert!((half.rx_d - want).length() < 1e-6);
-        }
-    }
+            gen(&s).map(|r| (ray.o + (r.o - ray.o) / eps, ray.d + (r.d - ray.d) / eps))
+        })
+    };
+    let (rx_o, rx_d) = shifted(Vec2::X)?;
+    let (ry_o, ry_d) = shifted(Vec2::Y)?;
+    Some(RayDiff {
+        rx_o,
+        rx_d,
+        ry_o,
+        ry_d,
+    })
 }

@@ -40,6 +40,17 @@ pub struct RayDiff {
 }
 
 impl RayDiff {
+    /// Offset rays equal to `ray` (no footprint).
+    #[inline]
+    pub fn none(ray: &Ray) -> RayDiff {
+        RayDiff {
+            rx_o: ray.o,
+            rx_d: ray.d,
+            ry_o: ray.o,
+            ry_d: ray.d,
+        }
+    }
+
     /// pbrt-v3's `ScaleDifferentials`: the offsets from `ray` times `s`.
     #[inline]
     pub fn scaled(&self, ray: &Ray, s: f32) -> RayDiff {

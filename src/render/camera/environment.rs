@@ -1,0 +1,63 @@
+//! The environment camera (pbrt-v3's `EnvironmentCamera`): a latitude-
+//! longitude map of every direction around the camera position. With raster
+//! position (x, y) on a W×H film, θ = π·y/H from camera-space +y (raster
+//! top row looks straight up, bottom row straight down) and φ = 2π·x/W
+//! around +y starting at +x: direction (sin θ cos φ, cos θ, sin θ sin φ). So
+//! the left edge looks along +x, a quarter across along +z (the camera's
+//! forward axis), the image centre along −x. pbrt-v3 gives it no
+//! differential method of its own: the base `Camera::GenerateRayDifferential`
+//! estimates them by finite differences over ±0.05 pixel, as here.
+//!
+//! | parameter | type | pbrt-v3 default |
+//! |---|---|---|
+//! | `shutteropen`, `shutterclose` | float | 0, 1 (kept; pbrs has no motion blur yet) |
+//! | `lensradius`, `focaldistance`, `frameaspectratio`, `screenwindow` | float | read and ignored by pbrt-v3 (0, 1e30, xres/yres, —) |
+
+use crate::render::geometry::{Ray, RayDiff};
+use crate::render::samplers::CameraSample;
+use glam::{Affine3A, Vec2, Vec3};
+use std::f32::consts::PI;
+
+#[derive(Clone, Debug)]
+pub struct EnvironmentCamera {
+    camera_to_world: Affine3A,
+    resolution: Vec2,
+}
+
+impl EnvironmentCamera {
+    pub fn new(camera_to_world: Affine3A, resolution: Vec2) -> EnvironmentCamera {
+        EnvironmentCamera {
+            camera_to_world,
+            resolution,
+        }
+    }
+
+    /// The camera-space direction of a raster position.
+    #[inline]
+    pub fn direction(&self, p_film: Vec2) -> Vec3 {
+        let theta = PI * p_film.y / self.resolution.y;
+        let phi = 2.0 * PI * p_film.x / self.resolution.x;
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos();
+        Vec3::new(st * cp, ct, st * sp)
+    }
+
+    #[inline]
+    pub fn generate_ray(&self, cs: &CameraSample) -> Ray {
+        Ray::new(
+            self.camera_to_world.transform_point3(Vec3::ZERO),
+            self.camera_to_world
+                .transform_vector3(self.direction(cs.p_film))
+                .normalize(),
+        )
+    }
+
+    #[inline]
+    pub fn generate_ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff) {
+        let ray = self.generate_ray(cs);
+        // Never `None`: every film position has a ray.
+        let diff = super::finite_differences(cs, &ray, |s| Some(self.generate_ray(s)))
+            .unwrap_or_else(|| RayDiff::none(&ray));
+        (ray, diff.scaled(&ray, scale))
+    }
+}
