@@ -41,6 +41,9 @@ pub struct LoadedScene {
     pub scene: SceneDescription,
     pub warnings: Vec<miette::Report>,
     pub summary: Summary,
+    /// Whether the Film gave a 4-value "cropwindow" (pbrt-v3 then ignores
+    /// the command line's `--cropwindow`).
+    pub film_has_cropwindow: bool,
 }
 
 /// A scene that did not load: at least one error.
@@ -63,7 +66,9 @@ impl std::fmt::Debug for LoadFailure {
 pub struct Ctx {
     pub sources: SourceMap,
     pub diags: Diags,
-    pub base_dir: PathBuf,
+    /// Per source file id, the directory its file names are relative to
+    /// (the directory of the top-level scene file it was reached from).
+    pub file_dirs: Vec<PathBuf>,
     pub loader: Box<dyn FileLoader>,
     /// Images read so far (each file is read once).
     pub images: image::ImageCache,
@@ -76,6 +81,17 @@ pub struct Ctx {
 }
 
 impl Ctx {
+    /// A file name written at `loc`, resolved as pbrt-v3 does: relative to
+    /// the directory of the top-level scene file it appears in.
+    pub fn resolve(&self, loc: Loc, name: &str) -> PathBuf {
+        let dir = self
+            .file_dirs
+            .get(loc.file as usize)
+            .map(PathBuf::as_path)
+            .unwrap_or(Path::new(""));
+        crate::lang::parser::resolve(dir, name)
+    }
+
     pub fn warn(&mut self, loc: Loc, msg: impl Into<String>, label: impl Into<String>) {
         let r = self
             .sources
@@ -223,38 +239,75 @@ fn kind_name(kind: ParamKind) -> &'static str {
 
 /// Reads, parses and builds a scene file.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadFailure> {
+    load_scene_files(std::slice::from_ref(&path.to_path_buf()))
+}
+
+/// The name standard input has in diagnostics; its file names are relative
+/// to the current directory.
+pub const STDIN_NAME: &str = "<stdin>";
+
+/// Reads one scene file named on the command line; `-` is standard input.
+pub fn read_scene_input(path: &Path) -> Result<(PathBuf, Arc<str>), LoadFailure> {
+    let stdin = path.as_os_str() == "-";
+    let shown = if stdin {
+        PathBuf::from(STDIN_NAME)
+    } else {
+        path.to_path_buf()
+    };
     // The user named this file, so a pipe is fine here (unlike Include targets).
-    let text = match std::fs::read(path).map_err(|e| e.to_string()) {
+    let read = if stdin {
+        let mut b = Vec::new();
+        // One byte past the limit is enough to know it is too large.
+        let mut limited = std::io::Read::take(std::io::stdin().lock(), u32::MAX as u64);
+        std::io::Read::read_to_end(&mut limited, &mut b).map(|_| b)
+    } else {
+        std::fs::read(path)
+    };
+    let text = match read.map_err(|e| e.to_string()) {
         Ok(b) => b,
         Err(e) => {
             return Err(plain_failure(
-                path,
-                format!("cannot read scene file \"{}\": {e}", path.display()),
+                &shown,
+                format!("cannot read scene file \"{}\": {e}", shown.display()),
             ))
         }
     };
     if text.len() >= u32::MAX as usize {
         return Err(plain_failure(
-            path,
-            format!("scene file \"{}\" is larger than 4 GiB", path.display()),
+            &shown,
+            format!("scene file \"{}\" is larger than 4 GiB", shown.display()),
         ));
     }
     match to_text(text) {
-        Ok(t) => load(path, t, Box::new(DiskLoader)),
+        Ok(t) => Ok((shown, t)),
         Err(at) => Err(plain_failure(
-            path,
+            &shown,
             format!(
                 "scene file \"{}\" is not UTF-8 text (invalid byte at offset {at})",
-                path.display()
+                shown.display()
             ),
         )),
     }
 }
 
+/// Reads, parses and builds the scene files named on the command line as one
+/// scene, in order (pbrt-v3 parses each in turn into the same state); `-`
+/// reads standard input. Each file's names resolve against its own directory.
+pub fn load_scene_files(paths: &[PathBuf]) -> Result<LoadedScene, LoadFailure> {
+    let mut inputs = Vec::with_capacity(paths.len());
+    for p in paths {
+        inputs.push(read_scene_input(p)?);
+    }
+    load(inputs, Box::new(DiskLoader))
+}
+
 /// Same, from text in memory; `path` names it in diagnostics and its parent dir
 /// resolves Includes and meshes.
 pub fn load_scene_str(text: &str, path: &Path) -> Result<LoadedScene, LoadFailure> {
-    load(path, Arc::from(text), Box::new(DiskLoader))
+    load(
+        vec![(path.to_path_buf(), Arc::from(text))],
+        Box::new(DiskLoader),
+    )
 }
 
 /// Same, with files (Includes, PLY meshes) read through `loader`.
@@ -263,7 +316,7 @@ pub fn load_scene_with(
     path: &Path,
     loader: Box<dyn FileLoader>,
 ) -> Result<LoadedScene, LoadFailure> {
-    load(path, Arc::from(text), loader)
+    load(vec![(path.to_path_buf(), Arc::from(text))], loader)
 }
 
 fn plain_failure(path: &Path, msg: String) -> LoadFailure {
@@ -273,19 +326,56 @@ fn plain_failure(path: &Path, msg: String) -> LoadFailure {
     }
 }
 
+/// Statements of one or more top-level files, Includes spliced, with what
+/// diagnostics and file-name resolution need.
+pub struct Parsed {
+    pub stmts: Vec<crate::lang::Stmt>,
+    pub sources: SourceMap,
+    pub diags: Diags,
+    /// Per source file id, the directory its file names are relative to.
+    pub file_dirs: Vec<PathBuf>,
+}
+
+/// Parses `inputs` (path, text) in order as one statement list.
+pub fn parse_inputs(inputs: Vec<(PathBuf, Arc<str>)>, loader: &dyn FileLoader) -> Parsed {
+    let mut it = inputs.into_iter();
+    let (path, text) = it
+        .next()
+        .unwrap_or_else(|| (PathBuf::from(STDIN_NAME), Arc::from("")));
+    let mut parser = Parser::new(&path, text, loader);
+    let mut stmts = parser.parse();
+    for (path, text) in it {
+        parser.add_top_level(&path, text);
+        stmts.extend(parser.parse());
+    }
+    let Parser {
+        sources,
+        diags,
+        file_dirs,
+        ..
+    } = parser;
+    Parsed {
+        stmts,
+        sources,
+        diags,
+        file_dirs,
+    }
+}
+
 fn load(
-    path: &Path,
-    text: Arc<str>,
+    inputs: Vec<(PathBuf, Arc<str>)>,
     loader: Box<dyn FileLoader>,
 ) -> Result<LoadedScene, LoadFailure> {
-    let mut parser = Parser::new(path, text, loader.as_ref());
-    let stmts = parser.parse();
-    let base_dir = parser.base_dir().to_path_buf();
-    let Parser { sources, diags, .. } = parser;
+    let Parsed {
+        stmts,
+        sources,
+        diags,
+        file_dirs,
+    } = parse_inputs(inputs, loader.as_ref());
     let mut ctx = Ctx {
         sources,
         diags,
-        base_dir,
+        file_dirs,
         loader,
         images: Default::default(),
         spectra: HashMap::new(),
@@ -299,6 +389,15 @@ fn load(
     }
     let mut b = state::Builder::new(&stmts, &mut ctx);
     b.run();
+    let film_has_cropwindow = b
+        .film
+        .and_then(|i| stmts[i].params())
+        .and_then(|p| {
+            p.items
+                .iter()
+                .find(|q| q.name == "cropwindow" && q.ty == crate::lang::params::ParamType::Float)
+        })
+        .is_some_and(|q| q.nums().len() == 4);
     let (camera, film, filter, sampler, integrator) = b.finish();
     let scene = SceneDescription {
         camera,
@@ -328,6 +427,7 @@ fn load(
         scene,
         warnings: ctx.diags.warnings,
         summary,
+        film_has_cropwindow,
     })
 }
 
