@@ -31,7 +31,9 @@ pub const USAGE_ERROR: i32 = 2;
                   follows pbrt-v3 (noted at the flag).\n\
                   Exit status: 0 success, 1 scene or render error, 2 usage error.",
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    // pbrt takes a flag given twice; the last one counts.
+    args_override_self = true
 )]
 pub struct Args {
     #[command(subcommand)]

@@ -361,6 +361,54 @@ mod tests {
     use super::*;
 
     #[test]
+    fn quick_changes_what_pbrt_v3_changes() {
+        let text = r#"Film "image" "integer xresolution" [ 130 ] "integer yresolution" [ 7 ]
+Sampler "stratified" "integer xsamples" [ 3 ] "integer ysamples" [ 5 ]
+WorldBegin
+LightSource "infinite" "rgb L" [ 1 1 1 ] "integer nsamples" [ 6 ]
+AttributeBegin
+AreaLightSource "diffuse" "integer nsamples" [ 9 ]
+Shape "sphere"
+AttributeEnd
+ObjectBegin "o"
+AreaLightSource "diffuse" "integer nsamples" [ 3 ]
+Shape "sphere"
+ObjectEnd
+ObjectInstance "o"
+WorldEnd
+"#;
+        let mut d = crate::loader::load_scene_str(text, std::path::Path::new("q.pbrt"))
+            .unwrap_or_else(|f| panic!("{f:?}"))
+            .scene;
+        apply_quick(&mut d);
+        assert_eq!((d.film.xresolution, d.film.yresolution), (32, 1));
+        assert_eq!(d.sampler.pixel_samples, 1);
+        assert!(matches!(
+            d.sampler.kind,
+            SamplerKind::Stratified {
+                xsamples: 1,
+                ysamples: 1,
+                ..
+            }
+        ));
+        assert_eq!(d.shapes[0].area_light.unwrap().n_samples, 2);
+        let inf = d.lights.iter().find_map(|l| match l {
+            LightDesc::Infinite { n_samples, .. } => Some(*n_samples),
+            _ => None,
+        });
+        assert_eq!(inf, Some(1));
+        // The random sampler keeps its count (pbrt-v3's RandomSampler has no
+        // quick-render case).
+        let text = "Sampler \"random\" \"integer pixelsamples\" [ 8 ]\nWorldBegin\nWorldEnd\n";
+        let mut d = crate::loader::load_scene_str(text, std::path::Path::new("r.pbrt"))
+            .unwrap_or_else(|f| panic!("{f:?}"))
+            .scene;
+        apply_quick(&mut d);
+        assert_eq!(d.sampler.pixel_samples, 8);
+        assert_eq!((d.film.xresolution, d.film.yresolution), (320, 180));
+    }
+
+    #[test]
     fn pixel_bounds_map_to_exact_pixels() {
         for res in [1u32, 3, 7, 64, 1000, 1280, 4097] {
             for (a, b) in [
