@@ -426,6 +426,69 @@ fn several_files_render_as_one_scene_and_dash_reads_stdin() {
     assert_eq!(bytes(&o1), bytes(&o4));
 }
 
+#[test]
+fn each_world_block_renders_in_turn_as_in_pbrt_v3() {
+    let d = tmp("worlds");
+    let film = |name: &str, w: u32| {
+        format!(
+            r#"Film "image" "integer xresolution" [ {w} ] "integer yresolution" [ 10 ] "string filename" [ "{name}" ]"#
+        )
+    };
+    let a = write(
+        &d,
+        "a.pbrt",
+        &scene(
+            &film("a.pfm", 12),
+            r#"Sampler "halton" "integer pixelsamples" [ 1 ]"#,
+        ),
+    );
+    // The second scene's options must not leak from the first (pbrt-v3
+    // starts afresh after WorldEnd): its default sampler has 16 spp.
+    let b_text = scene(&film("b.pfm", 14), "").replace(
+        r#"Material "matte" "rgb Kd" [ 0.5 0.4 0.3 ]"#,
+        r#"Material "matte" "rgb Kd" [ 0.1 0.6 0.2 ]"#,
+    );
+    let b = write(&d, "b.pbrt", &b_text);
+    let out = run(pbrs().current_dir(&d).arg(&a).arg(&b));
+    ok(&out);
+    let (ia, ib) = (image(&d.join("a.pfm")), image(&d.join("b.pfm")));
+    assert_eq!((ia.width, ib.width), (12, 14));
+    let both = [bytes(&d.join("a.pfm")), bytes(&d.join("b.pfm"))];
+    // Each alone gives the same files.
+    for (f, want) in [(&a, &both[0]), (&b, &both[1])] {
+        std::fs::remove_file(d.join("a.pfm")).ok();
+        std::fs::remove_file(d.join("b.pfm")).ok();
+        ok(&run(pbrs().current_dir(&d).arg("-q").arg(f)));
+        let name = if f == &a { "a.pfm" } else { "b.pfm" };
+        assert_eq!(&bytes(&d.join(name)), want);
+    }
+    // Both world blocks in one file: the same two renders. Options after
+    // the last WorldEnd render nothing, with a warning.
+    let one = write(
+        &d,
+        "ab.pbrt",
+        &format!(
+            "{}{}Sampler \"halton\"\n",
+            scene(
+                &film("a.pfm", 12),
+                r#"Sampler "halton" "integer pixelsamples" [ 1 ]"#
+            ),
+            b_text
+        ),
+    );
+    std::fs::remove_file(d.join("a.pfm")).ok();
+    std::fs::remove_file(d.join("b.pfm")).ok();
+    let out = run(pbrs().current_dir(&d).arg(&one));
+    ok(&out);
+    assert!(
+        stderr(&out).contains("after the last WorldEnd"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(bytes(&d.join("a.pfm")), both[0]);
+    assert_eq!(bytes(&d.join("b.pfm")), both[1]);
+}
+
 /// Every scene file under `scenes/` (not the references).
 fn all_scenes() -> Vec<PathBuf> {
     fn walk(d: &Path, out: &mut Vec<PathBuf>) {

@@ -2,23 +2,30 @@
 
 use super::render::scenes_label;
 use super::Args;
-use crate::loader::{load_scene_files, print_diagnostics};
+use crate::loader::{load_scene_files_each, print_diagnostics};
 
 /// Parses and builds the scene files without rendering. Prints the warnings,
 /// then the summary and what was left out (exit 0), or the errors (exit 1).
 pub fn run(args: &Args) -> i32 {
     let label = scenes_label(args);
-    match load_scene_files(&args.scenes) {
-        Ok(loaded) => {
-            if args.warnings() {
-                print_diagnostics(&loaded.warnings);
-            }
-            println!("{label}");
-            println!("{}", loaded.summary);
-            if !loaded.scene.skipped.is_empty() {
-                println!("left out:");
-                for s in &loaded.scene.skipped {
-                    println!("  - {s}");
+    match load_scene_files_each(&args.scenes) {
+        Ok(scenes) => {
+            let n = scenes.len();
+            for (i, loaded) in scenes.iter().enumerate() {
+                if args.warnings() {
+                    print_diagnostics(&loaded.warnings);
+                }
+                if n > 1 {
+                    println!("{label} (world block {} of {n})", i + 1);
+                } else {
+                    println!("{label}");
+                }
+                println!("{}", loaded.summary);
+                if !loaded.scene.skipped.is_empty() {
+                    println!("left out:");
+                    for s in &loaded.scene.skipped {
+                        println!("  - {s}");
+                    }
                 }
             }
             0

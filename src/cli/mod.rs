@@ -38,8 +38,9 @@ pub const USAGE_ERROR: i32 = 2;
 pub struct Args {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// Scene files (pbrt-v3 format), parsed in order as one scene (as pbrt-v3);
-    /// `-` reads standard input, as does giving none when standard input is
+    /// Scene files (pbrt-v3 format), parsed in order as one scene; each world
+    /// block renders at its WorldEnd, from a fresh state (as pbrt-v3, so
+    /// several complete scenes render in turn). `-` reads standard input, as does giving none when standard input is
     /// not a terminal. Each file's names are relative to its own directory
     /// (standard input's: the current directory).
     #[arg(value_name = "SCENE")]

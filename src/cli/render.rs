@@ -4,7 +4,7 @@
 
 use super::display::Display;
 use super::Args;
-use crate::loader::{load_scene_files, print_diagnostics};
+use crate::loader::{load_scene_files_each, print_diagnostics};
 use crate::render::driver::{peak_memory_bytes, render_observed, ChunkDone, RenderOptions};
 use crate::render::film::io::{check_output_path, write_image};
 use crate::render::film::Image;
@@ -222,7 +222,7 @@ impl PartialWriter {
 
 pub fn run(args: &Args) -> i32 {
     let label = scenes_label(args);
-    let loaded = match load_scene_files(&args.scenes) {
+    let scenes = match load_scene_files_each(&args.scenes) {
         Ok(l) => l,
         Err(f) => {
             if args.warnings() {
@@ -233,13 +233,24 @@ pub fn run(args: &Args) -> i32 {
             return 1;
         }
     };
-    if args.warnings() {
-        print_diagnostics(&loaded.warnings);
+    // pbrt-v3 renders at each WorldEnd: several world blocks (several
+    // complete scene files) render one after the other.
+    for loaded in scenes {
+        if args.warnings() {
+            print_diagnostics(&loaded.warnings);
+        }
+        let status = render_one(args, loaded.scene, loaded.film_has_cropwindow);
+        if status != 0 {
+            return status;
+        }
     }
-    let mut desc = loaded.scene;
+    0
+}
 
+/// Renders one scene with the command line's overrides and writes its image.
+fn render_one(args: &Args, mut desc: SceneDescription, film_has_cropwindow: bool) -> i32 {
     // Command-line overrides, validated before any work is done.
-    if let Err(e) = apply_overrides(args, &mut desc, loaded.film_has_cropwindow) {
+    if let Err(e) = apply_overrides(args, &mut desc, film_has_cropwindow) {
         return fail(e);
     }
     let out = desc.film.filename.clone();

@@ -362,32 +362,18 @@ pub fn parse_inputs(inputs: Vec<(PathBuf, Arc<str>)>, loader: &dyn FileLoader) -
     }
 }
 
-fn load(
-    inputs: Vec<(PathBuf, Arc<str>)>,
-    loader: Box<dyn FileLoader>,
-) -> Result<LoadedScene, LoadFailure> {
-    let Parsed {
-        stmts,
-        sources,
-        diags,
-        file_dirs,
-    } = parse_inputs(inputs, loader.as_ref());
-    let mut ctx = Ctx {
-        sources,
-        diags,
-        file_dirs,
-        loader,
-        images: Default::default(),
-        spectra: HashMap::new(),
-        fourier_tables: HashMap::new(),
-    };
-    if !ctx.diags.errors.is_empty() {
-        return Err(LoadFailure {
-            errors: ctx.diags.errors,
-            warnings: ctx.diags.warnings,
-        });
-    }
-    let mut b = state::Builder::new(&stmts, &mut ctx);
+/// What one build of a statement list gives.
+struct Built {
+    scene: SceneDescription,
+    kinds: Vec<DeclaredKind>,
+    textures: TexturesByClass,
+    film_has_cropwindow: bool,
+}
+
+type TexturesByClass = std::collections::BTreeMap<&'static str, usize>;
+
+fn build(ctx: &mut Ctx, stmts: &[crate::lang::Stmt]) -> Built {
+    let mut b = state::Builder::new(stmts, ctx);
     b.run();
     let film_has_cropwindow = b
         .film
@@ -414,21 +400,140 @@ fn load(
     };
     let kinds = std::mem::take(&mut b.material_kinds);
     let textures = std::mem::take(&mut b.texture_state.by_class);
-    drop(b);
-    if !ctx.diags.errors.is_empty() {
-        return Err(LoadFailure {
-            errors: ctx.diags.errors,
-            warnings: ctx.diags.warnings,
-        });
-    }
-    let mut summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
-    summary.textures_by_class = textures;
-    Ok(LoadedScene {
+    Built {
         scene,
-        warnings: ctx.diags.warnings,
-        summary,
+        kinds,
+        textures,
         film_has_cropwindow,
-    })
+    }
+}
+
+fn new_ctx(parsed: Parsed, loader: Box<dyn FileLoader>) -> (Vec<crate::lang::Stmt>, Ctx) {
+    let Parsed {
+        stmts,
+        sources,
+        diags,
+        file_dirs,
+    } = parsed;
+    let ctx = Ctx {
+        sources,
+        diags,
+        file_dirs,
+        loader,
+        images: Default::default(),
+        spectra: HashMap::new(),
+        fourier_tables: HashMap::new(),
+    };
+    (stmts, ctx)
+}
+
+fn failure(ctx: Ctx) -> LoadFailure {
+    LoadFailure {
+        errors: ctx.diags.errors,
+        warnings: ctx.diags.warnings,
+    }
+}
+
+fn loaded(b: Built, warnings: Vec<miette::Report>, n_warnings: usize) -> LoadedScene {
+    let mut summary = Summary::of(&b.scene, &b.kinds, n_warnings);
+    summary.textures_by_class = b.textures;
+    LoadedScene {
+        scene: b.scene,
+        warnings,
+        summary,
+        film_has_cropwindow: b.film_has_cropwindow,
+    }
+}
+
+fn load(
+    inputs: Vec<(PathBuf, Arc<str>)>,
+    loader: Box<dyn FileLoader>,
+) -> Result<LoadedScene, LoadFailure> {
+    let parsed = parse_inputs(inputs, loader.as_ref());
+    let (stmts, mut ctx) = new_ctx(parsed, loader);
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let b = build(&mut ctx, &stmts);
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let n = ctx.diags.warnings.len();
+    Ok(loaded(b, ctx.diags.warnings, n))
+}
+
+/// The statement ranges of the scenes pbrt-v3 renders one after the other:
+/// each `WorldEnd` that closes a world block renders, and pbrt-v3 then starts
+/// from a fresh state (api.cpp `pbrtWorldEnd` resets the options and the
+/// graphics state). Statements after the last `WorldEnd` with no
+/// `WorldBegin` among them render nothing (returned second); a list
+/// without any WorldEnd is one scene.
+pub fn world_blocks(
+    stmts: &[crate::lang::Stmt],
+) -> (Vec<std::ops::Range<usize>>, Option<std::ops::Range<usize>>) {
+    use crate::lang::DirKind;
+    let mut out = Vec::new();
+    let (mut start, mut in_world) = (0, false);
+    for (i, s) in stmts.iter().enumerate() {
+        match s.kind {
+            DirKind::WorldBegin => in_world = true,
+            DirKind::WorldEnd if in_world => {
+                out.push(start..i + 1);
+                start = i + 1;
+                in_world = false;
+            }
+            _ => {}
+        }
+    }
+    let rest = start..stmts.len();
+    if out.is_empty() {
+        (vec![rest], None)
+    } else if in_world {
+        out.push(rest);
+        (out, None)
+    } else {
+        (out, (!rest.is_empty()).then_some(rest))
+    }
+}
+
+/// [`load_scene_files`] as pbrt-v3's command line renders: one scene per
+/// world block, in order (several complete scene files render one after the
+/// other). All warnings go with the first scene; any error fails them all.
+pub fn load_scene_files_each(paths: &[PathBuf]) -> Result<Vec<LoadedScene>, LoadFailure> {
+    let mut inputs = Vec::with_capacity(paths.len());
+    for p in paths {
+        inputs.push(read_scene_input(p)?);
+    }
+    let loader: Box<dyn FileLoader> = Box::new(DiskLoader);
+    let parsed = parse_inputs(inputs, loader.as_ref());
+    let (stmts, mut ctx) = new_ctx(parsed, loader);
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let (blocks, trailing) = world_blocks(&stmts);
+    let mut built: Vec<Built> = blocks
+        .into_iter()
+        .map(|r| build(&mut ctx, &stmts[r]))
+        .collect();
+    if let Some(r) = trailing {
+        ctx.warn(
+            stmts[r.start].loc,
+            format!(
+                "`{}` after the last WorldEnd: no WorldBegin follows, so nothing renders with it (as pbrt-v3)",
+                stmts[r.start].kind.name()
+            ),
+            "ignored from here on",
+        );
+    }
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let n = ctx.diags.warnings.len();
+    let mut warnings = Some(ctx.diags.warnings);
+    Ok(built
+        .drain(..)
+        .map(|b| loaded(b, warnings.take().unwrap_or_default(), n))
+        .collect())
 }
 
 /// Prints diagnostics to stderr with miette's graphical handler (no colour when
