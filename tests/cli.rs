@@ -113,6 +113,13 @@ fn pbrt_v3_spellings_are_accepted_and_honoured() {
         .args(["--threads", "2", "-q", "-o"])
         .arg(&c)
         .arg(&s)));
+    // pbrt-v3: 0 threads is one per core.
+    let z = d.join("z.pfm");
+    ok(&run(pbrs()
+        .args(["--nthreads", "0", "-q", "-o"])
+        .arg(&z)
+        .arg(&s)));
+    assert_eq!(bytes(&a), bytes(&z));
     assert_eq!(bytes(&a), bytes(&b), "--nthreads 1 and 2 differ");
     assert_eq!(bytes(&a), bytes(&c));
     let img = image(&a);
@@ -341,6 +348,26 @@ fn exit_codes_and_quiet() {
         let out = run(pbrs().args(&args).stdin(Stdio::null()));
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
     }
+    // A value a flag cannot take: 2, after the scene is read.
+    for args in [
+        vec!["--spp", "0"],
+        vec!["--cropwindow", "0.5", "0.5", "0", "1"],
+        vec!["--pixelbounds", "50", "60", "0", "10"],
+        vec!["--partial-interval", "-1"],
+    ] {
+        let out = run(pbrs().args(&args).arg("--outfile").arg(&o).arg(&s));
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+    }
+    // Empty input renders nothing (pbrt-v3 renders at WorldEnd).
+    let empty = write(&d, "empty.pbrt", "# nothing\n");
+    let out = run(pbrs().current_dir(&d).arg(&empty));
+    ok(&out);
+    assert!(
+        stderr(&out).contains("nothing to render"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!d.join("pbrt.exr").exists());
     // Help in pbrt's spellings: 0, clap's generated text.
     for h in ["--help", "-help", "-h"] {
         let out = run(pbrs().arg(h));

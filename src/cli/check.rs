@@ -11,6 +11,9 @@ pub fn run(args: &Args) -> i32 {
     match load_scene_files_each(&args.scenes) {
         Ok(scenes) => {
             let n = scenes.len();
+            if n == 0 {
+                println!("{label}: empty: nothing to render");
+            }
             for (i, loaded) in scenes.iter().enumerate() {
                 if args.warnings() {
                     print_diagnostics(&loaded.warnings);

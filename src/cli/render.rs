@@ -233,6 +233,9 @@ pub fn run(args: &Args) -> i32 {
             return 1;
         }
     };
+    if scenes.is_empty() && args.warnings() {
+        eprintln!("warning: {label}: the scene is empty: nothing to render (as pbrt-v3)");
+    }
     // pbrt-v3 renders at each WorldEnd: several world blocks (several
     // complete scene files) render one after the other.
     for loaded in scenes {
@@ -250,8 +253,10 @@ pub fn run(args: &Args) -> i32 {
 /// Renders one scene with the command line's overrides and writes its image.
 fn render_one(args: &Args, mut desc: SceneDescription, film_has_cropwindow: bool) -> i32 {
     // Command-line overrides, validated before any work is done.
+    // A value the flags cannot take is a usage error.
     if let Err(e) = apply_overrides(args, &mut desc, film_has_cropwindow) {
-        return fail(e);
+        eprintln!("error: {e}");
+        return super::USAGE_ERROR;
     }
     let out = desc.film.filename.clone();
     if let Err(e) = check_output_path(&out) {

@@ -499,6 +499,7 @@ pub fn world_blocks(
 /// [`load_scene_files`] as pbrt-v3's command line renders: one scene per
 /// world block, in order (several complete scene files render one after the
 /// other). All warnings go with the first scene; any error fails them all.
+/// No statement at all gives no scene.
 pub fn load_scene_files_each(paths: &[PathBuf]) -> Result<Vec<LoadedScene>, LoadFailure> {
     let mut inputs = Vec::with_capacity(paths.len());
     for p in paths {
@@ -509,6 +510,10 @@ pub fn load_scene_files_each(paths: &[PathBuf]) -> Result<Vec<LoadedScene>, Load
     let (stmts, mut ctx) = new_ctx(parsed, loader);
     if !ctx.diags.errors.is_empty() {
         return Err(failure(ctx));
+    }
+    if stmts.is_empty() {
+        // pbrt-v3 renders at WorldEnd only: an empty input renders nothing.
+        return Ok(Vec::new());
     }
     let (blocks, trailing) = world_blocks(&stmts);
     let mut built: Vec<Built> = blocks
