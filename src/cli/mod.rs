@@ -91,8 +91,9 @@ pub struct Args {
     /// Print detailed statistics: what was built and skipped, rays, timings.
     #[arg(long)]
     pub stats: bool,
-    /// Write the image every --partial-interval seconds while rendering
-    /// (pbrt-v4's flag; each write is atomic: a temporary file renamed).
+    /// Write the image every --partial-interval seconds while rendering, with
+    /// the tiles finished so far (pbrt-v4's flag; pbrt-v4 writes after each
+    /// batch of samples instead). Each write is atomic: a temporary file renamed.
     #[arg(long)]
     pub write_partial_images: bool,
     /// Seconds between partial images; implies --write-partial-images.
