@@ -104,10 +104,13 @@ fn bad_output_extension_fails_before_rendering_and_writes_nothing() {
 
 #[test]
 fn invalid_overrides_are_errors() {
+    // Usage errors (exit 2), found before rendering. `--threads 0` is not
+    // one: pbrt-v3's `--nthreads 0` means one thread per core; a reversed
+    // crop window is ordered, as pbrt-v3 does (tests/cli.rs covers both).
     for args in [
         &["--spp", "0"][..],
-        &["--threads", "0"],
-        &["--cropwindow", "0.5", "0.2", "0", "1"],
+        &["--cropwindow", "0.5", "0.5", "0", "1"],
+        &["--threads", "-1"],
     ] {
         let o = pbrs()
             .arg("scenes/cornell-box.pbrt")
@@ -116,7 +119,7 @@ fn invalid_overrides_are_errors() {
             .current_dir(repo())
             .output()
             .unwrap();
-        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
     }
 }
 

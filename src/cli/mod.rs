@@ -1,11 +1,23 @@
 //! The command line: options, dispatch, progress and statistics.
+//!
+//! pbrs takes pbrt-v3's flags as pbrt-v3 spells them (one or two dashes,
+//! `--flag value` or `--flag=value`) and pbrt-v4's rendering flags; argv is
+//! normalised for clap by [`args::normalize`] first. Exit status: 0 success,
+//! 1 scene or render error, 2 usage error.
 
-use clap::Parser;
+use clap::{CommandFactory, Parser};
+use std::ffi::OsString;
 use std::path::PathBuf;
 
+mod args;
+mod cat;
 mod check;
 pub mod converge;
+pub mod display;
 mod render;
+
+/// Exit status of a usage error (clap's own).
+pub const USAGE_ERROR: i32 = 2;
 
 /// pbrs: render a pbrt-v3 scene.
 #[derive(Parser, Debug, Clone)]
@@ -13,45 +25,109 @@ mod render;
     name = "pbrs",
     version,
     about = "A physically based renderer for pbrt-v3 scenes",
+    after_help = "pbrt's command lines work unchanged: every flag takes one or two dashes and \
+                  `--flag value` or `--flag=value`; --cropwindow and --pixelbounds also take \
+                  pbrt-v4's single `x0,x1,y0,y1`. Where pbrt-v3 and pbrt-v4 differ, pbrs \
+                  follows pbrt-v3 (noted at the flag).\n\
+                  Exit status: 0 success, 1 scene or render error, 2 usage error.",
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    // pbrt takes a flag given twice; the last one counts.
+    args_override_self = true
 )]
 pub struct Args {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// The scene file (pbrt-v3 format).
-    #[arg(required = true)]
-    pub scene: Option<PathBuf>,
+    /// Scene files (pbrt-v3 format), parsed in order as one scene; each world
+    /// block renders at its WorldEnd, from a fresh state (as pbrt-v3, so
+    /// several complete scenes render in turn). `-` reads standard input, as does giving none when standard input is
+    /// not a terminal. Each file's names are relative to its own directory
+    /// (standard input's: the current directory).
+    #[arg(value_name = "SCENE")]
+    pub scenes: Vec<PathBuf>,
     /// Parse and build the scene, print warnings and a summary, do not render.
     #[arg(long)]
     pub check: bool,
+    /// Print the scene as pbrs read it (Includes spliced, one directive per
+    /// line, parameters normalised, file names resolved against the current
+    /// directory) to standard output; do not render (pbrt-v3's --cat;
+    /// pbrt-v4 calls it --format).
+    #[arg(long, visible_alias = "format", help_heading = "Scene tools")]
+    pub cat: bool,
+    /// As --cat, and write each trianglemesh with 500 indices or more to
+    /// mesh_NNNNN.ply in the current directory (prefix: $PLY_PREFIX), printed
+    /// as a plymesh (pbrt-v3's --toply).
+    #[arg(long, help_heading = "Scene tools")]
+    pub toply: bool,
     /// Output image (.exr, .png or .pfm); overrides the Film's filename.
-    #[arg(long, short = 'o')]
+    #[arg(long, short = 'o', value_name = "FILE")]
     pub outfile: Option<PathBuf>,
-    /// Samples per pixel; overrides the sampler's pixelsamples.
-    #[arg(long)]
+    /// Samples per pixel; overrides the sampler's pixelsamples (pbrt-v4).
+    #[arg(long, value_name = "N")]
     pub spp: Option<u32>,
-    /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long)]
+    /// Worker threads; 0 or absent: all cores. The image does not depend on it.
+    #[arg(long = "nthreads", visible_alias = "threads", value_name = "N")]
     pub threads: Option<usize>,
-    /// Seed for the sampler's scrambling and random dimensions.
-    #[arg(long, default_value_t = 0)]
+    /// Seed for the sampler's scrambling and random dimensions (pbrt-v4).
+    #[arg(long, default_value_t = 0, value_name = "N")]
     pub seed: u64,
-    /// Crop window in NDC: x0 x1 y0 y1; overrides the Film's cropwindow.
+    /// pbrt-v3's quick render: a quarter of each film resolution (at least 1),
+    /// one sample per pixel (all samplers but "random", as pbrt-v3), a quarter
+    /// of the area and infinite lights' "nsamples" (at least 1).
+    #[arg(long)]
+    pub quick: bool,
+    /// Crop window in NDC: x0 x1 y0 y1 (clamped to [0, 1] and ordered). As in
+    /// pbrt-v3, a "cropwindow" given to the Film takes precedence (pbrt-v4
+    /// lets the command line win).
     #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], allow_negative_numbers = true)]
     pub cropwindow: Option<Vec<f32>>,
-    /// No progress bar, no summary.
+    /// Render only pixels x0..x1, y0..y1 of the full image (pbrt-v4); replaces
+    /// any crop window.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], allow_negative_numbers = true)]
+    pub pixelbounds: Option<Vec<i64>>,
+    /// Print nothing but errors: no warnings, no progress, no summary.
     #[arg(long, short = 'q')]
     pub quiet: bool,
     /// Print detailed statistics: what was built and skipped, rays, timings.
     #[arg(long)]
     pub stats: bool,
+    /// Write the image every --partial-interval seconds while rendering, with
+    /// the tiles finished so far (pbrt-v4's flag; pbrt-v4 writes after each
+    /// batch of samples instead). Each write is atomic: a temporary file renamed.
+    #[arg(long)]
+    pub write_partial_images: bool,
+    /// Seconds between partial images; implies --write-partial-images.
+    #[arg(long, value_name = "SECONDS")]
+    pub partial_interval: Option<f64>,
+    /// Stream the image to the tev viewer at HOST:PORT while rendering
+    /// (pbrt-v4). A lost connection never stops the render.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub display_server: Option<String>,
+    /// pbrt-v3 (glog): verbosity. Accepted; pbrs has no verbose log.
+    #[arg(
+        long = "v",
+        short = 'v',
+        value_name = "N",
+        help_heading = "Logging (pbrt-v3)"
+    )]
+    pub verbosity: Option<i32>,
+    /// pbrt-v3 (glog): log to standard error. Accepted; pbrs's diagnostics
+    /// always go there.
+    #[arg(long, help_heading = "Logging (pbrt-v3)")]
+    pub logtostderr: bool,
+    /// pbrt-v3 (glog): log directory. Accepted; pbrs writes no log files.
+    #[arg(long, value_name = "DIR", help_heading = "Logging (pbrt-v3)")]
+    pub logdir: Option<PathBuf>,
+    /// pbrt-v3 (glog): 0 info, 1 warning, 2 error, 3 fatal. 2 or more hides
+    /// warnings; errors are always printed.
+    #[arg(long, value_name = "N", help_heading = "Logging (pbrt-v3)")]
+    pub minloglevel: Option<i32>,
 }
 
 impl Args {
-    /// The scene file (clap guarantees it unless a subcommand is given).
-    pub fn scene_path(&self) -> &std::path::Path {
-        self.scene.as_deref().unwrap_or(std::path::Path::new(""))
+    /// Whether warnings are printed.
+    pub fn warnings(&self) -> bool {
+        !self.quiet && self.minloglevel.is_none_or(|l| l < 2)
     }
 }
 
@@ -63,12 +139,46 @@ pub enum Command {
 
 /// Runs the command line; returns the process exit status.
 pub fn main() -> i32 {
-    let args = Args::parse();
+    run(std::env::args_os().collect())
+}
+
+/// Runs the command line `argv` (program name first).
+pub fn run(argv: Vec<OsString>) -> i32 {
+    let argv = args::normalize(argv, &Args::command());
+    let mut args = Args::parse_from(argv);
     if let Some(Command::Converge(c)) = &args.command {
         return converge::run(c);
     }
+    if args.scenes.is_empty() {
+        use std::io::IsTerminal;
+        if std::io::stdin().is_terminal() {
+            Args::command()
+                .error(
+                    clap::error::ErrorKind::MissingRequiredArgument,
+                    "no scene file given (use `-` to read the scene from standard input)",
+                )
+                .exit();
+        }
+        // pbrt-v3 reads standard input when no file is named.
+        args.scenes.push(PathBuf::from("-"));
+    }
+    if [args.check, args.cat, args.toply]
+        .iter()
+        .filter(|&&b| b)
+        .count()
+        > 1
+    {
+        Args::command()
+            .error(
+                clap::error::ErrorKind::ArgumentConflict,
+                "--check, --cat and --toply exclude each other",
+            )
+            .exit();
+    }
     if args.check {
         check::run(&args)
+    } else if args.cat || args.toply {
+        cat::run(&args)
     } else {
         render::run(&args)
     }

@@ -215,6 +215,10 @@ pub struct Parser<'l> {
     stack: Vec<Lexer>,
     peeked: Option<Token>,
     base_dir: PathBuf,
+    /// The directory file names are resolved against, per source file id:
+    /// that of the top-level file the file was reached from (pbrt-v3 sets its
+    /// search directory per file named on the command line).
+    pub file_dirs: Vec<PathBuf>,
     canon: Vec<PathBuf>,
     loader: &'l dyn FileLoader,
     /// Location of the end of the last token read (for EOF errors).
@@ -235,6 +239,7 @@ impl<'l> Parser<'l> {
             diags: Diags::default(),
             stack: vec![Lexer::new(file, 0)],
             peeked: None,
+            file_dirs: vec![base_dir.clone()],
             base_dir,
             canon: vec![canon],
             loader,
@@ -249,6 +254,24 @@ impl<'l> Parser<'l> {
 
     pub fn base_dir(&self) -> &Path {
         &self.base_dir
+    }
+
+    /// Queues another top-level file (a further scene file named on the
+    /// command line): the next [`Parser::parse`] reads it, with its own
+    /// directory for Includes and file names, after everything before it.
+    pub fn add_top_level(&mut self, path: &Path, text: Arc<str>) {
+        let file = self.sources.add_file(path, text);
+        self.base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        self.file_dirs.push(self.base_dir.clone());
+        self.canon = vec![path.canonicalize().unwrap_or_else(|_| path.to_path_buf())];
+        self.peeked = None;
+        self.stack = vec![Lexer::new(file, 0)];
+        self.last = Loc {
+            file,
+            chain: 0,
+            start: 0,
+            end: 0,
+        };
     }
 
     fn error(
@@ -771,6 +794,7 @@ impl<'l> Parser<'l> {
         };
         let chain = self.sources.push_chain(loc);
         let file = self.sources.add_file(&path, text);
+        self.file_dirs.push(self.base_dir.clone());
         // A token peeked before the Include belongs after the included file.
         debug_assert!(self.peeked.is_none());
         self.stack.push(Lexer::new(file, chain));

@@ -8,7 +8,7 @@ use super::ply::{read_ply, PlyMesh};
 use super::spd;
 use super::Ctx;
 use crate::lang::params::{Param, ParamList, ParamType};
-use crate::lang::parser::{resolve, Name};
+use crate::lang::parser::Name;
 use crate::lang::Loc;
 use crate::scene::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -88,7 +88,7 @@ pub(super) fn spectrum_value(ctx: &mut Ctx, q: &Param) -> Option<Vec3> {
 /// pbrt-v3; problems inside it are warnings at the parameter.
 fn spectrum_file(ctx: &mut Ctx, q: &Param) -> Vec3 {
     let name = &q.strs()[0];
-    let path = resolve(&ctx.base_dir, name);
+    let path = ctx.resolve(q.values_loc, name);
     if let Some(&c) = ctx.spectra.get(&path) {
         return c;
     }
@@ -689,7 +689,7 @@ fn mesh_file(
         );
         return None;
     };
-    let path = resolve(&ctx.base_dir, file);
+    let path = ctx.resolve(floc, file);
     if let Some(m) = meshes.get(&path) {
         return m.clone().map(Geometry::TriangleMesh);
     }

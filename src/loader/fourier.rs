@@ -15,7 +15,6 @@
 //! allocated; the structural checks are [`FourierTable::new`]'s.
 
 use super::Ctx;
-use crate::lang::parser::resolve;
 use crate::lang::Loc;
 use crate::scene::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
 use std::sync::Arc;
@@ -130,7 +129,7 @@ pub fn read_bsdf(bytes: &[u8], source: &str) -> Result<FourierTable, String> {
 /// `FourierMaterial` when its table failed to load (it reports an error and
 /// renders the surface black).
 pub fn fourier_table(ctx: &mut Ctx, name: &str, loc: Loc) -> Option<Arc<FourierTable>> {
-    let path = resolve(&ctx.base_dir, name);
+    let path = ctx.resolve(loc, name);
     if let Some(t) = ctx.fourier_tables.get(&path) {
         return t.clone();
     }

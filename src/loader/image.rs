@@ -29,7 +29,6 @@
 //! error rather than an abort.
 
 use super::Ctx;
-use crate::lang::parser::resolve;
 use crate::lang::Loc;
 use crate::scene::{Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
 use glam::Vec3;
@@ -61,7 +60,7 @@ pub fn load_image(
     filename: &str,
     decode: Decode,
 ) -> Option<Arc<RgbImage>> {
-    let path = resolve(&ctx.base_dir, filename);
+    let path = ctx.resolve(loc, filename);
     if let Some(img) = ctx.images.decoded.get(&(path.clone(), decode)) {
         return Some(img.clone());
     }

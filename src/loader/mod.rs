@@ -44,6 +44,9 @@ pub struct LoadedScene {
     pub scene: SceneDescription,
     pub warnings: Vec<miette::Report>,
     pub summary: Summary,
+    /// Whether the Film gave a 4-value "cropwindow" (pbrt-v3 then ignores
+    /// the command line's `--cropwindow`).
+    pub film_has_cropwindow: bool,
 }
 
 /// A scene that did not load: at least one error.
@@ -66,7 +69,9 @@ impl std::fmt::Debug for LoadFailure {
 pub struct Ctx {
     pub sources: SourceMap,
     pub diags: Diags,
-    pub base_dir: PathBuf,
+    /// Per source file id, the directory its file names are relative to
+    /// (the directory of the top-level scene file it was reached from).
+    pub file_dirs: Vec<PathBuf>,
     pub loader: Box<dyn FileLoader>,
     /// Images read so far (each file is read once).
     pub images: image::ImageCache,
@@ -79,6 +84,17 @@ pub struct Ctx {
 }
 
 impl Ctx {
+    /// A file name written at `loc`, resolved as pbrt-v3 does: relative to
+    /// the directory of the top-level scene file it appears in.
+    pub fn resolve(&self, loc: Loc, name: &str) -> PathBuf {
+        let dir = self
+            .file_dirs
+            .get(loc.file as usize)
+            .map(PathBuf::as_path)
+            .unwrap_or(Path::new(""));
+        crate::lang::parser::resolve(dir, name)
+    }
+
     pub fn warn(&mut self, loc: Loc, msg: impl Into<String>, label: impl Into<String>) {
         let r = self
             .sources
@@ -226,38 +242,75 @@ fn kind_name(kind: ParamKind) -> &'static str {
 
 /// Reads, parses and builds a scene file.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadFailure> {
+    load_scene_files(std::slice::from_ref(&path.to_path_buf()))
+}
+
+/// The name standard input has in diagnostics; its file names are relative
+/// to the current directory.
+pub const STDIN_NAME: &str = "<stdin>";
+
+/// Reads one scene file named on the command line; `-` is standard input.
+pub fn read_scene_input(path: &Path) -> Result<(PathBuf, Arc<str>), LoadFailure> {
+    let stdin = path.as_os_str() == "-";
+    let shown = if stdin {
+        PathBuf::from(STDIN_NAME)
+    } else {
+        path.to_path_buf()
+    };
     // The user named this file, so a pipe is fine here (unlike Include targets).
-    let text = match std::fs::read(path).map_err(|e| e.to_string()) {
+    let read = if stdin {
+        let mut b = Vec::new();
+        // One byte past the limit is enough to know it is too large.
+        let mut limited = std::io::Read::take(std::io::stdin().lock(), u32::MAX as u64);
+        std::io::Read::read_to_end(&mut limited, &mut b).map(|_| b)
+    } else {
+        std::fs::read(path)
+    };
+    let text = match read.map_err(|e| e.to_string()) {
         Ok(b) => b,
         Err(e) => {
             return Err(plain_failure(
-                path,
-                format!("cannot read scene file \"{}\": {e}", path.display()),
+                &shown,
+                format!("cannot read scene file \"{}\": {e}", shown.display()),
             ))
         }
     };
     if text.len() >= u32::MAX as usize {
         return Err(plain_failure(
-            path,
-            format!("scene file \"{}\" is larger than 4 GiB", path.display()),
+            &shown,
+            format!("scene file \"{}\" is larger than 4 GiB", shown.display()),
         ));
     }
     match to_text(text) {
-        Ok(t) => load(path, t, Box::new(DiskLoader)),
+        Ok(t) => Ok((shown, t)),
         Err(at) => Err(plain_failure(
-            path,
+            &shown,
             format!(
                 "scene file \"{}\" is not UTF-8 text (invalid byte at offset {at})",
-                path.display()
+                shown.display()
             ),
         )),
     }
 }
 
+/// Reads, parses and builds the scene files named on the command line as one
+/// scene, in order (pbrt-v3 parses each in turn into the same state); `-`
+/// reads standard input. Each file's names resolve against its own directory.
+pub fn load_scene_files(paths: &[PathBuf]) -> Result<LoadedScene, LoadFailure> {
+    let mut inputs = Vec::with_capacity(paths.len());
+    for p in paths {
+        inputs.push(read_scene_input(p)?);
+    }
+    load(inputs, Box::new(DiskLoader))
+}
+
 /// Same, from text in memory; `path` names it in diagnostics and its parent dir
 /// resolves Includes and meshes.
 pub fn load_scene_str(text: &str, path: &Path) -> Result<LoadedScene, LoadFailure> {
-    load(path, Arc::from(text), Box::new(DiskLoader))
+    load(
+        vec![(path.to_path_buf(), Arc::from(text))],
+        Box::new(DiskLoader),
+    )
 }
 
 /// Same, with files (Includes, PLY meshes) read through `loader`.
@@ -266,7 +319,7 @@ pub fn load_scene_with(
     path: &Path,
     loader: Box<dyn FileLoader>,
 ) -> Result<LoadedScene, LoadFailure> {
-    load(path, Arc::from(text), loader)
+    load(vec![(path.to_path_buf(), Arc::from(text))], loader)
 }
 
 fn plain_failure(path: &Path, msg: String) -> LoadFailure {
@@ -276,32 +329,64 @@ fn plain_failure(path: &Path, msg: String) -> LoadFailure {
     }
 }
 
-fn load(
-    path: &Path,
-    text: Arc<str>,
-    loader: Box<dyn FileLoader>,
-) -> Result<LoadedScene, LoadFailure> {
-    let mut parser = Parser::new(path, text, loader.as_ref());
-    let stmts = parser.parse();
-    let base_dir = parser.base_dir().to_path_buf();
-    let Parser { sources, diags, .. } = parser;
-    let mut ctx = Ctx {
+/// Statements of one or more top-level files, Includes spliced, with what
+/// diagnostics and file-name resolution need.
+pub struct Parsed {
+    pub stmts: Vec<crate::lang::Stmt>,
+    pub sources: SourceMap,
+    pub diags: Diags,
+    /// Per source file id, the directory its file names are relative to.
+    pub file_dirs: Vec<PathBuf>,
+}
+
+/// Parses `inputs` (path, text) in order as one statement list.
+pub fn parse_inputs(inputs: Vec<(PathBuf, Arc<str>)>, loader: &dyn FileLoader) -> Parsed {
+    let mut it = inputs.into_iter();
+    let (path, text) = it
+        .next()
+        .unwrap_or_else(|| (PathBuf::from(STDIN_NAME), Arc::from("")));
+    let mut parser = Parser::new(&path, text, loader);
+    let mut stmts = parser.parse();
+    for (path, text) in it {
+        parser.add_top_level(&path, text);
+        stmts.extend(parser.parse());
+    }
+    let Parser {
         sources,
         diags,
-        base_dir,
-        loader,
-        images: Default::default(),
-        spectra: HashMap::new(),
-        fourier_tables: HashMap::new(),
-    };
-    if !ctx.diags.errors.is_empty() {
-        return Err(LoadFailure {
-            errors: ctx.diags.errors,
-            warnings: ctx.diags.warnings,
-        });
+        file_dirs,
+        ..
+    } = parser;
+    Parsed {
+        stmts,
+        sources,
+        diags,
+        file_dirs,
     }
-    let mut b = state::Builder::new(&stmts, &mut ctx);
+}
+
+/// What one build of a statement list gives.
+struct Built {
+    scene: SceneDescription,
+    kinds: Vec<DeclaredKind>,
+    textures: TexturesByClass,
+    film_has_cropwindow: bool,
+}
+
+type TexturesByClass = std::collections::BTreeMap<&'static str, usize>;
+
+fn build(ctx: &mut Ctx, stmts: &[crate::lang::Stmt]) -> Built {
+    let mut b = state::Builder::new(stmts, ctx);
     b.run();
+    let film_has_cropwindow = b
+        .film
+        .and_then(|i| stmts[i].params())
+        .and_then(|p| {
+            p.items
+                .iter()
+                .find(|q| q.name == "cropwindow" && q.ty == crate::lang::params::ParamType::Float)
+        })
+        .is_some_and(|q| q.nums().len() == 4);
     let (camera, film, filter, sampler, integrator) = b.finish();
     let scene = SceneDescription {
         camera,
@@ -318,20 +403,145 @@ fn load(
     };
     let kinds = std::mem::take(&mut b.material_kinds);
     let textures = std::mem::take(&mut b.texture_state.by_class);
-    drop(b);
-    if !ctx.diags.errors.is_empty() {
-        return Err(LoadFailure {
-            errors: ctx.diags.errors,
-            warnings: ctx.diags.warnings,
-        });
-    }
-    let mut summary = Summary::of(&scene, &kinds, ctx.diags.warnings.len());
-    summary.textures_by_class = textures;
-    Ok(LoadedScene {
+    Built {
         scene,
+        kinds,
+        textures,
+        film_has_cropwindow,
+    }
+}
+
+fn new_ctx(parsed: Parsed, loader: Box<dyn FileLoader>) -> (Vec<crate::lang::Stmt>, Ctx) {
+    let Parsed {
+        stmts,
+        sources,
+        diags,
+        file_dirs,
+    } = parsed;
+    let ctx = Ctx {
+        sources,
+        diags,
+        file_dirs,
+        loader,
+        images: Default::default(),
+        spectra: HashMap::new(),
+        fourier_tables: HashMap::new(),
+    };
+    (stmts, ctx)
+}
+
+fn failure(ctx: Ctx) -> LoadFailure {
+    LoadFailure {
+        errors: ctx.diags.errors,
         warnings: ctx.diags.warnings,
+    }
+}
+
+fn loaded(b: Built, warnings: Vec<miette::Report>, n_warnings: usize) -> LoadedScene {
+    let mut summary = Summary::of(&b.scene, &b.kinds, n_warnings);
+    summary.textures_by_class = b.textures;
+    LoadedScene {
+        scene: b.scene,
+        warnings,
         summary,
-    })
+        film_has_cropwindow: b.film_has_cropwindow,
+    }
+}
+
+fn load(
+    inputs: Vec<(PathBuf, Arc<str>)>,
+    loader: Box<dyn FileLoader>,
+) -> Result<LoadedScene, LoadFailure> {
+    let parsed = parse_inputs(inputs, loader.as_ref());
+    let (stmts, mut ctx) = new_ctx(parsed, loader);
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let b = build(&mut ctx, &stmts);
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let n = ctx.diags.warnings.len();
+    Ok(loaded(b, ctx.diags.warnings, n))
+}
+
+/// The statement ranges of the scenes pbrt-v3 renders one after the other:
+/// each `WorldEnd` that closes a world block renders, and pbrt-v3 then starts
+/// from a fresh state (api.cpp `pbrtWorldEnd` resets the options and the
+/// graphics state). Statements after the last `WorldEnd` with no
+/// `WorldBegin` among them render nothing (returned second); a list
+/// without any WorldEnd is one scene.
+pub fn world_blocks(
+    stmts: &[crate::lang::Stmt],
+) -> (Vec<std::ops::Range<usize>>, Option<std::ops::Range<usize>>) {
+    use crate::lang::DirKind;
+    let mut out = Vec::new();
+    let (mut start, mut in_world) = (0, false);
+    for (i, s) in stmts.iter().enumerate() {
+        match s.kind {
+            DirKind::WorldBegin => in_world = true,
+            DirKind::WorldEnd if in_world => {
+                out.push(start..i + 1);
+                start = i + 1;
+                in_world = false;
+            }
+            _ => {}
+        }
+    }
+    let rest = start..stmts.len();
+    if out.is_empty() {
+        (vec![rest], None)
+    } else if in_world {
+        out.push(rest);
+        (out, None)
+    } else {
+        (out, (!rest.is_empty()).then_some(rest))
+    }
+}
+
+/// [`load_scene_files`] as pbrt-v3's command line renders: one scene per
+/// world block, in order (several complete scene files render one after the
+/// other). All warnings go with the first scene; any error fails them all.
+/// No statement at all gives no scene.
+pub fn load_scene_files_each(paths: &[PathBuf]) -> Result<Vec<LoadedScene>, LoadFailure> {
+    let mut inputs = Vec::with_capacity(paths.len());
+    for p in paths {
+        inputs.push(read_scene_input(p)?);
+    }
+    let loader: Box<dyn FileLoader> = Box::new(DiskLoader);
+    let parsed = parse_inputs(inputs, loader.as_ref());
+    let (stmts, mut ctx) = new_ctx(parsed, loader);
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    if stmts.is_empty() {
+        // pbrt-v3 renders at WorldEnd only: an empty input renders nothing.
+        return Ok(Vec::new());
+    }
+    let (blocks, trailing) = world_blocks(&stmts);
+    let mut built: Vec<Built> = blocks
+        .into_iter()
+        .map(|r| build(&mut ctx, &stmts[r]))
+        .collect();
+    if let Some(r) = trailing {
+        ctx.warn(
+            stmts[r.start].loc,
+            format!(
+                "`{}` after the last WorldEnd: no WorldBegin follows, so nothing renders with it (as pbrt-v3)",
+                stmts[r.start].kind.name()
+            ),
+            "ignored from here on",
+        );
+    }
+    if !ctx.diags.errors.is_empty() {
+        return Err(failure(ctx));
+    }
+    let n = ctx.diags.warnings.len();
+    let mut warnings = Some(ctx.diags.warnings);
+    Ok(built
+        .drain(..)
+        .map(|b| loaded(b, warnings.take().unwrap_or_default(), n))
+        .collect())
 }
 
 /// Prints diagnostics to stderr with miette's graphical handler (no colour when

@@ -82,7 +82,7 @@ pub struct Builder<'s, 'c> {
     stack: Vec<Frame>,
     // Options: the statement and the CTM it saw.
     camera: Option<(usize, DMat4)>,
-    film: Option<usize>,
+    pub(super) film: Option<usize>,
     filter: Option<usize>,
     sampler: Option<usize>,
     integrator: Option<usize>,

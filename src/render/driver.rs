@@ -57,6 +57,16 @@ struct TileCounts {
     negative: u64,
 }
 
+/// What [`Renderer::render_samples_observed`] reports after each group of
+/// tiles: counts, the group's tiles (sample-space bounds, in merge order)
+/// and the film with them merged.
+pub struct ChunkDone<'a> {
+    pub done: usize,
+    pub total: usize,
+    pub tiles: &'a [Bounds2i],
+    pub film: &'a Film,
+}
+
 /// A scene compiled for rendering, with its film. Samples can be added in
 /// ranges of sample indices: the samplers are stateless per (pixel, index),
 /// so rendering indices 0..n and then n..2n gives exactly the image of a
@@ -105,6 +115,17 @@ impl Renderer {
         samples: std::ops::Range<u32>,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) {
+        self.render_samples_observed(samples, &mut |c: &ChunkDone| progress(c.done, c.total));
+    }
+
+    /// [`Renderer::render_samples`], calling `on_chunk` on this thread after
+    /// each group of tiles is merged (between groups: render threads are not
+    /// waiting on it mid-tile, and nothing is done per sample).
+    pub fn render_samples_observed(
+        &mut self,
+        samples: std::ops::Range<u32>,
+        on_chunk: &mut dyn FnMut(&ChunkDone),
+    ) {
         let t1 = Instant::now();
         let tiles = self.film.tiles(16);
         let total = tiles.len();
@@ -129,9 +150,19 @@ impl Renderer {
                 self.stats.negative_samples += c.negative;
             }
             done += group.len();
-            progress(done, total);
+            on_chunk(&ChunkDone {
+                done,
+                total,
+                tiles: group,
+                film: &self.film,
+            });
         }
         self.stats.render_time += t1.elapsed();
+    }
+
+    /// The film as rendered so far.
+    pub fn film(&self) -> &Film {
+        &self.film
     }
 
     pub fn image(&self) -> Image {
@@ -167,9 +198,19 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(Image, RenderStats), String> {
+    render_observed(desc, opts, &mut |c: &ChunkDone| progress(c.done, c.total))
+}
+
+/// [`render`], with `on_chunk` called after each group of tiles (see
+/// [`Renderer::render_samples_observed`]).
+pub fn render_observed(
+    desc: &SceneDescription,
+    opts: &RenderOptions,
+    on_chunk: &mut dyn FnMut(&ChunkDone),
+) -> Result<(Image, RenderStats), String> {
     let mut r = Renderer::new(desc, opts)?;
     let spp = r.sampler.samples_per_pixel();
-    r.render_samples(0..spp, progress);
+    r.render_samples_observed(0..spp, on_chunk);
     Ok((r.image(), r.stats()))
 }
 

@@ -225,20 +225,45 @@ impl Film {
         let mut data = Vec::with_capacity(self.pixels.len() * 3);
         let scale = self.scale as f64;
         for p in &self.pixels {
-            if p.weight != 0.0 {
-                let inv = 1.0 / p.weight;
-                for c in 0..3 {
-                    data.push(((p.contrib[c] * inv).max(0.0) * scale) as f32);
-                }
-            } else {
-                data.extend([0.0; 3]);
-            }
+            data.extend(pixel_rgb(p, scale));
         }
         Image {
             width: w,
             height: h,
             data,
         }
+    }
+}
+
+impl Film {
+    /// Pixels of `region` (in film pixel coordinates, clipped to the pixel
+    /// bounds) as [`Film::image`] computes them: the clipped region and its
+    /// RGB triples, rows top to bottom.
+    pub fn region_rgb(&self, region: Bounds2i) -> (Bounds2i, Vec<f32>) {
+        let r = region.intersect(&self.pixel_bounds);
+        let (w, h) = (r.width().max(0), r.height().max(0));
+        let mut data = Vec::with_capacity((w * h) as usize * 3);
+        let scale = self.scale as f64;
+        let fw = self.pixel_bounds.width();
+        for y in r.min.y..r.min.y + h {
+            let row = ((y - self.pixel_bounds.min.y) * fw - self.pixel_bounds.min.x) as isize;
+            for x in r.min.x..r.min.x + w {
+                let p = &self.pixels[(row + x as isize) as usize];
+                data.extend(pixel_rgb(p, scale));
+            }
+        }
+        (r, data)
+    }
+}
+
+/// One pixel's value: `max(0, Σ wL / Σ w) × scale`, 0 where `Σ w == 0`.
+#[inline]
+fn pixel_rgb(p: &PixelSums, scale: f64) -> [f32; 3] {
+    if p.weight != 0.0 {
+        let inv = 1.0 / p.weight;
+        p.contrib.map(|c| ((c * inv).max(0.0) * scale) as f32)
+    } else {
+        [0.0; 3]
     }
 }
 

@@ -24,8 +24,9 @@ pub struct HaltonSampler {
     seed_hash: u64,
     sample_at_pixel_center: bool,
     base_scales: [u64; 2],
-    /// `base_scales[1]` for fast division.
-    scale1: DigitBase,
+    /// `base_scales[1]` for fast division; `None` when it is 1 (a film one
+    /// pixel high), which `DigitBase` does not take.
+    scale1: Option<DigitBase>,
     base_exponents: [u32; 2],
     sample_stride: u64,
     mult_inverse: [u64; 2],
@@ -66,7 +67,7 @@ impl HaltonSampler {
             seed_hash: mix64(seed ^ 0x4a61_6c74_6f6e_5f68),
             sample_at_pixel_center,
             base_scales,
-            scale1: DigitBase::new(base_scales[1] as u32),
+            scale1: (base_scales[1] > 1).then(|| DigitBase::new(base_scales[1] as u32)),
             base_exponents,
             sample_stride,
             mult_inverse,
@@ -135,7 +136,7 @@ impl HaltonSampler {
         }
         match dim {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
-            1 => radical_inverse(&BASE3, self.scale1.div(index)),
+            1 => radical_inverse(&BASE3, self.scale1.as_ref().map_or(index, |s| s.div(index))),
             d if (d as usize) < PRIME_TABLE_SIZE => self.tables.scrambled(d as usize, index),
             d => hash_to_unit(mix64(
                 mix64(index ^ self.seed_hash)
