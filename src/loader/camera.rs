@@ -6,7 +6,7 @@
 use super::entities::{boolean, default_camera, float, float_opt, string};
 use super::Ctx;
 use crate::lang::params::{ParamList, ParamType};
-use crate::lang::parser::{resolve, Name};
+use crate::lang::parser::Name;
 use crate::render::camera::realistic::focus_lens;
 use crate::scene::{CameraDesc, CameraKind, FilmDesc, RealisticDesc};
 use glam::DMat4;
@@ -199,7 +199,7 @@ fn realistic(ctx: &mut Ctx, name: &Name, p: &ParamList, film: &FilmDesc) -> Opti
         );
         return None;
     };
-    let path = resolve(&ctx.base_dir, file);
+    let path = ctx.resolve(floc, file);
     let shown = path.display().to_string();
     let mut ok = true;
     if !(aperture > 0.0 && aperture.is_finite()) {
