@@ -53,7 +53,7 @@ struct Frame {
 /// A shape recorded inside ObjectBegin, built when the object is first instanced.
 struct PendingShape {
     stmt: usize,
-    ctm: DMat4,
+    ctm: [DMat4; 2],
     graphics: Graphics,
 }
 
@@ -80,8 +80,11 @@ pub struct Builder<'s, 'c> {
     named_coords: HashMap<String, [DMat4; 2]>,
     graphics: Graphics,
     stack: Vec<Frame>,
-    // Options: the statement and the CTM it saw.
-    camera: Option<(usize, DMat4)>,
+    // Options: the statement and the CTMs (start, end) it saw.
+    camera: Option<(usize, [DMat4; 2])>,
+    /// `TransformTimes` (pbrt-v3's default 0, 1): the times of the start and
+    /// end CTMs.
+    transform_times: (f64, f64),
     pub(super) film: Option<usize>,
     filter: Option<usize>,
     sampler: Option<usize>,
@@ -134,6 +137,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             },
             stack: Vec::new(),
             camera: None,
+            transform_times: (0.0, 1.0),
             film: None,
             filter: None,
             sampler: None,
@@ -325,20 +329,16 @@ impl<'s, 'c> Builder<'s, 'c> {
                         ActiveKind::StartTime => [true, false],
                         ActiveKind::EndTime => [false, true],
                     };
-                    if k != ActiveKind::All {
-                        self.ctx.warn(s.loc, "ActiveTransform: motion blur is not supported; pbrs uses the start-time transforms", "animated transforms ignored");
-                    }
                 }
             }
-            K::TransformTimes => {
-                if nums != [0.0, 1.0] {
-                    self.ctx.warn(s.loc, "TransformTimes: motion blur is not supported; ignored", "ignored");
-                }
-            }
+            // pbrt-v3 takes the two times as given (no ordering check):
+            // interpolation clamps to the start transform up to the start
+            // time and to the end one from the end time on.
+            K::TransformTimes => self.transform_times = (nums[0], nums[1]),
             K::Camera => {
-                self.camera = Some((i, self.ctm[0]));
+                self.camera = Some((i, self.ctm));
                 if self.ctm[0] != self.ctm[1] {
-                    self.ctx.warn(s.loc, "animated camera transform: motion blur is not supported; the start transform is used", "this Camera");
+                    self.ctx.warn(s.loc, "animated camera transform: recorded, but pbrs does not render motion blur yet; the start transform is used", "this Camera");
                 }
                 let inv = self.ctm[0].inverse();
                 self.named_coords.insert("camera".into(), [inv, self.ctm[1].inverse()]);
@@ -595,20 +595,22 @@ impl<'s, 'c> Builder<'s, 'c> {
                 i
             }
         };
-        if self.ctm[0] != self.ctm[1] {
+        let motion = self.animated(self.ctm);
+        if motion.is_some() {
             self.ctx.warn(
                 n.loc,
-                "animated instance transform: the start transform is used",
+                "animated instance transform: recorded, but pbrs does not render motion blur yet; the start transform is used",
                 "this ObjectInstance",
             );
         }
-        if !self.ctm[0].is_finite() {
+        if !self.ctm[0].is_finite() || !self.ctm[1].is_finite() {
             self.ctx.error(n.loc, "the instance transform has non-finite entries (overflow in the transform statements)", "this ObjectInstance", None);
             return;
         }
         self.instances.push(InstanceDesc {
             object: index,
             instance_to_world: self.ctm[0],
+            motion,
         });
     }
 
@@ -620,25 +622,38 @@ impl<'s, 'c> Builder<'s, 'c> {
             }
             def.shapes.push(PendingShape {
                 stmt: i,
-                ctm: self.ctm[0],
+                ctm: self.ctm,
                 graphics: self.graphics.clone(),
             });
             return;
         }
-        if self.ctm[0] != self.ctm[1] {
-            self.ctx.warn(s.loc, "animated shape transform: motion blur is not supported; the start transform is used", "this Shape");
-        }
         let graphics = self.graphics.clone();
-        let area = graphics.area_light.map(|(i, _)| i);
-        if let Some(shape) = self.build_shape(i, self.ctm[0], &graphics, area) {
+        let mut area = graphics.area_light.map(|(i, _)| i);
+        if self.ctm[0] != self.ctm[1] {
+            self.ctx.warn(s.loc, "animated shape transform: recorded, but pbrs does not render motion blur yet; the start transform is used", "this Shape");
+            if area.take().is_some() {
+                self.ctx.warn(
+                    s.loc,
+                    "the current area light is ignored for an animated shape (as pbrt-v3)",
+                    "this Shape is not emissive",
+                );
+            }
+        }
+        if let Some(shape) = self.build_shape(i, self.ctm, &graphics, area) {
             self.shapes.push(shape);
         }
+    }
+
+    /// The animated transform of a CTM pair, `None` if both are equal.
+    fn animated(&self, ctm: [DMat4; 2]) -> Option<Arc<AnimatedTransform>> {
+        let (t0, t1) = self.transform_times;
+        AnimatedTransform::new(ctm[0], t0, ctm[1], t1).map(Arc::new)
     }
 
     fn build_shape(
         &mut self,
         i: usize,
-        ctm: DMat4,
+        ctms: [DMat4; 2],
         g: &Graphics,
         area: Option<usize>,
     ) -> Option<ShapeDesc> {
@@ -646,7 +661,8 @@ impl<'s, 'c> Builder<'s, 'c> {
         let Directive::Entity { name, params } = &stmts[i].dir else {
             return None;
         };
-        if !ctm.is_finite() {
+        let ctm = ctms[0];
+        if !ctm.is_finite() || !ctms[1].is_finite() {
             self.ctx.error(stmts[i].loc, "the shape's transform has non-finite entries (overflow in the transform statements)", "this Shape", None);
             params.mark_all_used();
             return None;
@@ -688,6 +704,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         Some(ShapeDesc {
             geometry,
             object_to_world: ctm,
+            motion: self.animated(ctms),
             reverse_orientation: g.reverse,
             material,
             area_light,
@@ -834,11 +851,23 @@ impl<'s, 'c> Builder<'s, 'c> {
         };
         // The film first: the realistic camera needs its size.
         let film = entities::film(self.ctx, ent(self.film));
-        let camera = entities::camera(
+        let mut camera = entities::camera(
             self.ctx,
-            self.camera.and_then(|(i, m)| ent(Some(i)).map(|e| (e, m))),
+            self.camera
+                .and_then(|(i, m)| ent(Some(i)).map(|e| (e, m[0]))),
             &film,
         );
+        if let Some((i, [start, end])) = self.camera {
+            if start != end {
+                // The start inverse was checked by `entities::camera`.
+                let end_inv = end.inverse();
+                if end_inv.is_finite() && end.determinant().abs() >= 1e-300 {
+                    camera.motion = self.animated([camera.camera_to_world, end_inv]);
+                } else {
+                    self.ctx.error(stmts[i].loc, "the camera's end transform (the CTM at Camera under ActiveTransform EndTime) is singular: it cannot be inverted", "this Camera", None);
+                }
+            }
+        }
         let filter = entities::filter(self.ctx, ent(self.filter));
         let sampler = entities::sampler(self.ctx, ent(self.sampler));
         let integrator = entities::integrator(self.ctx, ent(self.integrator));
