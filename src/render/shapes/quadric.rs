@@ -6,7 +6,7 @@ use super::{
     Cone, Cylinder, DiffGeom, Disk, Hyperboloid, Paraboloid, ShapeSample, Sphere, SurfacePoint,
 };
 use crate::render::geometry::efloat::EFloat;
-use crate::render::geometry::{gamma, Bounds3};
+use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Mat4, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
@@ -103,30 +103,34 @@ impl Quadric {
     }
 
     /// Density by world area of the shape's area sampling at an object point
-    /// (cones, paraboloids and hyperboloids; their light sampling is pbrs's).
+    /// (the shapes sampled by area alone; not spheres or disks).
     pub fn area_density(&self, p_obj: DVec3) -> f32 {
         match self {
+            Quadric::Cylinder(c) => c.area_density(p_obj),
             Quadric::Cone(c) => c.area_density(p_obj),
             Quadric::Paraboloid(c) => c.area_density(p_obj),
             Quadric::Hyperboloid(c) => c.area_density(p_obj),
-            _ => f32::NAN,
+            Quadric::Sphere(_) | Quadric::Disk(_) => f32::NAN,
         }
     }
 
     /// A point sampled as seen from a reference point; density by solid angle.
     #[inline]
     pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
-        match self {
-            Quadric::Sphere(s) => s.sample_from(p, p_error, n, u),
-            Quadric::Disk(d) => d.sample_from(p, u),
-            Quadric::Cylinder(c) => c.sample_from(p, u),
-            Quadric::Cone(c) => c.sample_from(p, u),
-            Quadric::Paraboloid(c) => c.sample_from(p, u),
-            Quadric::Hyperboloid(c) => c.sample_from(p, u),
-        }
+        let by_area = match self {
+            Quadric::Sphere(s) => return s.sample_from(p, p_error, n, u),
+            Quadric::Disk(d) => d.sample_area(u),
+            Quadric::Cylinder(c) => c.sample_area(u),
+            Quadric::Cone(c) => c.sample_area(u),
+            Quadric::Paraboloid(c) => c.sample_area(u),
+            Quadric::Hyperboloid(c) => c.sample_area(u),
+        };
+        super::to_solid_angle(p, by_area)
     }
 
-    /// Density by solid angle of `sample_from` producing direction `wi`.
+    /// Density by solid angle of `sample_from` producing direction `wi`:
+    /// pbrt-v3's `Shape::Pdf(ref, wi)`, the area density at the first hit of
+    /// the ray spawned along `wi`.
     #[inline]
     pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
         match self {
@@ -134,10 +138,16 @@ impl Quadric {
                 s.pdf_from(p, p_error, n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
             }
             Quadric::Disk(d) => d.pdf_from(p, p_error, n, wi),
-            Quadric::Cylinder(c) => c.pdf_from(p, p_error, n, wi),
-            Quadric::Cone(c) => c.pdf_from(p, p_error, n, wi),
-            Quadric::Paraboloid(c) => c.pdf_from(p, p_error, n, wi),
-            Quadric::Hyperboloid(c) => c.pdf_from(p, p_error, n, wi),
+            _ => {
+                let o = offset_ray_origin(p, p_error, n, wi);
+                match self.intersect(o, wi, f32::INFINITY) {
+                    Some((_, h)) => {
+                        let density = self.area_density(h.point_and_error().0);
+                        solid_angle_pdf(p, &self.surface_point(h), wi, density)
+                    }
+                    None => 0.0,
+                }
+            }
         }
     }
 }
@@ -259,6 +269,27 @@ impl Placement {
         }
     }
 
+    /// The world differential geometry of an object-space parametrisation
+    /// at a hit: dp/du, dp/dv and the second derivatives (dn/du, dn/dv by
+    /// pbrt-v3's Weingarten equations); the shading frame is the same.
+    pub fn diff_geom(&self, uv: (f64, f64), dpdu: DVec3, dpdv: DVec3, d2: [DVec3; 3]) -> DiffGeom {
+        let (dndu, dndv) = weingarten(dpdu, dpdv, d2[0], d2[1], d2[2]);
+        let (dpdu, dpdv) = (self.vector(dpdu), self.vector(dpdv));
+        let (dndu, dndv) = (self.normal_derivative(dndu), self.normal_derivative(dndv));
+        DiffGeom {
+            uv: Vec2::new(uv.0 as f32, uv.1 as f32),
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            shading_dndu: dndu,
+            shading_dndv: dndv,
+            ..DiffGeom::ZERO
+        }
+    }
+
     /// A tangent vector in world space.
     #[inline]
     pub fn vector(&self, v: DVec3) -> Vec3 {
@@ -372,13 +403,7 @@ pub fn phi_of(p: DVec3) -> f64 {
 
 /// pbrt-v3's Weingarten equations: dn/du and dn/dv from the first and
 /// second fundamental forms (object space).
-pub fn weingarten(
-    dpdu: DVec3,
-    dpdv: DVec3,
-    d2uu: DVec3,
-    d2uv: DVec3,
-    d2vv: DVec3,
-) -> (DVec3, DVec3) {
+fn weingarten(dpdu: DVec3, dpdv: DVec3, d2uu: DVec3, d2uv: DVec3, d2vv: DVec3) -> (DVec3, DVec3) {
     let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
     let n = dpdu.cross(dpdv).normalize();
     let (e2, f2, g2) = (n.dot(d2uu), n.dot(d2uv), n.dot(d2vv));
@@ -391,7 +416,7 @@ pub fn weingarten(
 /// pbrt-v3's `Shape::Pdf(ref, wi)` for an area density at the surface point
 /// `h` the ray from `p` along `wi` hits: the solid-angle density.
 #[inline]
-pub fn solid_angle_pdf(p: Vec3, h: &SurfacePoint, wi: Vec3, area_density: f32) -> f32 {
+fn solid_angle_pdf(p: Vec3, h: &SurfacePoint, wi: Vec3, area_density: f32) -> f32 {
     let pdf = area_density * h.p.distance_squared(p) / h.n.dot(wi).abs();
     if pdf.is_finite() {
         pdf
