@@ -1,7 +1,9 @@
-//! The closed set of analytic shapes (pbrt-v3's quadrics) as one enum that
-//! only delegates: the BVH holds them as non-triangle primitives, traced by
-//! callback, and area lights sit on them.
+//! The closed set of analytic shapes (pbrt-v3's quadrics, and curve pieces)
+//! as one enum that only delegates: the BVH holds them as non-triangle
+//! primitives, traced by callback, and area lights sit on them (not on
+//! curves, which pbrt-v3 cannot sample).
 
+use super::curve::{Curve, CurveHit};
 use super::{
     Cone, Cylinder, DiffGeom, Disk, Hyperboloid, Paraboloid, ShapeSample, Sphere, SurfacePoint,
 };
@@ -17,6 +19,7 @@ pub enum Quadric {
     Cone(Cone),
     Paraboloid(Paraboloid),
     Hyperboloid(Hyperboloid),
+    Curve(Curve),
 }
 
 macro_rules! each {
@@ -28,6 +31,7 @@ macro_rules! each {
             Quadric::Cone($s) => $e,
             Quadric::Paraboloid($s) => $e,
             Quadric::Hyperboloid($s) => $e,
+            Quadric::Curve($s) => $e,
         }
     };
 }
@@ -64,6 +68,7 @@ impl Quadric {
             Quadric::Cone(c) => c.is_valid(),
             Quadric::Paraboloid(c) => c.is_valid(),
             Quadric::Hyperboloid(c) => c.is_valid(),
+            Quadric::Curve(c) => c.is_valid(),
         }
     }
 
@@ -80,11 +85,17 @@ impl Quadric {
             Quadric::Cone(s) => bounded(s.intersect(o, d, t_max)),
             Quadric::Paraboloid(s) => bounded(s.intersect(o, d, t_max)),
             Quadric::Hyperboloid(s) => bounded(s.intersect(o, d, t_max)),
+            Quadric::Curve(s) => s
+                .intersect(o, d, t_max)
+                .map(|(t, h)| (t, QuadricHit::Curve(h))),
         }
     }
 
     #[inline]
     pub fn surface_point(&self, h: QuadricHit) -> SurfacePoint {
+        if let (Quadric::Curve(c), QuadricHit::Curve(h)) = (self, h) {
+            return c.surface_point(h);
+        }
         let (p, err) = h.point_and_error();
         match self {
             Quadric::Sphere(s) => s.surface_point(p),
@@ -93,13 +104,29 @@ impl Quadric {
             Quadric::Cone(s) => s.surface_point(p, err),
             Quadric::Paraboloid(s) => s.surface_point(p, err),
             Quadric::Hyperboloid(s) => s.surface_point(p, err),
+            // (Never reached: a curve's hits are curve hits.)
+            Quadric::Curve(_) => SurfacePoint {
+                p: p.as_vec3(),
+                p_error: err.as_vec3(),
+                n: Vec3::Z,
+                ns: Vec3::Z,
+            },
         }
     }
 
     #[inline]
     pub fn diff_geom(&self, h: QuadricHit) -> DiffGeom {
         let (p, _) = h.point_and_error();
-        each!(self, s => s.diff_geom(p))
+        match (self, h) {
+            (Quadric::Curve(c), QuadricHit::Curve(h)) => c.diff_geom(h),
+            (Quadric::Sphere(s), _) => s.diff_geom(p),
+            (Quadric::Disk(s), _) => s.diff_geom(p),
+            (Quadric::Cylinder(s), _) => s.diff_geom(p),
+            (Quadric::Cone(s), _) => s.diff_geom(p),
+            (Quadric::Paraboloid(s), _) => s.diff_geom(p),
+            (Quadric::Hyperboloid(s), _) => s.diff_geom(p),
+            (Quadric::Curve(_), _) => DiffGeom::ZERO,
+        }
     }
 
     /// Density by world area of the shape's area sampling at an object point
@@ -110,7 +137,7 @@ impl Quadric {
             Quadric::Cone(c) => c.area_density(p_obj),
             Quadric::Paraboloid(c) => c.area_density(p_obj),
             Quadric::Hyperboloid(c) => c.area_density(p_obj),
-            Quadric::Sphere(_) | Quadric::Disk(_) => f32::NAN,
+            Quadric::Sphere(_) | Quadric::Disk(_) | Quadric::Curve(_) => f32::NAN,
         }
     }
 
@@ -124,6 +151,8 @@ impl Quadric {
             Quadric::Cone(c) => c.sample_area(u),
             Quadric::Paraboloid(c) => c.sample_area(u),
             Quadric::Hyperboloid(c) => c.sample_area(u),
+            // Never a light (the scene leaves curves' emission out).
+            Quadric::Curve(_) => return None,
         };
         super::to_solid_angle(p, by_area)
     }
@@ -138,6 +167,7 @@ impl Quadric {
                 s.pdf_from(p, p_error, n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
             }
             Quadric::Disk(d) => d.pdf_from(p, p_error, n, wi),
+            Quadric::Curve(_) => 0.0,
             _ => {
                 let o = offset_ray_origin(p, p_error, n, wi);
                 match self.intersect(o, wi, f32::INFINITY) {
@@ -158,7 +188,12 @@ impl Quadric {
 #[derive(Clone, Copy, Debug)]
 pub enum QuadricHit {
     Exact(DVec3),
-    Bounded { p: Vec3, err: Vec3 },
+    Bounded {
+        p: Vec3,
+        err: Vec3,
+    },
+    /// A curve piece's hit (its dp/dv depends on the ray).
+    Curve(CurveHit),
 }
 
 impl QuadricHit {
@@ -167,6 +202,7 @@ impl QuadricHit {
         match self {
             QuadricHit::Exact(p) => (p, DVec3::ZERO),
             QuadricHit::Bounded { p, err } => (p.as_dvec3(), err.as_dvec3()),
+            QuadricHit::Curve(h) => (h.p.as_dvec3(), DVec3::splat(h.err as f64)),
         }
     }
 }
