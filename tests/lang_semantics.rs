@@ -548,11 +548,11 @@ fn disk_parameters_and_bad_disks() {
 
 #[test]
 fn unsupported_shapes_and_directives_warn_and_load() {
-    let s = load("WorldBegin\nShape \"curve\" \"float width\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"ptex\"\nShape \"sphere\"\nWorldEnd");
+    let s = load("WorldBegin\nShape \"curvy\" \"float width\" 3\nShape \"cylindr\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nTexture \"t\" \"float\" \"ptex\"\nShape \"sphere\"\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 1);
     let w = warnings(&s);
     assert!(
-        w.contains("mem.pbrt:2:7: shape \"curve\" is not supported by pbrs: skipped"),
+        w.contains("mem.pbrt:2:7: unknown shape \"curvy\" (did you mean \"curve\"?)"),
         "{w}"
     );
     assert!(w.contains("did you mean \"cylinder\""), "{w}");

@@ -311,8 +311,6 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
 
 // ---------------------------------------------------------------- shapes
 
-const OTHER_SHAPES: &[&str] = &["curve"];
-
 /// The shapes pbrs builds (pbrt-v3's, and the mesh-file extensions).
 const SHAPES: &[&str] = &[
     "sphere",
@@ -321,6 +319,7 @@ const SHAPES: &[&str] = &[
     "cone",
     "paraboloid",
     "hyperboloid",
+    "curve",
     "trianglemesh",
     "plymesh",
     "objmesh",
@@ -389,33 +388,25 @@ pub fn geometry(
         "cone" => cone(ctx, name, p),
         "paraboloid" => paraboloid(ctx, name, p),
         "hyperboloid" => hyperboloid(ctx, name, p),
+        "curve" => curve(ctx, name, p),
         "trianglemesh" => triangle_mesh(ctx, name, p).map(|m| Geometry::TriangleMesh(Arc::new(m))),
         "plymesh" | "objmesh" | "gltfmesh" => mesh_file(ctx, name, p, meshes),
         "loopsubdiv" | "nurbs" | "heightfield" => super::refine::shape(ctx, name, p),
         other => {
             p.mark_all_used();
-            if OTHER_SHAPES.contains(&other) {
-                ctx.warn(
-                    name.loc,
-                    format!("shape \"{other}\" is not supported by pbrs: skipped"),
-                    "shape skipped",
-                );
-            } else {
-                let all: Vec<&str> = SHAPES
-                    .iter()
-                    .chain(OTHER_SHAPES)
-                    .chain(super::refine::REFINED_SHAPES)
-                    .copied()
-                    .collect();
-                let hint = super::state::closest_name(other, &all)
-                    .map(|c| format!(" (did you mean \"{c}\"?)"))
-                    .unwrap_or_default();
-                ctx.warn(
-                    name.loc,
-                    format!("unknown shape \"{other}\"{hint}: skipped (as pbrt-v3)"),
-                    "unknown shape",
-                );
-            }
+            let all: Vec<&str> = SHAPES
+                .iter()
+                .chain(super::refine::REFINED_SHAPES)
+                .copied()
+                .collect();
+            let hint = super::state::closest_name(other, &all)
+                .map(|c| format!(" (did you mean \"{c}\"?)"))
+                .unwrap_or_default();
+            ctx.warn(
+                name.loc,
+                format!("unknown shape \"{other}\"{hint}: skipped (as pbrt-v3)"),
+                "unknown shape",
+            );
             None
         }
     }
@@ -748,6 +739,231 @@ fn mesh_file(
     };
     meshes.insert(path, mesh.clone());
     mesh.map(Geometry::TriangleMesh)
+}
+
+/// Most Bézier segments one `curve` may have (each becomes 2^splitdepth BVH
+/// primitives).
+const MAX_CURVE_SEGMENTS: usize = 1 << 22;
+
+/// pbrt-v3's `CreateCurveShape`: the curve as cubic Bézier segments, with
+/// its checks (located errors where pbrt-v3 reports an error and makes no
+/// shape).
+fn curve(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+    let width = float(p, "width", 1.0);
+    let width0 = float(p, "width0", width);
+    let width1 = float(p, "width1", width);
+    let (degree, degree_loc) = int(p, "degree", 3);
+    if degree != 2 && degree != 3 {
+        ctx.error(
+            degree_loc.unwrap_or(name.loc),
+            format!("curve degree {degree}: only degree 2 and 3 curves are supported (as pbrt-v3)"),
+            "degree must be 2 or 3",
+            None,
+        );
+        return None;
+    }
+    let degree = degree as usize;
+    let bspline = match string(p, "basis") {
+        None | Some(("bezier", _)) => false,
+        Some(("bspline", _)) => true,
+        Some((other, loc)) => {
+            ctx.error(
+                loc,
+                format!("curve basis \"{other}\": only \"bezier\" and \"bspline\" are supported (as pbrt-v3)"),
+                "unknown basis",
+                None,
+            );
+            return None;
+        }
+    };
+    let Some(pp) = p.find("P", |t| t == ParamType::Point3) else {
+        ctx.error(
+            name.loc,
+            "curve needs control points \"point P\"",
+            "no \"point P\"",
+            None,
+        );
+        return None;
+    };
+    let cp = to_vec3(pp.nums());
+    let ncp = cp.len();
+    let segments = if bspline {
+        if ncp < degree + 1 {
+            ctx.error(
+                pp.values_loc,
+                format!(
+                    "{ncp} control points: a degree {degree} b-spline curve needs at least {}",
+                    degree + 1
+                ),
+                "too few control points",
+                None,
+            );
+            return None;
+        }
+        ncp - degree
+    } else {
+        if ncp < degree + 1 || !(ncp - 1 - degree).is_multiple_of(degree) {
+            ctx.error(
+                pp.values_loc,
+                format!("{ncp} control points: a degree {degree} Bézier curve needs {} + n·{degree} (n ≥ 0)", degree + 1),
+                "wrong number of control points",
+                None,
+            );
+            return None;
+        }
+        (ncp - 1) / degree
+    };
+    if cp.iter().any(|v| !v.is_finite()) {
+        ctx.error(
+            pp.values_loc,
+            "a control point of \"P\" does not fit a 32-bit float",
+            "too large",
+            None,
+        );
+        return None;
+    }
+    if segments > MAX_CURVE_SEGMENTS {
+        ctx.error(
+            pp.values_loc,
+            format!("{segments} curve segments: pbrs takes at most {MAX_CURVE_SEGMENTS} per curve"),
+            "too many segments",
+            None,
+        );
+        return None;
+    }
+    let kind = match string(p, "type") {
+        None | Some(("flat", _)) => CurveKind::Flat,
+        Some(("ribbon", _)) => CurveKind::Ribbon,
+        Some(("cylinder", _)) => CurveKind::Cylinder,
+        Some((other, loc)) => {
+            ctx.warn(
+                loc,
+                format!("unknown curve type \"{other}\": \"cylinder\" is used (as pbrt-v3)"),
+                "unknown curve type",
+            );
+            CurveKind::Cylinder
+        }
+    };
+    let mut normals = None;
+    match p.find("N", |t| t == ParamType::Normal) {
+        Some(q) if kind != CurveKind::Ribbon => {
+            ctx.warn(
+                q.values_loc,
+                "curve normals \"N\" are only used by \"ribbon\" curves: ignored (as pbrt-v3)",
+                "ignored",
+            );
+        }
+        Some(q) => {
+            let n = to_vec3(q.nums());
+            if n.len() != segments + 1 {
+                ctx.error(
+                    q.values_loc,
+                    format!(
+                        "{} normals: a ribbon curve with {segments} segments needs {}",
+                        n.len(),
+                        segments + 1
+                    ),
+                    "wrong number of normals",
+                    None,
+                );
+                return None;
+            }
+            if n.iter()
+                .any(|v| !(v.is_finite() && v.length_squared() > 0.0 && v.normalize().is_finite()))
+            {
+                ctx.error(
+                    q.values_loc,
+                    "a ribbon normal is zero or not a finite 32-bit vector",
+                    "bad normal",
+                    None,
+                );
+                return None;
+            }
+            normals = Some(n);
+        }
+        None if kind == CurveKind::Ribbon => {
+            ctx.error(
+                name.loc,
+                "a ribbon curve needs normals \"N\" at its segments' ends (as pbrt-v3)",
+                "no \"normal N\"",
+                None,
+            );
+            return None;
+        }
+        None => {}
+    }
+    let split_depth = match int(p, "splitdepth", -1) {
+        (-1, None) => float(p, "splitdepth", 3.0) as i64,
+        (d, _) => d,
+    };
+    // pbrt-v3 takes a negative depth as no split and overflows past 31;
+    // beyond 10 a piece is already far below the subdivision's resolution.
+    let split_depth = split_depth.clamp(0, 10) as u32;
+    let (w0, w1) = (width0 as f32, width1 as f32);
+    let wloc = p
+        .get("width0")
+        .or_else(|| p.get("width1"))
+        .or_else(|| p.get("width"))
+        .map(|q| q.values_loc)
+        .unwrap_or(name.loc);
+    if !(w0 > 0.0 && w1 > 0.0 && w0.is_finite() && w1.is_finite()) {
+        ctx.error(
+            wloc,
+            format!("curve widths {width0} and {width1}: both must be positive 32-bit floats (pbrt-v3 gives NaN or no curve otherwise)"),
+            "width must be > 0",
+            None,
+        );
+        return None;
+    }
+    let mut out = Vec::with_capacity(segments);
+    for seg in 0..segments {
+        let bez = if bspline {
+            bspline_to_bezier(&cp[seg..seg + degree + 1])
+        } else {
+            bezier_to_cubic(&cp[seg * degree..seg * degree + degree + 1])
+        };
+        let t0 = seg as f32 / segments as f32;
+        let t1 = (seg + 1) as f32 / segments as f32;
+        out.push(CurveSegment {
+            cp: bez,
+            width: [w0 + (w1 - w0) * t0, w0 + (w1 - w0) * t1],
+            normals: normals.as_ref().map(|n: &Vec<Vec3>| [n[seg], n[seg + 1]]),
+        });
+    }
+    Some(Geometry::Curve(Arc::new(CurveData {
+        kind,
+        segments: out,
+        split_depth,
+    })))
+}
+
+/// A Bézier segment of degree 2 or 3 as a cubic (degree elevation).
+fn bezier_to_cubic(c: &[Vec3]) -> [Vec3; 4] {
+    if c.len() == 3 {
+        [
+            c[0],
+            c[0].lerp(c[1], 2.0 / 3.0),
+            c[1].lerp(c[2], 1.0 / 3.0),
+            c[2],
+        ]
+    } else {
+        [c[0], c[1], c[2], c[3]]
+    }
+}
+
+/// A uniform b-spline segment of degree 2 or 3 as the cubic Bézier of the
+/// same curve (by blossoming, as pbrt-v3).
+fn bspline_to_bezier(c: &[Vec3]) -> [Vec3; 4] {
+    if c.len() == 3 {
+        let (p11, p12, p22) = (c[0].lerp(c[1], 0.5), c[1], c[1].lerp(c[2], 0.5));
+        [p11, p11.lerp(p12, 2.0 / 3.0), p12.lerp(p22, 1.0 / 3.0), p22]
+    } else {
+        let p122 = c[0].lerp(c[1], 2.0 / 3.0);
+        let p223 = c[1].lerp(c[2], 1.0 / 3.0);
+        let p233 = c[1].lerp(c[2], 2.0 / 3.0);
+        let p334 = c[2].lerp(c[3], 1.0 / 3.0);
+        [p122.lerp(p223, 0.5), p223, p233, p233.lerp(p334, 0.5)]
+    }
 }
 
 fn to_vec3(v: &[f64]) -> Vec<Vec3> {

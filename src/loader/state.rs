@@ -688,7 +688,12 @@ impl<'s, 'c> Builder<'s, 'c> {
             _ => (None, None),
         };
         let material = self.material_for_shape(&g.material, params, &g.textures);
-        let area_light = area.map(|a| self.area_light(a));
+        let mut area_light = area.map(|a| self.area_light(a));
+        if matches!(geometry, Geometry::Curve(_)) && area_light.is_some() {
+            // pbrt-v3 aborts when it samples one (`Curve::Sample`).
+            self.ctx.warn(stmts[i].loc, "an area light on a curve is not supported by pbrs (pbrt-v3 cannot sample curves): the curve does not emit", "this curve is not emissive");
+            area_light = None;
+        }
         self.ctx
             .report_unused(params, &format!("Shape \"{}\"", name.value));
         let emits = area_light.is_some_and(|a| a.l.max_element() > 0.0);

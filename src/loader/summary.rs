@@ -175,6 +175,7 @@ fn geometry_name(g: &Geometry) -> &'static str {
         Geometry::TriangleMesh(_) => "trianglemesh",
         Geometry::Sphere { .. } => "sphere",
         Geometry::Disk { .. } => "disk",
+        Geometry::Curve(_) => "curve",
         Geometry::Cylinder { .. } => "cylinder",
         Geometry::Cone { .. } => "cone",
         Geometry::Paraboloid { .. } => "paraboloid",

@@ -8,7 +8,8 @@ use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
 use crate::render::shapes::{
-    AlphaMask, Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Quadric, Sphere, TriangleMesh,
+    AlphaMask, Cone, Curve, CurveCommon, Cylinder, Disk, Hyperboloid, Paraboloid, Quadric, Sphere,
+    TriangleMesh,
 };
 use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, DVec3, Vec3};
@@ -60,8 +61,12 @@ impl RenderScene {
                     }
                     meshes.push(tm);
                 }
+                // Curves never emit (the loader warned).
+                scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, to_world, s)),
                 g => {
-                    let mut q = quadric(g, to_world, s).expect("not a mesh");
+                    let Some(mut q) = quadric(g, to_world, s) else {
+                        return;
+                    };
                     if let Some(a) = emit {
                         q.set_light(Some(area.len() as u32));
                         area.push((AreaShape::Quadric(quadrics.len() as u32), a));
@@ -251,17 +256,40 @@ fn object(obj: &scene::ObjectDesc) -> Object {
     for s in &obj.shapes {
         match &s.geometry {
             scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, s.object_to_world, s)),
+            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, s.object_to_world, s)),
             g => quadrics.extend(quadric(g, s.object_to_world, s)),
         }
     }
     Object::new(meshes, quadrics)
 }
 
-/// An analytic shape in the space `to_world` maps to (`None` for meshes).
+/// The pieces of a curve's segments (pbrt-v3's `CreateCurve` for each), in
+/// the space `to_world` maps to.
+fn curve_pieces<'a>(
+    c: &'a scene::CurveData,
+    to_world: DMat4,
+    s: &ShapeDesc,
+) -> impl Iterator<Item = Quadric> + 'a {
+    let (reverse, material) = (s.reverse_orientation, s.material.0);
+    c.segments.iter().flat_map(move |seg| {
+        let common = Arc::new(CurveCommon::new(
+            c.kind,
+            seg.cp,
+            seg.width,
+            seg.normals,
+            to_world,
+            reverse,
+        ));
+        Curve::pieces(common, c.split_depth, material).map(Quadric::Curve)
+    })
+}
+
+/// An analytic shape in the space `to_world` maps to (`None` for meshes and
+/// curves).
 fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadric> {
     let (reverse, material) = (s.reverse_orientation, s.material.0);
     Some(match *g {
-        scene::Geometry::TriangleMesh(_) => return None,
+        scene::Geometry::TriangleMesh(_) | scene::Geometry::Curve(_) => return None,
         scene::Geometry::Sphere {
             radius,
             z_min,

@@ -298,6 +298,9 @@ pub enum Geometry {
         /// Degrees, (0, 360].
         phi_max: f32,
     },
+    /// pbrt-v3's `curve`, as cubic Bézier segments (bspline and degree-2
+    /// input already converted).
+    Curve(Arc<CurveData>),
     /// pbrt-v3's `disk`: 0 <= inner_radius < radius.
     Disk {
         height: f32,
@@ -306,6 +309,32 @@ pub enum Geometry {
         /// Degrees, (0, 360].
         phi_max: f32,
     },
+}
+
+/// pbrt-v3's curve types.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CurveKind {
+    Flat,
+    Ribbon,
+    Cylinder,
+}
+
+/// One cubic Bézier segment of a curve (object space).
+#[derive(Clone, Debug)]
+pub struct CurveSegment {
+    pub cp: [glam::Vec3; 4],
+    /// Widths at the segment's ends (> 0).
+    pub width: [f32; 2],
+    /// Ribbon normals at the segment's ends (ribbons only).
+    pub normals: Option<[glam::Vec3; 2]>,
+}
+
+/// A `curve` shape: its segments, each split into 2^`split_depth` pieces.
+#[derive(Clone, Debug)]
+pub struct CurveData {
+    pub kind: CurveKind,
+    pub segments: Vec<CurveSegment>,
+    pub split_depth: u32,
 }
 
 /// Triangle mesh data in object space, shared between shapes and instances.

@@ -15,7 +15,7 @@
 //! 1/(world area) (pbrt-v3 uses the object-space area).
 
 use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
+use crate::render::geometry::{gamma, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
 use std::f64::consts::TAU;
 
@@ -209,29 +209,10 @@ impl Cylinder {
 
     /// dA_world / dA_obj = |det M| · |M^-T n_obj|.
     #[inline]
-    fn area_density(&self, p_obj: DVec3) -> f32 {
+    pub fn area_density(&self, p_obj: DVec3) -> f32 {
         let n_obj = DVec3::new(p_obj.x, p_obj.y, 0.0) / self.radius;
         let obj_area = (self.z_max - self.z_min) * self.radius * self.phi_max;
         (1.0 / (obj_area * self.det_abs * (self.normal_matrix * n_obj).length())) as f32
-    }
-
-    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
-        super::to_solid_angle(p, self.sample_area(u))
-    }
-
-    /// pbrt-v3's `Shape::Pdf(ref, wi)`: the area density at the first hit.
-    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-        let o = offset_ray_origin(p, p_error, n, wi);
-        let Some((_, p_obj)) = self.intersect(o, wi, f32::INFINITY) else {
-            return 0.0;
-        };
-        let h = self.surface_point(p_obj);
-        let pdf = self.area_density(p_obj) * h.p.distance_squared(p) / h.n.dot(wi).abs();
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
     }
 }
 

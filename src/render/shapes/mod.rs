@@ -2,6 +2,7 @@
 //! surface interactions carrying error bounds, and sampling for area lights.
 
 mod cone;
+mod curve;
 mod cylinder;
 mod disk;
 mod hyperboloid;
@@ -11,6 +12,7 @@ mod sphere;
 mod triangle;
 
 pub use cone::Cone;
+pub use curve::{Curve, CurveCommon, CurveHit, CurveKind};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use hyperboloid::{hyperboloid_coefficients, Hyperboloid};

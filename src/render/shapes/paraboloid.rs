@@ -18,10 +18,10 @@
 //! above z grows as (4cz + 1)^{3/2}, inverted in closed form), with the
 //! exact world-area density.
 
-use super::quadric::{pbrt_closest, phi_f32, phi_of, solid_angle_pdf, weingarten, Placement};
+use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};
-use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
+use crate::render::geometry::{gamma, Bounds3};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
@@ -155,24 +155,7 @@ impl Paraboloid {
         let d2uu = -pm * pm * DVec3::new(p.x, p.y, 0.0);
         let d2uv = dz * pm * DVec3::new(-p.y / (2.0 * p.z), p.x / (2.0 * p.z), 0.0);
         let d2vv = -dz * dz * DVec3::new(p.x / (4.0 * p.z * p.z), p.y / (4.0 * p.z * p.z), 0.0);
-        let (dndu, dndv) = weingarten(dpdu, dpdv, d2uu, d2uv, d2vv);
-        let (dpdu, dpdv) = (self.place.vector(dpdu), self.place.vector(dpdv));
-        let (dndu, dndv) = (
-            self.place.normal_derivative(dndu),
-            self.place.normal_derivative(dndv),
-        );
-        DiffGeom {
-            uv: Vec2::new(u as f32, v as f32),
-            dpdu,
-            dpdv,
-            dndu,
-            dndv,
-            shading_dpdu: dpdu,
-            shading_dpdv: dpdv,
-            shading_dndu: dndu,
-            shading_dndv: dndv,
-            ..DiffGeom::ZERO
-        }
+        self.place.diff_geom((u, v), dpdu, dpdv, [d2uu, d2uv, d2vv])
     }
 
     #[inline]
@@ -191,26 +174,6 @@ impl Paraboloid {
         ShapeSample {
             point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
-        }
-    }
-
-    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
-        super::to_solid_angle(p, self.sample_area(u))
-    }
-
-    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-        let o = offset_ray_origin(p, p_error, n, wi);
-        match self.intersect(o, wi, f32::INFINITY) {
-            Some((_, q, err)) => {
-                let q = q.as_dvec3();
-                solid_angle_pdf(
-                    p,
-                    &self.surface_point(q, err.as_dvec3()),
-                    wi,
-                    self.area_density(q),
-                )
-            }
-            None => 0.0,
         }
     }
 }

@@ -1,12 +1,14 @@
-//! The closed set of analytic shapes (pbrt-v3's quadrics) as one enum that
-//! only delegates: the BVH holds them as non-triangle primitives, traced by
-//! callback, and area lights sit on them.
+//! The closed set of analytic shapes (pbrt-v3's quadrics, and curve pieces)
+//! as one enum that only delegates: the BVH holds them as non-triangle
+//! primitives, traced by callback, and area lights sit on them (not on
+//! curves, which pbrt-v3 cannot sample).
 
+use super::curve::{Curve, CurveHit};
 use super::{
     Cone, Cylinder, DiffGeom, Disk, Hyperboloid, Paraboloid, ShapeSample, Sphere, SurfacePoint,
 };
 use crate::render::geometry::efloat::EFloat;
-use crate::render::geometry::{gamma, Bounds3};
+use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Mat4, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
@@ -17,6 +19,7 @@ pub enum Quadric {
     Cone(Cone),
     Paraboloid(Paraboloid),
     Hyperboloid(Hyperboloid),
+    Curve(Curve),
 }
 
 macro_rules! each {
@@ -28,6 +31,7 @@ macro_rules! each {
             Quadric::Cone($s) => $e,
             Quadric::Paraboloid($s) => $e,
             Quadric::Hyperboloid($s) => $e,
+            Quadric::Curve($s) => $e,
         }
     };
 }
@@ -64,6 +68,7 @@ impl Quadric {
             Quadric::Cone(c) => c.is_valid(),
             Quadric::Paraboloid(c) => c.is_valid(),
             Quadric::Hyperboloid(c) => c.is_valid(),
+            Quadric::Curve(c) => c.is_valid(),
         }
     }
 
@@ -80,11 +85,17 @@ impl Quadric {
             Quadric::Cone(s) => bounded(s.intersect(o, d, t_max)),
             Quadric::Paraboloid(s) => bounded(s.intersect(o, d, t_max)),
             Quadric::Hyperboloid(s) => bounded(s.intersect(o, d, t_max)),
+            Quadric::Curve(s) => s
+                .intersect(o, d, t_max)
+                .map(|(t, h)| (t, QuadricHit::Curve(h))),
         }
     }
 
     #[inline]
     pub fn surface_point(&self, h: QuadricHit) -> SurfacePoint {
+        if let (Quadric::Curve(c), QuadricHit::Curve(h)) = (self, h) {
+            return c.surface_point(h);
+        }
         let (p, err) = h.point_and_error();
         match self {
             Quadric::Sphere(s) => s.surface_point(p),
@@ -93,40 +104,62 @@ impl Quadric {
             Quadric::Cone(s) => s.surface_point(p, err),
             Quadric::Paraboloid(s) => s.surface_point(p, err),
             Quadric::Hyperboloid(s) => s.surface_point(p, err),
+            // (Never reached: a curve's hits are curve hits.)
+            Quadric::Curve(_) => SurfacePoint {
+                p: p.as_vec3(),
+                p_error: err.as_vec3(),
+                n: Vec3::Z,
+                ns: Vec3::Z,
+            },
         }
     }
 
     #[inline]
     pub fn diff_geom(&self, h: QuadricHit) -> DiffGeom {
         let (p, _) = h.point_and_error();
-        each!(self, s => s.diff_geom(p))
+        match (self, h) {
+            (Quadric::Curve(c), QuadricHit::Curve(h)) => c.diff_geom(h),
+            (Quadric::Sphere(s), _) => s.diff_geom(p),
+            (Quadric::Disk(s), _) => s.diff_geom(p),
+            (Quadric::Cylinder(s), _) => s.diff_geom(p),
+            (Quadric::Cone(s), _) => s.diff_geom(p),
+            (Quadric::Paraboloid(s), _) => s.diff_geom(p),
+            (Quadric::Hyperboloid(s), _) => s.diff_geom(p),
+            (Quadric::Curve(_), _) => DiffGeom::ZERO,
+        }
     }
 
     /// Density by world area of the shape's area sampling at an object point
-    /// (cones, paraboloids and hyperboloids; their light sampling is pbrs's).
+    /// (the shapes sampled by area alone; not spheres or disks).
     pub fn area_density(&self, p_obj: DVec3) -> f32 {
         match self {
+            Quadric::Cylinder(c) => c.area_density(p_obj),
             Quadric::Cone(c) => c.area_density(p_obj),
             Quadric::Paraboloid(c) => c.area_density(p_obj),
             Quadric::Hyperboloid(c) => c.area_density(p_obj),
-            _ => f32::NAN,
+            Quadric::Sphere(_) | Quadric::Disk(_) | Quadric::Curve(_) => f32::NAN,
         }
     }
 
     /// A point sampled as seen from a reference point; density by solid angle.
     #[inline]
     pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
-        match self {
-            Quadric::Sphere(s) => s.sample_from(p, p_error, n, u),
-            Quadric::Disk(d) => d.sample_from(p, u),
-            Quadric::Cylinder(c) => c.sample_from(p, u),
-            Quadric::Cone(c) => c.sample_from(p, u),
-            Quadric::Paraboloid(c) => c.sample_from(p, u),
-            Quadric::Hyperboloid(c) => c.sample_from(p, u),
-        }
+        let by_area = match self {
+            Quadric::Sphere(s) => return s.sample_from(p, p_error, n, u),
+            Quadric::Disk(d) => d.sample_area(u),
+            Quadric::Cylinder(c) => c.sample_area(u),
+            Quadric::Cone(c) => c.sample_area(u),
+            Quadric::Paraboloid(c) => c.sample_area(u),
+            Quadric::Hyperboloid(c) => c.sample_area(u),
+            // Never a light (the scene leaves curves' emission out).
+            Quadric::Curve(_) => return None,
+        };
+        super::to_solid_angle(p, by_area)
     }
 
-    /// Density by solid angle of `sample_from` producing direction `wi`.
+    /// Density by solid angle of `sample_from` producing direction `wi`:
+    /// pbrt-v3's `Shape::Pdf(ref, wi)`, the area density at the first hit of
+    /// the ray spawned along `wi`.
     #[inline]
     pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
         match self {
@@ -134,10 +167,17 @@ impl Quadric {
                 s.pdf_from(p, p_error, n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
             }
             Quadric::Disk(d) => d.pdf_from(p, p_error, n, wi),
-            Quadric::Cylinder(c) => c.pdf_from(p, p_error, n, wi),
-            Quadric::Cone(c) => c.pdf_from(p, p_error, n, wi),
-            Quadric::Paraboloid(c) => c.pdf_from(p, p_error, n, wi),
-            Quadric::Hyperboloid(c) => c.pdf_from(p, p_error, n, wi),
+            Quadric::Curve(_) => 0.0,
+            _ => {
+                let o = offset_ray_origin(p, p_error, n, wi);
+                match self.intersect(o, wi, f32::INFINITY) {
+                    Some((_, h)) => {
+                        let density = self.area_density(h.point_and_error().0);
+                        solid_angle_pdf(p, &self.surface_point(h), wi, density)
+                    }
+                    None => 0.0,
+                }
+            }
         }
     }
 }
@@ -148,7 +188,12 @@ impl Quadric {
 #[derive(Clone, Copy, Debug)]
 pub enum QuadricHit {
     Exact(DVec3),
-    Bounded { p: Vec3, err: Vec3 },
+    Bounded {
+        p: Vec3,
+        err: Vec3,
+    },
+    /// A curve piece's hit (its dp/dv depends on the ray).
+    Curve(CurveHit),
 }
 
 impl QuadricHit {
@@ -157,6 +202,7 @@ impl QuadricHit {
         match self {
             QuadricHit::Exact(p) => (p, DVec3::ZERO),
             QuadricHit::Bounded { p, err } => (p.as_dvec3(), err.as_dvec3()),
+            QuadricHit::Curve(h) => (h.p.as_dvec3(), DVec3::splat(h.err as f64)),
         }
     }
 }
@@ -256,6 +302,27 @@ impl Placement {
             p_error: Vec3::from(ew),
             n,
             ns: n,
+        }
+    }
+
+    /// The world differential geometry of an object-space parametrisation
+    /// at a hit: dp/du, dp/dv and the second derivatives (dn/du, dn/dv by
+    /// pbrt-v3's Weingarten equations); the shading frame is the same.
+    pub fn diff_geom(&self, uv: (f64, f64), dpdu: DVec3, dpdv: DVec3, d2: [DVec3; 3]) -> DiffGeom {
+        let (dndu, dndv) = weingarten(dpdu, dpdv, d2[0], d2[1], d2[2]);
+        let (dpdu, dpdv) = (self.vector(dpdu), self.vector(dpdv));
+        let (dndu, dndv) = (self.normal_derivative(dndu), self.normal_derivative(dndv));
+        DiffGeom {
+            uv: Vec2::new(uv.0 as f32, uv.1 as f32),
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            shading_dndu: dndu,
+            shading_dndv: dndv,
+            ..DiffGeom::ZERO
         }
     }
 
@@ -372,13 +439,7 @@ pub fn phi_of(p: DVec3) -> f64 {
 
 /// pbrt-v3's Weingarten equations: dn/du and dn/dv from the first and
 /// second fundamental forms (object space).
-pub fn weingarten(
-    dpdu: DVec3,
-    dpdv: DVec3,
-    d2uu: DVec3,
-    d2uv: DVec3,
-    d2vv: DVec3,
-) -> (DVec3, DVec3) {
+fn weingarten(dpdu: DVec3, dpdv: DVec3, d2uu: DVec3, d2uv: DVec3, d2vv: DVec3) -> (DVec3, DVec3) {
     let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
     let n = dpdu.cross(dpdv).normalize();
     let (e2, f2, g2) = (n.dot(d2uu), n.dot(d2uv), n.dot(d2vv));
@@ -391,7 +452,7 @@ pub fn weingarten(
 /// pbrt-v3's `Shape::Pdf(ref, wi)` for an area density at the surface point
 /// `h` the ray from `p` along `wi` hits: the solid-angle density.
 #[inline]
-pub fn solid_angle_pdf(p: Vec3, h: &SurfacePoint, wi: Vec3, area_density: f32) -> f32 {
+fn solid_angle_pdf(p: Vec3, h: &SurfacePoint, wi: Vec3, area_density: f32) -> f32 {
     let pdf = area_density * h.p.distance_squared(p) / h.n.dot(wi).abs();
     if pdf.is_finite() {
         pdf
