@@ -228,7 +228,11 @@ fn render_tile(
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
-    let lens = scene.camera.uses_lens();
+    // Whether the camera sample's time and lens values are read (all
+    // samplers draw both, as pbrt-v3; Halton skips computing them when
+    // nothing reads them).
+    let lens =
+        scene.camera.uses_lens() || scene.camera.is_moving() || scene.geometry.moving_count() > 0;
     // pbrt-v3 scales camera ray differentials by 1/√spp. Rays carry them
     // only in scenes whose materials can use them.
     let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();

@@ -245,7 +245,8 @@ impl Integrator {
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 if w.pass < MAX_PASS_THROUGH {
-                    let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                    let ray =
+                        spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d).with_time(s.time);
                     // A spawned ray has no differentials (pbrt-v3's SpawnRay).
                     stack.push(Work {
                         ray,
@@ -326,7 +327,7 @@ impl Integrator {
                         let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
                         if f != Vec3::ZERO {
                             scratch.counts.shadow += 1;
-                            if !scene.geometry.occluded(&ls.shadow) {
+                            if !scene.geometry.occluded(&ls.shadow.with_time(s.time)) {
                                 local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
                             }
                         }
@@ -354,7 +355,8 @@ impl Integrator {
                     if let Some(bs) = bsdf.sample(wo, u, filter) {
                         let cos = bs.wi.dot(s.point.ns).abs();
                         if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
-                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi)
+                                .with_time(s.time);
                             let beta = w.beta * bs.f * cos / bs.pdf;
                             let diff = match (&w.diff, &geom) {
                                 (Some(d), Some(g)) if i == 0 => {
@@ -547,7 +549,7 @@ fn path_li(
             if pass > MAX_PASS_THROUGH {
                 break;
             }
-            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d).with_time(s.time);
             diff = None;
             continue;
         }
@@ -583,7 +585,7 @@ fn path_li(
                 1.0 / eta2
             };
         }
-        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi).with_time(s.time);
         // Russian roulette after bounce 3 on max(β·etaScale).
         let rr = (beta * eta_scale).max_element();
         if rr < rr_threshold && bounces > 3 {
@@ -687,7 +689,7 @@ fn light_strategy(
         return Vec3::ZERO;
     }
     scratch.counts.shadow += 1;
-    if scene.geometry.occluded(&ls.shadow) {
+    if scene.geometry.occluded(&ls.shadow.with_time(s.time)) {
         return Vec3::ZERO;
     }
     let light_pdf = pmf * ls.pdf;
@@ -788,7 +790,7 @@ fn estimate_direct(
         if let Some(bs) = bsdf.sample(wo, u_scatter, BxdfFlags::NON_SPECULAR) {
             let f = bs.f * bs.wi.dot(ns).abs();
             if f != Vec3::ZERO && bs.pdf > 0.0 {
-                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi).with_time(s.time);
                 let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
                     return ld;
