@@ -307,3 +307,455 @@ WorldEnd
         .to_string()
         .contains("area light is ignored for an animated shape")));
 }
+
+// ---------------------------------------------------------------------------
+// Interpolation against hand-computed matrices.
+
+#[test]
+fn interpolation_at_keyframes_and_midpoint_is_the_hand_computed_matrix() {
+    // Start: translate (1, 0, 0). End: translate (3, 2, 0), turn 90° about z,
+    // scale 2. Halfway: translate (2, 1, 0), turn 45°, scale 1.5.
+    let start = DMat4::from_translation(DVec3::new(1.0, 0.0, 0.0));
+    let end = DMat4::from_translation(DVec3::new(3.0, 2.0, 0.0))
+        * DMat4::from_rotation_z(90f64.to_radians())
+        * DMat4::from_scale(DVec3::splat(2.0));
+    let at = AnimatedTransform::new(start, 0.0, end, 1.0).unwrap();
+    assert_eq!(at.interpolate(0.0), start);
+    assert_eq!(at.interpolate(1.0), end);
+    let c = 1.5 * std::f64::consts::FRAC_1_SQRT_2;
+    // Columns: x axis, y axis, z axis, translation.
+    let want = DMat4::from_cols_array(&[
+        c, c, 0.0, 0.0, //
+        -c, c, 0.0, 0.0, //
+        0.0, 0.0, 1.5, 0.0, //
+        2.0, 1.0, 0.0, 1.0,
+    ]);
+    let mid = at.interpolate(0.5);
+    assert!(close(mid, want, 1e-12), "{mid:?}");
+    // A quarter of the way: 22.5°, scale 1.25, translate (1.5, 0.5, 0).
+    let (s, co) = 22.5f64.to_radians().sin_cos();
+    let want = DMat4::from_cols_array(&[
+        1.25 * co,
+        1.25 * s,
+        0.0,
+        0.0,
+        -1.25 * s,
+        1.25 * co,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.25,
+        0.0,
+        1.5,
+        0.5,
+        0.0,
+        1.0,
+    ]);
+    assert!(close(at.interpolate(0.25), want, 1e-12));
+    // The times are TransformTimes': halfway between 2 and 6 is 4.
+    let at = AnimatedTransform::new(start, 2.0, end, 6.0).unwrap();
+    assert!(close(at.interpolate(4.0), mid, 1e-12));
+}
+
+#[test]
+fn motion_bounds_hold_rotations_up_to_half_a_turn() {
+    let mut rng = 3u64;
+    let (lo, hi) = (DVec3::new(-0.5, -1.0, -0.3), DVec3::new(0.7, 0.4, 0.6));
+    for deg in [10.0f64, 45.0, 90.0, 135.0, 170.0, 179.0, 180.0] {
+        for axis in [DVec3::Z, DVec3::new(1.0, 1.0, 0.3).normalize()] {
+            let start = DMat4::from_translation(DVec3::new(2.0, 0.0, 0.0));
+            let end = DMat4::from_axis_angle(axis, deg.to_radians())
+                * DMat4::from_translation(DVec3::new(2.0, 0.5, 0.0));
+            let at = AnimatedTransform::new(start, 0.0, end, 1.0).unwrap();
+            let (bmin, bmax) = at.motion_bounds(lo, hi);
+            for i in 0..4000 {
+                let t = if i < 101 {
+                    i as f64 / 100.0
+                } else {
+                    lcg(&mut rng)
+                };
+                let m = at.interpolate(t);
+                for c in 0..8 {
+                    let p = DVec3::new(
+                        if c & 1 == 0 { lo.x } else { hi.x },
+                        if c & 2 == 0 { lo.y } else { hi.y },
+                        if c & 4 == 0 { lo.z } else { hi.z },
+                    );
+                    let w = m.transform_point3(p);
+                    assert!(
+                        w.cmpge(bmin).all() && w.cmple(bmax).all(),
+                        "{deg}° about {axis}: corner {c} at t {t} is {w}, bounds {bmin} {bmax}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The renderer: rays at a time see the geometry where the interpolated
+// transform puts it.
+
+use glam::{Vec2, Vec3};
+use pbrs::render::geometry::Ray;
+use pbrs::render::samplers::CameraSample;
+use pbrs::render::scene::RenderScene;
+
+fn render_scene(text: &str) -> RenderScene {
+    RenderScene::new(&load(text).scene)
+}
+
+fn down(x: f32, y: f32, time: f32) -> Ray {
+    Ray::new(Vec3::new(x, y, 10.0), Vec3::new(0.0, 0.0, -1.0)).with_time(time)
+}
+
+/// A sphere of radius 0.5 moving from x = 0 to x = 2 between times 0 and 1,
+/// and a triangle turning 90° about z (it starts along +x, ends along +y).
+const MOVING: &str = r#"
+Camera "perspective"
+Film "image" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+AttributeBegin
+  ActiveTransform EndTime
+  Translate 2 0 0
+  ActiveTransform All
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+AttributeBegin
+  Translate 0 0 -3
+  ActiveTransform EndTime
+  Rotate 90 0 0 1
+  ActiveTransform All
+  Shape "trianglemesh" "integer indices" [0 1 2]
+    "point P" [1 -0.2 0  4 -0.2 0  4 0.2 0]
+AttributeEnd
+WorldEnd
+"#;
+
+#[test]
+fn rays_hit_a_moving_sphere_where_its_transform_puts_it() {
+    let sc = render_scene(MOVING);
+    let g = &sc.geometry;
+    assert_eq!(g.moving_count(), 2);
+    for (x, time, hit) in [
+        (0.0, 0.0, true),
+        (2.0, 0.0, false),
+        (2.0, 1.0, true),
+        (0.0, 1.0, false),
+        (1.0, 0.5, true),
+        (0.0, 0.5, false),
+        (1.7, 0.85, true),
+    ] {
+        let r = down(x, 0.0, time);
+        let h = g.intersect(&r);
+        assert_eq!(h.is_some(), hit, "x {x} at time {time}");
+        assert_eq!(g.occluded(&Ray { t_max: 100.0, ..r }), hit);
+        if let Some(h) = h {
+            // The top of the sphere: z = 0.5, normal +z, in world space.
+            let s = g.surface(&h);
+            assert!((h.t - 9.5).abs() < 1e-4, "{}", h.t);
+            assert!((s.point.p - Vec3::new(x, 0.0, 0.5)).length() < 1e-4);
+            assert!((s.point.n - Vec3::Z).length() < 1e-4, "{:?}", s.point.n);
+            assert_eq!(s.time, time);
+        }
+    }
+}
+
+#[test]
+fn rays_hit_a_turning_triangle_where_its_transform_puts_it() {
+    let sc = render_scene(MOVING);
+    let g = &sc.geometry;
+    // At time 0 the triangle lies along +x (at z = -3), at time 1 along +y,
+    // halfway along the diagonal.
+    let on = |x: f32, y: f32, t: f32| {
+        g.intersect(&down(x, y, t))
+            .map(|h| (h.t - 13.0).abs() < 1e-4)
+            .unwrap_or(false)
+    };
+    assert!(on(3.0, 0.0, 0.0));
+    assert!(!on(0.0, 3.0, 0.0));
+    assert!(on(0.0, 3.0, 1.0));
+    assert!(!on(3.0, 0.0, 1.0));
+    let d = 3.0 * std::f32::consts::FRAC_1_SQRT_2;
+    assert!(on(d, d, 0.5));
+    assert!(!on(3.0, 0.0, 0.5) && !on(0.0, 3.0, 0.5));
+    // Before the start time and after the end time the keyframes hold.
+    assert!(on(3.0, 0.0, -1.0));
+    assert!(on(0.0, 3.0, 2.0));
+}
+
+#[test]
+fn animated_instances_move_and_still_ones_do_not() {
+    let text = r#"
+Camera "perspective"
+Film "image" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+ObjectBegin "ball"
+  Shape "sphere" "float radius" 0.5
+ObjectEnd
+AttributeBegin
+  Translate -3 0 0
+  ObjectInstance "ball"
+AttributeEnd
+AttributeBegin
+  ActiveTransform EndTime
+  Translate 0 2 0
+  ActiveTransform All
+  ObjectInstance "ball"
+AttributeEnd
+WorldEnd
+"#;
+    let sc = render_scene(text);
+    let g = &sc.geometry;
+    assert_eq!((g.instance_count(), g.moving_count()), (1, 1));
+    for t in [0.0, 0.3, 1.0] {
+        assert!(g.intersect(&down(-3.0, 0.0, t)).is_some());
+    }
+    assert!(g.intersect(&down(0.0, 0.0, 0.0)).is_some());
+    assert!(g.intersect(&down(0.0, 0.0, 1.0)).is_none());
+    let h = g.intersect(&down(0.0, 1.0, 0.5)).expect("halfway");
+    let s = g.surface(&h);
+    assert!((s.point.p - Vec3::new(0.0, 1.0, 0.5)).length() < 1e-4);
+}
+
+#[test]
+fn a_moving_camera_moves_its_rays_within_the_shutter() {
+    let text = r#"
+ActiveTransform EndTime
+Translate -4 0 0
+ActiveTransform All
+Camera "perspective" "float shutteropen" 0.25 "float shutterclose" 0.75
+Film "image" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+WorldEnd
+"#;
+    let sc = render_scene(text);
+    let cam = &sc.camera;
+    assert!(cam.is_moving());
+    let cs = |time: f32| CameraSample {
+        p_film: Vec2::new(4.0, 4.0),
+        p_lens: Vec2::new(0.5, 0.5),
+        time,
+    };
+    // The world-to-camera end transform translates by -4: the camera
+    // itself goes to +4. Sample time 0 is the shutter's opening (0.25, a
+    // quarter of the way), 1 its closing, 0.5 the middle.
+    for (u, time, x) in [(0.0, 0.25, 1.0), (0.5, 0.5, 2.0), (1.0, 0.75, 3.0)] {
+        let (r, w) = cam.generate_ray(&cs(u));
+        assert_eq!(w, 1.0);
+        assert_eq!(r.time, time);
+        assert!((r.o - Vec3::new(x, 0.0, 0.0)).length() < 1e-5, "{:?}", r.o);
+        assert!((r.d - Vec3::Z).length() < 1e-5);
+        let (rd, diff, _) = cam.generate_ray_differential(&cs(u), 1.0);
+        assert_eq!((rd.o, rd.d, rd.time), (r.o, r.d, r.time));
+        assert!((diff.rx_o - r.o).length() < 1e-5);
+        assert!(diff.rx_d.x > r.d.x, "one pixel right looks further right");
+    }
+    // A still camera stamps the time too and does not move.
+    let sc = render_scene(
+        r#"Camera "perspective" "float shutteropen" 2 "float shutterclose" 4
+Film "image" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+WorldEnd
+"#,
+    );
+    assert!(!sc.camera.is_moving());
+    let (r, _) = sc.camera.generate_ray(&cs(0.25));
+    assert_eq!(r.time, 2.5);
+    assert_eq!(r.o, Vec3::ZERO);
+}
+
+// ---------------------------------------------------------------------------
+// Static scenes: no motion structures and the same image.
+
+use pbrs::render::driver::{render, RenderOptions};
+
+fn image(text: &str) -> Vec<f32> {
+    let desc = load(text).scene;
+    render(&desc, &RenderOptions::default(), &|_, _| {})
+        .expect("render")
+        .0
+        .data
+}
+
+const STILL_WORLD: &str = r#"
+Integrator "path" "integer maxdepth" [3]
+Sampler "halton" "integer pixelsamples" 4
+Film "image" "integer xresolution" 16 "integer yresolution" 16
+WorldBegin
+LightSource "point" "point from" [0 3 3] "rgb I" [10 10 10]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [2 2 2]
+  Translate 0 2 0
+  Shape "sphere" "float radius" 0.3
+AttributeEnd
+Material "matte" "rgb Kd" [0.6 0.5 0.4]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point P" [-3 -1 -3  3 -1 -3  3 -1 3  -3 -1 3]
+ObjectBegin "ball"
+  Shape "sphere" "float radius" 0.5
+ObjectEnd
+AttributeBegin
+  Translate 0.8 -0.5 0
+  ObjectInstance "ball"
+AttributeEnd
+Shape "sphere" "float radius" 0.4
+WorldEnd
+"#;
+
+#[test]
+fn a_static_scene_ignores_transform_times_and_the_shutter() {
+    let head = "LookAt 0 0.5 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n";
+    let plain = image(&format!("{head}{STILL_WORLD}"));
+    let timed = image(&format!(
+        "TransformTimes 0.3 0.9\nLookAt 0 0.5 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40 \"float shutteropen\" 0.1 \"float shutterclose\" 0.6\n{STILL_WORLD}"
+    ));
+    assert!(plain.iter().any(|&v| v > 0.0));
+    assert_eq!(plain, timed, "time must not reach a static scene's image");
+    // An "animation" whose two transforms agree is static.
+    let same = image(&format!(
+        "{head}{}",
+        STILL_WORLD.replace(
+            "Shape \"sphere\" \"float radius\" 0.4",
+            "ActiveTransform EndTime\nTranslate 0 0 0\nActiveTransform All\nShape \"sphere\" \"float radius\" 0.4"
+        )
+    ));
+    assert_eq!(plain, same);
+    let sc = render_scene(&format!("{head}{STILL_WORLD}"));
+    assert_eq!(sc.geometry.moving_count(), 0);
+    assert!(!sc.camera.is_moving());
+    assert!(sc
+        .notes
+        .iter()
+        .any(|n| n.contains("motion: none (no motion structures built)")));
+}
+
+#[test]
+fn a_moving_scene_renders_blur_between_its_keyframes() {
+    // The sphere at 0.4 moves; its image is a blend of the two keyframe
+    // images, different from both (and finite).
+    let head = "LookAt 0 0.5 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n";
+    let moved = |what: &str| {
+        image(&format!(
+            "{head}{}",
+            STILL_WORLD.replace(
+                "Shape \"sphere\" \"float radius\" 0.4",
+                &format!("{what}\nShape \"sphere\" \"float radius\" 0.4")
+            )
+        ))
+    };
+    let start = moved("");
+    let end = moved("Translate -1 0 0");
+    let blur = moved("ActiveTransform EndTime\nTranslate -1 0 0\nActiveTransform All");
+    assert!(blur.iter().all(|v| v.is_finite()));
+    assert_ne!(blur, start);
+    assert_ne!(blur, end);
+}
+
+// ---------------------------------------------------------------------------
+// Bad input: located diagnostics, never a panic.
+
+fn warnings_of(text: &str) -> Vec<String> {
+    load(text).warnings.iter().map(|w| w.to_string()).collect()
+}
+
+#[test]
+fn bad_transform_times_are_located_diagnostics() {
+    let world = "Camera \"perspective\"\nFilm \"image\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\nShape \"sphere\"\nWorldEnd\n";
+    // End before start: a warning, pbrt-v3's clamping (no motion between).
+    let text = format!("TransformTimes 1 0\n{world}");
+    let w = warnings_of(&text);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("end time 0 is before the start time 1")),
+        "{w:?}"
+    );
+    let located = load(&text)
+        .warnings
+        .iter()
+        .map(|w| format!("{w:?}"))
+        .collect::<Vec<_>>();
+    assert!(
+        located.iter().any(|w| w.contains("motion-test.pbrt:1:1")),
+        "{located:?}"
+    );
+    let img = image(&text);
+    assert!(img.iter().all(|v| v.is_finite()));
+    // Non-finite times: an error at the statement.
+    let err = load_scene_str(
+        &format!("TransformTimes 0 1e999\n{world}"),
+        Path::new("motion-test.pbrt"),
+    )
+    .err()
+    .expect("an error");
+    let e: Vec<String> = err.errors.iter().map(|e| format!("{e:?}")).collect();
+    assert!(
+        e.iter()
+            .any(|e| e.contains("finite") && e.contains("motion-test.pbrt:1:1")),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn singular_and_mirrored_animated_transforms_warn_and_never_panic() {
+    let scene = |edit: &str| {
+        format!(
+            "Camera \"perspective\"\nFilm \"image\" \"integer xresolution\" 8 \"integer yresolution\" 8\nSampler \"halton\" \"integer pixelsamples\" 2\nWorldBegin\nLightSource \"point\" \"point from\" [0 0 -3] \"rgb I\" [5 5 5]\nAttributeBegin\nTranslate 0 0 4\nActiveTransform EndTime\n{edit}\nActiveTransform All\nShape \"sphere\"\nAttributeEnd\nWorldEnd\n"
+        )
+    };
+    // A keyframe of scale 0: left out, with a warning.
+    let text = scene("Scale 0 1 1");
+    let w = warnings_of(&text);
+    assert!(w.iter().any(|w| w.contains("singular")), "{w:?}");
+    let sc = render_scene(&text);
+    assert_eq!(sc.geometry.moving_count(), 0);
+    assert!(sc.notes.iter().any(|n| n.contains("singular start or end")));
+    assert!(image(&text).iter().all(|v| v.is_finite()));
+    // A mirror at the end: warned (pbrt-v3 interpolates it wrongly); the
+    // scale passes through 0 halfway, where the sphere vanishes for those
+    // rays only.
+    let text = scene("Scale -1 1 1");
+    let w = warnings_of(&text);
+    assert!(w.iter().any(|w| w.contains("mirror")), "{w:?}");
+    let sc = render_scene(&text);
+    assert_eq!(sc.geometry.moving_count(), 1);
+    let ray = |t: f32| Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::Z).with_time(t);
+    assert!(sc.geometry.intersect(&ray(0.0)).is_some());
+    assert!(sc.geometry.intersect(&ray(1.0)).is_some());
+    assert!(!sc.geometry.occluded(&Ray {
+        t_max: 100.0,
+        ..ray(0.5)
+    }));
+    assert!(image(&text).iter().all(|v| v.is_finite()));
+    // A projective keyframe: warned.
+    let text = scene("ConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0.5  0 0 0 1]");
+    let w = warnings_of(&text);
+    assert!(w.iter().any(|w| w.contains("projective")), "{w:?}");
+    assert!(image(&text).iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn animated_shapes_inside_objects_use_their_start_transform() {
+    let text = r#"
+Camera "perspective"
+Film "image" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+ObjectBegin "o"
+  ActiveTransform EndTime
+  Translate 5 0 0
+  ActiveTransform All
+  Shape "sphere"
+ObjectEnd
+ObjectInstance "o"
+WorldEnd
+"#;
+    let w = warnings_of(text);
+    assert!(
+        w.iter().any(|w| w.contains("inside an object definition")),
+        "{w:?}"
+    );
+    let sc = render_scene(text);
+    assert_eq!(sc.geometry.moving_count(), 0);
+    assert!(sc.geometry.intersect(&down(0.0, 0.0, 1.0)).is_some());
+}
