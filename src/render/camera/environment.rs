@@ -44,12 +44,7 @@ impl EnvironmentCamera {
 
     #[inline]
     pub fn generate_ray(&self, cs: &CameraSample) -> Ray {
-        Ray::new(
-            self.camera_to_world.transform_point3(Vec3::ZERO),
-            self.camera_to_world
-                .transform_vector3(self.direction(cs.p_film))
-                .normalize(),
-        )
+        super::world_ray(&self.camera_to_world, Vec3::ZERO, self.direction(cs.p_film))
     }
 
     #[inline]

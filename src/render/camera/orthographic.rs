@@ -73,10 +73,7 @@ impl OrthographicCamera {
 
     #[inline]
     fn to_world(&self, o: Vec3, d: Vec3) -> Ray {
-        Ray::new(
-            self.camera_to_world.transform_point3(o),
-            self.camera_to_world.transform_vector3(d).normalize(),
-        )
+        super::world_ray(&self.camera_to_world, o, d)
     }
 
     /// Camera-space origin, direction and lens point of the ray.

@@ -14,6 +14,7 @@
 //! | `screenwindow` | float[4] (xmin xmax ymin ymax) | [-frame, frame] × [-1, 1] if frame > 1, else [-1, 1] × [-1/frame, 1/frame] |
 //! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
 
+use super::world_ray;
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
 use crate::render::sampling::concentric_sample_disk;
@@ -74,9 +75,7 @@ impl PerspectiveCamera {
         let ft = self.focal_distance / d.z;
         let focus = d * ft;
         let d = (focus - lens).normalize();
-        let wo = self.camera_to_world.transform_point3(lens);
-        let wd = self.camera_to_world.transform_vector3(d).normalize();
-        Ray::new(wo, wd)
+        world_ray(&self.camera_to_world, lens, d)
     }
 
     /// The camera ray for a film position (raster coordinates) and lens sample.
@@ -88,9 +87,7 @@ impl PerspectiveCamera {
             return self.lens_ray(dir, Vec3::new(lens.x, lens.y, 0.0));
         }
         // Pinhole: one normalisation, after the transform (which may scale).
-        let wo = self.camera_to_world.transform_point3(Vec3::ZERO);
-        let wd = self.camera_to_world.transform_vector3(dir).normalize();
-        Ray::new(wo, wd)
+        world_ray(&self.camera_to_world, Vec3::ZERO, dir)
     }
 
     /// `generate_ray` (the same ray, bit for bit) with the differentials of

@@ -487,14 +487,13 @@ impl RealisticCamera {
             d: p_rear - p_film,
         };
         let out = self.lens.trace_from_film(r_film)?;
-        let o = self.camera_to_world.transform_point3(out.o);
-        let d = self.camera_to_world.transform_vector3(out.d).normalize();
-        if !o.is_finite() || !d.is_finite() {
+        let ray = super::world_ray(&self.camera_to_world, out.o, out.d);
+        if !ray.o.is_finite() || !ray.d.is_finite() {
             return None;
         }
         let cos = r_film.d.normalize().z;
         let cos4 = (cos * cos) * (cos * cos);
-        Some((Ray::new(o, d), cos4 * area * self.weight_scale))
+        Some((ray, cos4 * area * self.weight_scale))
     }
 
     /// The ray, its differentials (scaled by `scale`) and its weight; weight
