@@ -238,7 +238,7 @@ impl Placement {
     /// differs from a placed sphere as it does in pbrt-v3 (a placed sphere's
     /// normal is flipped by its transform's handedness; an instance's is not).
     #[inline]
-    fn to_world(&self, s: SurfacePoint, has_vertex_normals: bool) -> SurfacePoint {
+    fn point_to_world(&self, s: SurfacePoint, has_vertex_normals: bool) -> SurfacePoint {
         let p = self
             .object_to_world
             .transform_point3(s.p.as_dvec3())
@@ -779,7 +779,7 @@ impl Geometry {
             .expect("a moving instance's hit has an invertible transform at its time");
         let (s, vertex_normals) = object.shapes().surface(hit.prim, hit.local);
         SurfaceHit {
-            point: place.to_world(s.point, vertex_normals),
+            point: place.point_to_world(s.point, vertex_normals),
             material: s.material,
             // Area lights inside objects are ignored (as pbrt-v3).
             light: None,
