@@ -269,15 +269,7 @@ fn grazing_and_tangent_rays_give_no_nan() {
 
 /// The error messages of a scene that must not load.
 fn errors(shape: &str) -> String {
-    match load_text(&format!("WorldBegin\n{shape}\nWorldEnd\n")) {
-        Ok(_) => panic!("loaded, but should not: {shape}"),
-        Err(f) => f
-            .errors
-            .iter()
-            .map(|e| format!("{e}\n{e:?}"))
-            .collect::<Vec<_>>()
-            .join("\n"),
-    }
+    world_errors(&repo().join("scenes/curve-test.pbrt"), shape)
 }
 
 #[test]

@@ -39,16 +39,7 @@ fn mesh(shape: &str) -> Arc<MeshData> {
 
 /// The error messages of a scene that must not load.
 fn errors(shape: &str) -> String {
-    match load_text(&format!("WorldBegin\n{shape}\nWorldEnd\n")) {
-        Ok(_) => panic!("loaded, but should not: {shape}"),
-        // The messages, then the rendered reports (with their locations).
-        Err(f) => f
-            .errors
-            .iter()
-            .map(|e| format!("{e}\n{e:?}"))
-            .collect::<Vec<_>>()
-            .join("\n"),
-    }
+    world_errors(&repo().join("scenes/refined-test.pbrt"), shape)
 }
 
 fn nums<T: std::fmt::Display>(v: &[T]) -> String {

@@ -277,3 +277,18 @@ pub fn bsdf_of(
         &ctx,
     )
 }
+
+/// The errors of `body` wrapped in a world block, loaded as if from the file
+/// `path` (which need not exist), when it must not load: each message, then
+/// its rendered report (with the location).
+pub fn world_errors(path: &Path, body: &str) -> String {
+    match pbrs::loader::load_scene_str(&format!("WorldBegin\n{body}\nWorldEnd\n"), path) {
+        Ok(_) => panic!("loaded, but should not: {body}"),
+        Err(f) => f
+            .errors
+            .iter()
+            .map(|e| format!("{e}\n{e:?}"))
+            .collect::<Vec<_>>()
+            .join("\n"),
+    }
+}
