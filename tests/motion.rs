@@ -406,8 +406,8 @@ fn render_scene(text: &str) -> RenderScene {
     RenderScene::new(&load(text).scene)
 }
 
-fn down(x: f32, y: f32, time: f32) -> Ray {
-    Ray::new(Vec3::new(x, y, 10.0), Vec3::new(0.0, 0.0, -1.0)).with_time(time)
+fn down(x: f32, y: f32) -> Ray {
+    Ray::new(Vec3::new(x, y, 10.0), Vec3::new(0.0, 0.0, -1.0))
 }
 
 /// A sphere of radius 0.5 moving from x = 0 to x = 2 between times 0 and 1,
@@ -447,13 +447,13 @@ fn rays_hit_a_moving_sphere_where_its_transform_puts_it() {
         (0.0, 0.5, false),
         (1.7, 0.85, true),
     ] {
-        let r = down(x, 0.0, time);
-        let h = g.intersect(&r);
+        let r = down(x, 0.0);
+        let h = g.intersect_at(&r, time);
         assert_eq!(h.is_some(), hit, "x {x} at time {time}");
-        assert_eq!(g.occluded(&Ray { t_max: 100.0, ..r }), hit);
+        assert_eq!(g.occluded_at(&Ray { t_max: 100.0, ..r }, time), hit);
         if let Some(h) = h {
             // The top of the sphere: z = 0.5, normal +z, in world space.
-            let s = g.surface(&h);
+            let s = g.surface_at(&h, time);
             assert!((h.t - 9.5).abs() < 1e-4, "{}", h.t);
             assert!((s.point.p - Vec3::new(x, 0.0, 0.5)).length() < 1e-4);
             assert!((s.point.n - Vec3::Z).length() < 1e-4, "{:?}", s.point.n);
@@ -469,7 +469,7 @@ fn rays_hit_a_turning_triangle_where_its_transform_puts_it() {
     // At time 0 the triangle lies along +x (at z = -3), at time 1 along +y,
     // halfway along the diagonal.
     let on = |x: f32, y: f32, t: f32| {
-        g.intersect(&down(x, y, t))
+        g.intersect_at(&down(x, y), t)
             .map(|h| (h.t - 13.0).abs() < 1e-4)
             .unwrap_or(false)
     };
@@ -510,12 +510,12 @@ WorldEnd
     let g = &sc.geometry;
     assert_eq!((g.instance_count(), g.moving_count()), (1, 1));
     for t in [0.0, 0.3, 1.0] {
-        assert!(g.intersect(&down(-3.0, 0.0, t)).is_some());
+        assert!(g.intersect_at(&down(-3.0, 0.0), t).is_some());
     }
-    assert!(g.intersect(&down(0.0, 0.0, 0.0)).is_some());
-    assert!(g.intersect(&down(0.0, 0.0, 1.0)).is_none());
-    let h = g.intersect(&down(0.0, 1.0, 0.5)).expect("halfway");
-    let s = g.surface(&h);
+    assert!(g.intersect_at(&down(0.0, 0.0), 0.0).is_some());
+    assert!(g.intersect_at(&down(0.0, 0.0), 1.0).is_none());
+    let h = g.intersect_at(&down(0.0, 1.0), 0.5).expect("halfway");
+    let s = g.surface_at(&h, 0.5);
     assert!((s.point.p - Vec3::new(0.0, 1.0, 0.5)).length() < 1e-4);
 }
 
@@ -544,15 +544,15 @@ WorldEnd
     for (u, time, x) in [(0.0, 0.25, 1.0), (0.5, 0.5, 2.0), (1.0, 0.75, 3.0)] {
         let (r, w) = cam.generate_ray(&cs(u));
         assert_eq!(w, 1.0);
-        assert_eq!(r.time, time);
+        assert_eq!(cam.time(&cs(u)), time);
         assert!((r.o - Vec3::new(x, 0.0, 0.0)).length() < 1e-5, "{:?}", r.o);
         assert!((r.d - Vec3::Z).length() < 1e-5);
         let (rd, diff, _) = cam.generate_ray_differential(&cs(u), 1.0);
-        assert_eq!((rd.o, rd.d, rd.time), (r.o, r.d, r.time));
+        assert_eq!((rd.o, rd.d), (r.o, r.d));
         assert!((diff.rx_o - r.o).length() < 1e-5);
         assert!(diff.rx_d.x > r.d.x, "one pixel right looks further right");
     }
-    // A still camera stamps the time too and does not move.
+    // A still camera gives the time too and does not move.
     let sc = render_scene(
         r#"Camera "perspective" "float shutteropen" 2 "float shutterclose" 4
 Film "image" "integer xresolution" 8 "integer yresolution" 8
@@ -562,7 +562,7 @@ WorldEnd
     );
     assert!(!sc.camera.is_moving());
     let (r, _) = sc.camera.generate_ray(&cs(0.25));
-    assert_eq!(r.time, 2.5);
+    assert_eq!(sc.camera.time(&cs(0.25)), 2.5);
     assert_eq!(r.o, Vec3::ZERO);
 }
 
@@ -720,13 +720,16 @@ fn singular_and_mirrored_animated_transforms_warn_and_never_panic() {
     assert!(w.iter().any(|w| w.contains("mirror")), "{w:?}");
     let sc = render_scene(&text);
     assert_eq!(sc.geometry.moving_count(), 1);
-    let ray = |t: f32| Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::Z).with_time(t);
-    assert!(sc.geometry.intersect(&ray(0.0)).is_some());
-    assert!(sc.geometry.intersect(&ray(1.0)).is_some());
-    assert!(!sc.geometry.occluded(&Ray {
-        t_max: 100.0,
-        ..ray(0.5)
-    }));
+    let ray = Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::Z);
+    assert!(sc.geometry.intersect_at(&ray, 0.0).is_some());
+    assert!(sc.geometry.intersect_at(&ray, 1.0).is_some());
+    assert!(!sc.geometry.occluded_at(
+        &Ray {
+            t_max: 100.0,
+            ..ray
+        },
+        0.5
+    ));
     assert!(image(&text).iter().all(|v| v.is_finite()));
     // A projective keyframe: warned.
     let text = scene("ConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0.5  0 0 0 1]");
@@ -757,5 +760,5 @@ WorldEnd
     );
     let sc = render_scene(text);
     assert_eq!(sc.geometry.moving_count(), 0);
-    assert!(sc.geometry.intersect(&down(0.0, 0.0, 1.0)).is_some());
+    assert!(sc.geometry.intersect_at(&down(0.0, 0.0), 1.0).is_some());
 }

@@ -75,8 +75,6 @@ pub struct Hit {
     /// The instance hit: an index into the instances, or into the moving
     /// instances with `MOVING_BIT` set, or `NO_INSTANCE`.
     instance: u32,
-    /// The ray's time (the shading of a moving instance's hit needs it).
-    time: f32,
     local: HitLocal,
 }
 
@@ -97,7 +95,7 @@ pub struct SurfaceHit {
     /// The area light of this primitive, if it emits.
     pub light: Option<u32>,
     /// The time of the ray that found it (pbrt-v3's `Interaction::time`):
-    /// the rays spawned here take it.
+    /// the rays spawned here are traced at it.
     pub time: f32,
 }
 
@@ -220,7 +218,6 @@ impl Placement {
             o,
             d,
             t_max: ray.t_max,
-            time: ray.time,
         }
     }
 
@@ -457,7 +454,6 @@ impl Shapes<'_> {
                     t,
                     prim,
                     instance: NO_INSTANCE,
-                    time: ray.time,
                     local: HitLocal::Quadric(p),
                 })
             } else if prim.mesh == MOVING_TAG {
@@ -474,7 +470,6 @@ impl Shapes<'_> {
                 t,
                 prim: self.level.prims[pos as usize],
                 instance: NO_INSTANCE,
-                time: ray.time,
                 local: HitLocal::Bary(b),
             }),
             Closest::Other => other,
@@ -522,7 +517,6 @@ impl Shapes<'_> {
             t,
             prim,
             instance: NO_INSTANCE,
-            time: ray.time,
             local: HitLocal::Bary(b),
         })
     }
@@ -678,8 +672,18 @@ impl Geometry {
     /// traversal is inlined here, so that nothing is passed through memory
     /// on the way in: a struct written just before a call and read back
     /// with wider loads stalls store forwarding.)
-    #[inline(never)]
+    ///
+    /// At time 0: for a still scene (or a test); a path takes
+    /// [`Geometry::intersect_at`] with its time.
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_at(ray, 0.0)
+    }
+
+    /// Closest hit along the ray at scene time `time` (read only by moving
+    /// instances: a still scene never looks at it).
+    #[inline(never)]
+    pub fn intersect_at(&self, ray: &Ray, time: f32) -> Option<Hit> {
         self.shapes().intersect(
             ray,
             |i, t_max| {
@@ -691,16 +695,16 @@ impl Geometry {
                     .intersect(&r, |_, _| None, |_, _| None)
                     .map(|h| Hit { instance: i, ..h })
             },
-            |i, t_max| self.moving_intersect(ray, i, t_max),
+            |i, t_max| self.moving_intersect(ray, time, i, t_max),
         )
     }
 
     /// A moving instance's closest hit (the transform interpolated at the
     /// ray's time, as pbrt-v3's `TransformedPrimitive::Intersect`).
     #[inline(never)]
-    fn moving_intersect(&self, ray: &Ray, i: u32, t_max: f32) -> Option<Hit> {
+    fn moving_intersect(&self, ray: &Ray, time: f32, i: u32, t_max: f32) -> Option<Hit> {
         let inst = &self.moving[i as usize];
-        let mut r = inst.at(ray.time)?.object_ray(ray);
+        let mut r = inst.at(time)?.object_ray(ray);
         r.t_max = t_max;
         inst.object
             .shapes()
@@ -712,9 +716,9 @@ impl Geometry {
     }
 
     #[inline(never)]
-    fn moving_occluded(&self, ray: &Ray, i: u32) -> bool {
+    fn moving_occluded(&self, ray: &Ray, time: f32, i: u32) -> bool {
         let inst = &self.moving[i as usize];
-        let Some(place) = inst.at(ray.time) else {
+        let Some(place) = inst.at(time) else {
             return false;
         };
         inst.object
@@ -722,9 +726,16 @@ impl Geometry {
             .occluded(&place.object_ray(ray), |_| false, |_| false)
     }
 
-    /// True if anything blocks the ray before `t_max`.
-    #[inline(never)]
+    /// True if anything blocks the ray before `t_max`, at time 0 (see
+    /// [`Geometry::intersect`]).
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_at(ray, 0.0)
+    }
+
+    /// True if anything blocks the ray before `t_max` at scene time `time`.
+    #[inline(never)]
+    pub fn occluded_at(&self, ray: &Ray, time: f32) -> bool {
         self.shapes().occluded(
             ray,
             |i| {
@@ -733,20 +744,20 @@ impl Geometry {
                     .shapes()
                     .occluded(&inst.place.object_ray(ray), |_| false, |_| false)
             },
-            |i| self.moving_occluded(ray, i),
+            |i| self.moving_occluded(ray, time, i),
         )
     }
 
     /// The object and placement of an instance hit (a moving instance's at
-    /// the hit's time; `None` only if that transform has become singular,
-    /// which the hit itself rules out).
-    fn placed(&self, hit: &Hit) -> Option<(&Object, Placement)> {
+    /// the time of the ray that found it; `None` only if that transform has
+    /// become singular, which the hit itself rules out).
+    fn placed(&self, hit: &Hit, time: f32) -> Option<(&Object, Placement)> {
         if hit.instance & MOVING_BIT == 0 {
             let inst = &self.instances[hit.instance as usize];
             return Some((&inst.object, inst.place));
         }
         let inst = &self.moving[(hit.instance & !MOVING_BIT) as usize];
-        Some((&inst.object, inst.at(hit.time)?))
+        Some((&inst.object, inst.at(time)?))
     }
 
     /// The differential geometry of a hit (uv, dp/du, …), for materials
@@ -756,7 +767,7 @@ impl Geometry {
         if hit.instance == NO_INSTANCE {
             return self.shapes().diff_geom(hit.prim, hit.local, s.point.ns);
         }
-        let Some((object, place)) = self.placed(hit) else {
+        let Some((object, place)) = self.placed(hit, s.time) else {
             return DiffGeom::ZERO;
         };
         let shapes = object.shapes();
@@ -764,18 +775,21 @@ impl Geometry {
         place.geom_to_world(shapes.diff_geom(hit.prim, hit.local, local.point.ns))
     }
 
-    /// Shading data of a hit.
+    /// Shading data of a hit found at time 0 (see [`Geometry::intersect`]).
     #[inline]
     pub fn surface(&self, hit: &Hit) -> SurfaceHit {
+        self.surface_at(hit, 0.0)
+    }
+
+    /// Shading data of a hit found by a ray at scene time `time`.
+    #[inline]
+    pub fn surface_at(&self, hit: &Hit, time: f32) -> SurfaceHit {
         if hit.instance == NO_INSTANCE {
             let s = self.shapes().surface(hit.prim, hit.local).0;
-            return SurfaceHit {
-                time: hit.time,
-                ..s
-            };
+            return SurfaceHit { time, ..s };
         }
         let (object, place) = self
-            .placed(hit)
+            .placed(hit, time)
             .expect("a moving instance's hit has an invertible transform at its time");
         let (s, vertex_normals) = object.shapes().surface(hit.prim, hit.local);
         SurfaceHit {
@@ -783,7 +797,7 @@ impl Geometry {
             material: s.material,
             // Area lights inside objects are ignored (as pbrt-v3).
             light: None,
-            time: hit.time,
+            time,
         }
     }
 }

@@ -1,8 +1,9 @@
 //! Cameras: pbrt-v3's four, one file each, behind a closed enum that only
 //! delegates (one `match` per camera ray, no dynamic dispatch).
 //!
-//! [`Camera`] is the projection with the shutter: it stamps each ray with
-//! its time (pbrt-v3's `Lerp(sample.time, shutterOpen, shutterClose)`), and
+//! [`Camera`] is the projection with the shutter: [`Camera::time`] is a
+//! sample's ray time (pbrt-v3's `Lerp(sample.time, shutterOpen,
+//! shutterClose)`, which the integrators keep for the whole path), and
 //! a camera with an animated camera-to-world (pbrt-v3's `CameraToWorld(ray)`
 //! with an `AnimatedTransform`) builds its projection in camera space and
 //! moves each ray and its differentials by the transform at the ray's time.
@@ -128,20 +129,19 @@ impl Camera {
 
     /// pbrt-v3's ray time: the sample's time in [0, 1) mapped to the shutter.
     #[inline(always)]
-    fn time(&self, cs: &CameraSample) -> f32 {
+    pub fn time(&self, cs: &CameraSample) -> f32 {
         let (a, b) = (self.shutter_open, self.shutter_close);
         (1.0 - cs.time) * a + cs.time * b
     }
 
     /// The camera ray for a film position (raster coordinates), lens sample
-    /// and time sample, and its weight.
+    /// and time sample (at [`Camera::time`]), and its weight.
     #[inline]
     pub fn generate_ray(&self, cs: &CameraSample) -> (Ray, f32) {
-        let time = self.time(cs);
         let (ray, w) = self.projection.generate_ray(cs);
         match &self.motion {
-            None => (ray.with_time(time), w),
-            Some(m) => (move_ray(&at(m, time), &ray).with_time(time), w),
+            None => (ray, w),
+            Some(m) => (move_ray(&at(m, self.time(cs)), &ray), w),
         }
     }
 
@@ -149,12 +149,11 @@ impl Camera {
     /// one-pixel step in x and y scaled by `scale`.
     #[inline]
     pub fn generate_ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
-        let time = self.time(cs);
         let (ray, d, w) = self.projection.generate_ray_differential(cs, scale);
         match &self.motion {
-            None => (ray.with_time(time), d, w),
+            None => (ray, d, w),
             Some(m) => {
-                let to_world = at(m, time);
+                let to_world = at(m, self.time(cs));
                 let o = |p: Vec3| to_world.transform_point3(p);
                 let v = |v: Vec3| to_world.transform_vector3(v);
                 let diff = RayDiff {
@@ -163,7 +162,7 @@ impl Camera {
                     ry_o: o(d.ry_o),
                     ry_d: v(d.ry_d).normalize(),
                 };
-                (move_ray(&to_world, &ray).with_time(time), diff, w)
+                (move_ray(&to_world, &ray), diff, w)
             }
         }
     }
@@ -181,7 +180,6 @@ fn at(m: &AnimatedTransform, time: f32) -> Affine3A {
 #[inline]
 fn move_ray(to_world: &Affine3A, r: &Ray) -> Ray {
     Ray {
-        time: r.time,
         t_max: r.t_max,
         ..world_ray(to_world, r.o, r.d)
     }

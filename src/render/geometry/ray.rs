@@ -4,34 +4,27 @@ use glam::Vec3;
 /// on top of the far end's own error offset.
 pub const SHADOW_EPSILON: f32 = 0.0001;
 
-/// A ray `o + t d`, `0 < t < t_max`, at scene time `time` (pbrt-v3's
-/// `Ray::time`: the camera draws it within the shutter interval and every
-/// ray that continues a path inherits it; only animated transforms read it).
-/// `d` need not be unit length.
+/// A ray `o + t d`, `0 < t < t_max`. `d` need not be unit length.
+///
+/// pbrt-v3's `Ray::time` is not a field: every ray of a path has the camera
+/// ray's time, so the integrators keep it once per path and pass it to the
+/// `*_at` queries of [`Geometry`](crate::render::accel::Geometry), and a
+/// still scene's rays stay 28 bytes.
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
     pub o: Vec3,
     pub d: Vec3,
     pub t_max: f32,
-    pub time: f32,
 }
 
 impl Ray {
-    /// A ray at time 0 (set the time with [`Ray::with_time`]).
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Ray {
         Ray {
             o,
             d,
             t_max: f32::INFINITY,
-            time: 0.0,
         }
-    }
-    /// The same ray at `time` (a spawned ray takes the time of the ray whose
-    /// path it continues, as pbrt-v3's `SpawnRay` takes the interaction's).
-    #[inline(always)]
-    pub fn with_time(self, time: f32) -> Ray {
-        Ray { time, ..self }
     }
     #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
@@ -141,7 +134,6 @@ pub fn spawn_ray_from_to(pf: Vec3, p1: Vec3, e1: Vec3, n1: Vec3) -> Ray {
         o: pf,
         d: pt - pf,
         t_max: 1.0 - SHADOW_EPSILON,
-        time: 0.0,
     }
 }
 
@@ -153,7 +145,6 @@ pub fn spawn_ray_to_point(p0: Vec3, e0: Vec3, n0: Vec3, p1: Vec3) -> Ray {
         o: pf,
         d: p1 - pf,
         t_max: 1.0 - SHADOW_EPSILON,
-        time: 0.0,
     }
 }
 

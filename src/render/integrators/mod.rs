@@ -177,12 +177,15 @@ impl Integrator {
         }
     }
 
-    /// Radiance arriving at the camera along `ray`, with its differentials
-    /// if it has them.
+    /// Radiance arriving at the camera along `ray` at scene time `time`
+    /// (every ray of the path is traced at it), with its differentials if it
+    /// has them.
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn li(
         &self,
         ray: Ray,
+        time: f32,
         diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
@@ -195,6 +198,7 @@ impl Integrator {
                 lights,
             } => path_li(
                 ray,
+                time,
                 diff,
                 scene,
                 sampler,
@@ -204,7 +208,7 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.specular_tree_li(ray, diff, scene, sampler, scratch)
+                self.specular_tree_li(ray, time, diff, scene, sampler, scratch)
             }
         }
     }
@@ -219,6 +223,7 @@ impl Integrator {
     fn specular_tree_li(
         &self,
         ray: Ray,
+        time: f32,
         diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
@@ -237,16 +242,15 @@ impl Integrator {
         let mut bsdf = Bsdf::empty();
         while let Some(w) = stack.pop() {
             scratch.counts.closest += 1;
-            let Some(hit) = scene.geometry.intersect(&w.ray) else {
+            let Some(hit) = scene.geometry.intersect_at(&w.ray, time) else {
                 l += w.beta * escaped(scene, w.ray.d);
                 continue;
             };
-            let mut s = scene.geometry.surface(&hit);
+            let mut s = scene.geometry.surface_at(&hit, time);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 if w.pass < MAX_PASS_THROUGH {
-                    let ray =
-                        spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d).with_time(s.time);
+                    let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
                     // A spawned ray has no differentials (pbrt-v3's SpawnRay).
                     stack.push(Work {
                         ray,
@@ -327,7 +331,7 @@ impl Integrator {
                         let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
                         if f != Vec3::ZERO {
                             scratch.counts.shadow += 1;
-                            if !scene.geometry.occluded(&ls.shadow.with_time(s.time)) {
+                            if !scene.geometry.occluded_at(&ls.shadow, s.time) {
                                 local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
                             }
                         }
@@ -355,8 +359,7 @@ impl Integrator {
                     if let Some(bs) = bsdf.sample(wo, u, filter) {
                         let cos = bs.wi.dot(s.point.ns).abs();
                         if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
-                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi)
-                                .with_time(s.time);
+                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                             let beta = w.beta * bs.f * cos / bs.pdf;
                             let diff = match (&w.diff, &geom) {
                                 (Some(d), Some(g)) if i == 0 => {
@@ -486,6 +489,7 @@ fn escaped(scene: &RenderScene, d: Vec3) -> Vec3 {
 #[allow(clippy::too_many_arguments)]
 fn path_li(
     mut ray: Ray,
+    time: f32,
     diff: Option<RayDiff>,
     scene: &RenderScene,
     sampler: &mut Sampler,
@@ -510,7 +514,7 @@ fn path_li(
     let mut bsdf_pdf = 0.0f32;
     loop {
         scratch.counts.closest += 1;
-        let hit = scene.geometry.intersect(&ray);
+        let hit = scene.geometry.intersect_at(&ray, time);
         let Some(hit) = hit else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
@@ -525,7 +529,7 @@ fn path_li(
             }
             break;
         };
-        let mut s = scene.geometry.surface(&hit);
+        let mut s = scene.geometry.surface_at(&hit, time);
         let wo = -ray.d;
         if let Some(light_index) = s.light {
             let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
@@ -549,7 +553,7 @@ fn path_li(
             if pass > MAX_PASS_THROUGH {
                 break;
             }
-            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d).with_time(s.time);
+            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
             diff = None;
             continue;
         }
@@ -585,7 +589,7 @@ fn path_li(
                 1.0 / eta2
             };
         }
-        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi).with_time(s.time);
+        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
         // Russian roulette after bounce 3 on max(β·etaScale).
         let rr = (beta * eta_scale).max_element();
         if rr < rr_threshold && bounces > 3 {
@@ -689,7 +693,7 @@ fn light_strategy(
         return Vec3::ZERO;
     }
     scratch.counts.shadow += 1;
-    if scene.geometry.occluded(&ls.shadow.with_time(s.time)) {
+    if scene.geometry.occluded_at(&ls.shadow, s.time) {
         return Vec3::ZERO;
     }
     let light_pdf = pmf * ls.pdf;
@@ -790,16 +794,16 @@ fn estimate_direct(
         if let Some(bs) = bsdf.sample(wo, u_scatter, BxdfFlags::NON_SPECULAR) {
             let f = bs.f * bs.wi.dot(ns).abs();
             if f != Vec3::ZERO && bs.pdf > 0.0 {
-                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi).with_time(s.time);
+                let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                 let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
                     return ld;
                 }
                 let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
                 scratch.counts.closest += 1;
-                let li = match geom.intersect(&ray) {
+                let li = match geom.intersect_at(&ray, s.time) {
                     Some(h) => {
-                        let hs = geom.surface(&h);
+                        let hs = geom.surface_at(&h, s.time);
                         if hs.light == Some(light_index) {
                             light.emitted(hs.point.n, -bs.wi)
                         } else {
