@@ -35,7 +35,6 @@ fn trace(sc: &RenderScene, o: Vec3, d: Vec3) -> Option<Found> {
         o,
         d,
         t_max: f32::INFINITY,
-        time: 0.0,
     };
     let hit = sc.geometry.intersect(&ray)?;
     let s = sc.geometry.surface(&hit);

@@ -147,7 +147,6 @@ fn down_ray(x: f32, y: f32) -> Ray {
         o: Vec3::new(x, y, -1.0),
         d: Vec3::Z,
         t_max: 10.0,
-        time: 0.0,
     }
 }
 
