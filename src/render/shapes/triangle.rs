@@ -338,6 +338,9 @@ impl TriangleRay {
         if det == 0.0 || !det.is_finite() {
             return None;
         }
+        // The largest |z| before z is scaled to ray-parameter units: the
+        // shear's x and y errors are in length units (see `delta_x`).
+        let max_z = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
         p0t.z *= sz;
         p1t.z *= sz;
         p2t.z *= sz;
@@ -355,8 +358,14 @@ impl TriangleRay {
         let delta_z = gamma(3) * max_zt;
         let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
         let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
-        let delta_x = gamma(5) * (max_xt + max_zt);
-        let delta_y = gamma(5) * (max_yt + max_zt);
+        // pbrt-v3's bound on the sheared x and y, γ₅(max|x| + max|z|) (its
+        // book, 3.9.6), with z in length units as the shear used it. (pbrt-v3's
+        // code takes the z scaled by 1/d_z, which agrees within √3 for unit
+        // directions but is not scale-invariant: an instance's object-space
+        // ray at scale 1e5 has |d| ~ 1e-5, and the scaled z then rejected
+        // most real hits as indistinguishable from t = 0.)
+        let delta_x = gamma(5) * (max_xt + max_z);
+        let delta_y = gamma(5) * (max_yt + max_z);
         let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
         let max_e = e0.abs().max(e1.abs()).max(e2.abs());
         let delta_t =
@@ -529,6 +538,8 @@ impl TriangleRay4 {
         let det = e0 + e1 + e2;
         let finite = det.abs().cmplt(Vec4::INFINITY);
         let mut ok = inside & det.cmpne(zero) & finite;
+        // Unscaled |z| for the x and y error bounds (see the scalar test).
+        let max_z = p0z.abs().max(p1z.abs()).max(p2z.abs());
         p0z *= sz;
         p1z *= sz;
         p2z *= sz;
@@ -544,8 +555,8 @@ impl TriangleRay4 {
         let max_xt = p0x.abs().max(p1x.abs()).max(p2x.abs());
         let max_yt = p0y.abs().max(p1y.abs()).max(p2y.abs());
         let g5 = Vec4::splat(gamma(5));
-        let delta_x = g5 * (max_xt + max_zt);
-        let delta_y = g5 * (max_yt + max_zt);
+        let delta_x = g5 * (max_xt + max_z);
+        let delta_y = g5 * (max_yt + max_z);
         let delta_e = Vec4::splat(2.0)
             * (Vec4::splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
         let max_e = e0.abs().max(e1.abs()).max(e2.abs());
