@@ -30,7 +30,7 @@ impl Lcg {
 }
 
 /// Camera, film and lights shared by both scenes: a floor under a square
-/// area light, seen from the front and above.
+/// area light (facing down), seen from the front and above.
 fn header(res: u32, spp: u32) -> String {
     format!(
         r#"LookAt 0 0.9 2.4  0 0.25 0  0 1 0
@@ -41,7 +41,7 @@ Integrator "path" "integer maxdepth" [5]
 WorldBegin
 AttributeBegin
   AreaLightSource "diffuse" "rgb L" [8 8 8]
-  Shape "trianglemesh" "integer indices" [0 2 1 0 3 2]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     "point P" [-0.5 2 -0.5  0.5 2 -0.5  0.5 2 0.5  -0.5 2 0.5]
 AttributeEnd
 Material "matte" "rgb Kd" [0.6 0.6 0.6]

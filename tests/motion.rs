@@ -98,6 +98,41 @@ fn lcg(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
+/// `inverse_at` (built from the interpolated parts, with the fixed part of
+/// a translation or a turn precomputed) inverts `interpolate` at every time,
+/// for each kind of motion: translation, turn and translation, scale change.
+#[test]
+fn inverse_at_inverts_the_interpolated_transform() {
+    let a = DMat4::from_scale_rotation_translation(
+        DVec3::new(1.0, 2.0, 0.5),
+        DQuat::from_rotation_x(0.3),
+        DVec3::new(1.0, 1.0, 1.0),
+    );
+    let cases = [
+        (a, DMat4::from_translation(DVec3::new(0.0, 3.0, -1.0)) * a),
+        (a, a * DMat4::from_rotation_y(2.0)),
+        (
+            a,
+            DMat4::from_scale_rotation_translation(
+                DVec3::new(0.2, 1.0, 3.0),
+                DQuat::from_axis_angle(DVec3::new(1.0, 1.0, 0.0).normalize(), 3.0),
+                DVec3::new(-2.0, 4.0, 0.0),
+            ),
+        ),
+        (a, a * DMat4::from_rotation_z(0.01)),
+    ];
+    for (k, (a, b)) in cases.into_iter().enumerate() {
+        let at = AnimatedTransform::new(a, 0.5, b, 2.0).unwrap();
+        for time in [-1.0, 0.5, 0.6, 1.0, 1.25, 1.9, 2.0, 3.0] {
+            let p = at.inverse_at(time) * at.interpolate(time);
+            assert!(
+                close(p, DMat4::IDENTITY, 1e-12),
+                "case {k} at {time}: {p:?}"
+            );
+        }
+    }
+}
+
 #[test]
 fn motion_bounds_contain_the_box_at_every_time() {
     let mut rng = 7u64;

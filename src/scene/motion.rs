@@ -26,6 +26,31 @@ pub struct AnimatedTransform {
     /// The two rotations differ enough to need slerp (pbrt-v3's
     /// `hasRotation`: quaternion dot below 0.9995).
     has_rotation: bool,
+    /// The per-transform part of [`slerp`] (the angle between the two
+    /// rotations and the unit quaternion orthogonal to the first in their
+    /// plane), so that a query at a time costs one sine and cosine.
+    slerp_linear: bool,
+    slerp_theta: f64,
+    slerp_perp: DQuat,
+    /// The inverses of the keyframes (world to object before the start and
+    /// after the end).
+    start_inv: DMat4,
+    end_inv: DMat4,
+    /// The part of the inverse that does not move (most animations only
+    /// translate, or turn and translate), so that a ray's query at a time
+    /// inverts only what changes.
+    fixed_inv: FixedInverse,
+}
+
+/// What of the inverse transform stays the same over the interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FixedInverse {
+    /// Only T moves: `S⁻¹ R⁻¹` is fixed.
+    Linear(DMat3),
+    /// R and T move: `S⁻¹` is fixed.
+    Scale(DMat3),
+    /// Everything may change.
+    None,
 }
 
 /// `M = T * R * S` of one keyframe.
@@ -53,7 +78,8 @@ impl AnimatedTransform {
         if k0.r.dot(k1.r) < 0.0 {
             k1.r = -k1.r;
         }
-        let has_rotation = k0.r.dot(k1.r) < SLERP_LINEAR_DOT;
+        let cos = k0.r.dot(k1.r);
+        let has_rotation = cos < SLERP_LINEAR_DOT;
         Some(AnimatedTransform {
             start,
             end,
@@ -61,6 +87,18 @@ impl AnimatedTransform {
             end_time,
             keys: [k0, k1],
             has_rotation,
+            slerp_linear: cos > SLERP_LINEAR_DOT,
+            slerp_theta: cos.clamp(-1.0, 1.0).acos(),
+            slerp_perp: (k1.r - k0.r * cos).normalize(),
+            start_inv: start.inverse(),
+            end_inv: end.inverse(),
+            fixed_inv: if k0.s != k1.s {
+                FixedInverse::None
+            } else if k0.r == k1.r {
+                FixedInverse::Linear(DMat3::from_mat4(start.inverse()))
+            } else {
+                FixedInverse::Scale(k0.s.inverse())
+            },
         })
     }
 
@@ -81,16 +119,65 @@ impl AnimatedTransform {
         self.at_fraction(u)
     }
 
-    /// The interpolated transform at fraction `u` in [0, 1] of the interval.
-    fn at_fraction(&self, u: f64) -> DMat4 {
+    /// The inverse of [`AnimatedTransform::interpolate`] at `time` (world to
+    /// object for a ray at that time), from the interpolated parts:
+    /// `S⁻¹ R⁻¹ T⁻¹`, cheaper than inverting the 4×4 (the keyframes' own
+    /// inverses before the start and after the end).
+    pub fn inverse_at(&self, time: f64) -> DMat4 {
+        if time <= self.start_time || time.is_nan() {
+            return self.start_inv;
+        }
+        if time >= self.end_time {
+            return self.end_inv;
+        }
+        let u = (time - self.start_time) / (self.end_time - self.start_time);
+        let m = match self.fixed_inv {
+            FixedInverse::Linear(m) => m,
+            FixedInverse::Scale(s_inv) => s_inv * DMat3::from_quat(self.rotation(u).conjugate()),
+            FixedInverse::None => {
+                let (_, r, s) = self.parts(u);
+                s.inverse() * DMat3::from_quat(r.conjugate())
+            }
+        };
+        let t = self.keys[0].t.lerp(self.keys[1].t, u);
+        DMat4::from_cols(
+            m.x_axis.extend(0.0),
+            m.y_axis.extend(0.0),
+            m.z_axis.extend(0.0),
+            (-(m * t)).extend(1.0),
+        )
+    }
+
+    /// R at fraction `u`: `slerp(u, R₀, R₁)` with its per-transform part
+    /// precomputed (the same operations, so the same values).
+    #[inline]
+    fn rotation(&self, u: f64) -> DQuat {
+        let [a, b] = &self.keys;
+        if self.slerp_linear {
+            (a.r * (1.0 - u) + b.r * u).normalize()
+        } else {
+            let theta = self.slerp_theta * u;
+            a.r * theta.cos() + self.slerp_perp * theta.sin()
+        }
+    }
+
+    /// T, R and S at fraction `u` in [0, 1] of the interval.
+    #[inline]
+    fn parts(&self, u: f64) -> (DVec3, DQuat, DMat3) {
         let [a, b] = &self.keys;
         let t = a.t.lerp(b.t, u);
-        let r = slerp(u, a.r, b.r);
+        let r = self.rotation(u);
         let s = DMat3::from_cols(
             a.s.x_axis.lerp(b.s.x_axis, u),
             a.s.y_axis.lerp(b.s.y_axis, u),
             a.s.z_axis.lerp(b.s.z_axis, u),
         );
+        (t, r, s)
+    }
+
+    /// The interpolated transform at fraction `u` in [0, 1] of the interval.
+    fn at_fraction(&self, u: f64) -> DMat4 {
+        let (t, r, s) = self.parts(u);
         let m = DMat3::from_quat(r) * s;
         DMat4::from_cols(
             m.x_axis.extend(0.0),

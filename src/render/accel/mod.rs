@@ -206,19 +206,7 @@ impl Placement {
     /// The world ray in object space (same `t` parameterisation).
     #[inline]
     fn object_ray(&self, ray: &Ray) -> Ray {
-        let o = self
-            .world_to_object
-            .transform_point3(ray.o.as_dvec3())
-            .as_vec3();
-        let d = self
-            .world_to_object
-            .transform_vector3(ray.d.as_dvec3())
-            .as_vec3();
-        Ray {
-            o,
-            d,
-            t_max: ray.t_max,
-        }
+        object_ray(&self.world_to_object, ray)
     }
 
     /// An object-space surface point in world space: the position mapped in
@@ -268,6 +256,20 @@ impl Placement {
             shading_dndv: n * g.shading_dndv,
             ..DiffGeom::ZERO
         }
+    }
+}
+
+/// A world ray mapped by `world_to_object` (same `t` parameterisation).
+#[inline]
+fn object_ray(world_to_object: &DMat4, ray: &Ray) -> Ray {
+    let o = world_to_object.transform_point3(ray.o.as_dvec3()).as_vec3();
+    let d = world_to_object
+        .transform_vector3(ray.d.as_dvec3())
+        .as_vec3();
+    Ray {
+        o,
+        d,
+        t_max: ray.t_max,
     }
 }
 
@@ -332,10 +334,19 @@ impl MovingInstance {
         &self.object
     }
 
-    /// The placement at `time`.
+    /// The placement at `time` (for shading a hit).
     #[inline]
     fn at(&self, time: f32) -> Option<Placement> {
         Placement::new(self.motion.interpolate(time as f64))
+    }
+
+    /// A world ray at `time` in object space (for intersection: only the
+    /// inverse transform, from the interpolated parts), `None` if the
+    /// transform is singular then.
+    #[inline]
+    fn object_ray_at(&self, ray: &Ray, time: f32) -> Option<Ray> {
+        let m = self.motion.inverse_at(time as f64);
+        m.is_finite().then(|| object_ray(&m, ray))
     }
 
     /// A box holding the object's bounds over the whole motion (pbrt-v3's
@@ -704,7 +715,7 @@ impl Geometry {
     #[inline(never)]
     fn moving_intersect(&self, ray: &Ray, time: f32, i: u32, t_max: f32) -> Option<Hit> {
         let inst = &self.moving[i as usize];
-        let mut r = inst.at(time)?.object_ray(ray);
+        let mut r = inst.object_ray_at(ray, time)?;
         r.t_max = t_max;
         inst.object
             .shapes()
@@ -718,12 +729,10 @@ impl Geometry {
     #[inline(never)]
     fn moving_occluded(&self, ray: &Ray, time: f32, i: u32) -> bool {
         let inst = &self.moving[i as usize];
-        let Some(place) = inst.at(time) else {
+        let Some(r) = inst.object_ray_at(ray, time) else {
             return false;
         };
-        inst.object
-            .shapes()
-            .occluded(&place.object_ray(ray), |_| false, |_| false)
+        inst.object.shapes().occluded(&r, |_| false, |_| false)
     }
 
     /// True if anything blocks the ray before `t_max`, at time 0 (see
