@@ -56,7 +56,7 @@ fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
 
 #[test]
 fn cone_hits_where_the_cone_says() {
-    let c = Quadric::Cone(cone());
+    let c = Quadric::from(cone());
     // Along −x at z = 1 (radius 0.25 there), y = 0.
     let (t, p) = c
         .intersect(OFF + Vec3::new(5.0, 0.0, 1.0), -Vec3::X, f32::INFINITY)
@@ -104,7 +104,7 @@ fn cone_hits_where_the_cone_says() {
 
 #[test]
 fn paraboloid_hits_where_the_paraboloid_says() {
-    let q = Quadric::Paraboloid(paraboloid());
+    let q = Quadric::from(paraboloid());
     // Along −x at z = 1.28: radius 0.8.
     let (t, p) = q
         .intersect(OFF + Vec3::new(5.0, 0.0, 1.28), -Vec3::X, f32::INFINITY)
@@ -156,7 +156,7 @@ fn hyperboloid_fits_the_line_and_hits_where_it_says() {
     // The line meets the axis (pbrt-v3's defaults, a cone) or is horizontal.
     assert!(hyperboloid_coefficients(DVec3::ZERO, DVec3::ONE).is_none());
     assert!(hyperboloid_coefficients(DVec3::X, DVec3::Y).is_none());
-    let h = Quadric::Hyperboloid(hyperboloid());
+    let h = Quadric::from(hyperboloid());
     // The waist: along −x at z = 0, y = 0 hits x = 1 (φ from the line's
     // point (1, 0, 0) is 0, v = 1/2).
     let (t, p) = h
@@ -211,7 +211,7 @@ fn cases() -> Vec<Case> {
     vec![
         (
             "cone",
-            Quadric::Cone(Cone::new(0.5, 2.0, 360.0, m, false, 0)),
+            Quadric::from(Cone::new(0.5, 2.0, 360.0, m, false, 0)),
             0.0,
             2.0,
             TAU,
@@ -220,7 +220,7 @@ fn cases() -> Vec<Case> {
         ),
         (
             "partial paraboloid",
-            Quadric::Paraboloid(Paraboloid::new(1.0, 0.5, 2.0, 200.0, m, false, 0)),
+            Quadric::from(Paraboloid::new(1.0, 0.5, 2.0, 200.0, m, false, 0)),
             0.5,
             2.0,
             200f64.to_radians(),
@@ -229,7 +229,7 @@ fn cases() -> Vec<Case> {
         ),
         (
             "hyperboloid",
-            Quadric::Hyperboloid(Hyperboloid::new(
+            Quadric::from(Hyperboloid::new(
                 Vec3::new(1.0, -1.0, -1.0),
                 Vec3::new(1.0, 1.0, 1.0),
                 360.0,
@@ -341,9 +341,9 @@ fn rays_leaving_the_surfaces_do_not_rehit_them_at_any_scale() {
             * DMat4::from_rotation_x(-1.1)
             * DMat4::from_scale(DVec3::splat(scale));
         let shapes = [
-            Quadric::Cone(Cone::new(0.5, 2.0, 360.0, m, false, 0)),
-            Quadric::Paraboloid(Paraboloid::new(1.0, 0.0, 2.0, 360.0, m, false, 0)),
-            Quadric::Hyperboloid(Hyperboloid::new(
+            Quadric::from(Cone::new(0.5, 2.0, 360.0, m, false, 0)),
+            Quadric::from(Paraboloid::new(1.0, 0.0, 2.0, 360.0, m, false, 0)),
+            Quadric::from(Hyperboloid::new(
                 Vec3::new(1.0, -1.0, -1.0),
                 Vec3::new(1.0, 1.0, 1.0),
                 360.0,
@@ -397,9 +397,9 @@ fn rays_leaving_the_surfaces_do_not_rehit_them_at_any_scale() {
 fn grazing_rays_give_finite_hits() {
     let mut rng = Pcg32::with_sequence(3);
     let shapes = [
-        Quadric::Cone(cone()),
-        Quadric::Paraboloid(paraboloid()),
-        Quadric::Hyperboloid(hyperboloid()),
+        Quadric::from(cone()),
+        Quadric::from(paraboloid()),
+        Quadric::from(hyperboloid()),
     ];
     for q in &shapes {
         for _ in 0..20_000 {

@@ -335,7 +335,7 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
             z_min,
             z_max,
             phi_max,
-        } => Quadric::Sphere(Sphere::new(
+        } => Quadric::from(Sphere::new(
             radius, z_min, z_max, phi_max, to_world, reverse, material,
         )),
         scene::Geometry::Cylinder {
@@ -343,14 +343,14 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
             z_min,
             z_max,
             phi_max,
-        } => Quadric::Cylinder(Cylinder::new(
+        } => Quadric::from(Cylinder::new(
             radius, z_min, z_max, phi_max, to_world, reverse, material,
         )),
         scene::Geometry::Cone {
             radius,
             height,
             phi_max,
-        } => Quadric::Cone(Cone::new(
+        } => Quadric::from(Cone::new(
             radius, height, phi_max, to_world, reverse, material,
         )),
         scene::Geometry::Paraboloid {
@@ -358,10 +358,10 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
             z_min,
             z_max,
             phi_max,
-        } => Quadric::Paraboloid(Paraboloid::new(
+        } => Quadric::from(Paraboloid::new(
             radius, z_min, z_max, phi_max, to_world, reverse, material,
         )),
-        scene::Geometry::Hyperboloid { p1, p2, phi_max } => Quadric::Hyperboloid(Hyperboloid::new(
+        scene::Geometry::Hyperboloid { p1, p2, phi_max } => Quadric::from(Hyperboloid::new(
             p1, p2, phi_max, to_world, reverse, material,
         )),
         scene::Geometry::Disk {
@@ -369,7 +369,7 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
             radius,
             inner_radius,
             phi_max,
-        } => Quadric::Disk(Disk::new(
+        } => Quadric::from(Disk::new(
             height,
             radius,
             inner_radius,
