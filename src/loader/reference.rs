@@ -136,6 +136,15 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
         ParamKind::Filename => ("string: a file name".to_string(), None),
         ParamKind::SameTexture(d) => ("texture of the texture's type".to_string(), Some(num(d))),
         ParamKind::SameValue(d) => ("value of the texture's type".to_string(), Some(num(d))),
+        ParamKind::Spectrum(d) => (
+            "spectrum".to_string(),
+            Some(spectrum(SpectrumDefault::Rgb(d))),
+        ),
+        ParamKind::Point3([x, y, z]) => (
+            "point3".to_string(),
+            Some(format!("{} {} {}", num(x), num(y), num(z))),
+        ),
+        ParamKind::Floats => ("float[]".to_string(), None),
     };
     (
         format!("{ty}{nonneg}"),
