@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use pbrs::lang::parser::FileLoader;
 use pbrs::loader::{load_scene_str, load_scene_with, LoadFailure, LoadedScene};
 use pbrs::render::camera::realistic::LensRay;
-use pbrs::render::camera::{Camera, RealisticCamera};
+use pbrs::render::camera::{Camera, Projection, RealisticCamera};
 use pbrs::render::geometry::Ray;
 use pbrs::render::samplers::CameraSample;
 use pbrs::scene::{CameraKind, SceneDescription};
@@ -208,8 +208,8 @@ fn load_lens_scene(text: &str) -> SceneDescription {
 }
 
 fn realistic_of(s: &SceneDescription) -> RealisticCamera {
-    match camera_of(s) {
-        Camera::Realistic(c) => c,
+    match camera_of(s).projection {
+        Projection::Realistic(c) => c,
         other => panic!("not realistic: {other:?}"),
     }
 }
@@ -374,7 +374,10 @@ fn realistic_samples_are_finite_or_zero_weight() {
         FILM,
     ));
     let cams = [
-        (Camera::Realistic(dgauss().1.clone()), "dgauss"),
+        (
+            Camera::still(Projection::Realistic(dgauss().1.clone())),
+            "dgauss",
+        ),
         (camera_of(&fisheye), "fisheye"),
     ];
     for (cam, name) in &cams {

@@ -593,15 +593,17 @@ fn phase_rules() {
 }
 
 #[test]
-fn motion_is_ignored_with_a_warning() {
+fn motion_is_recorded_without_warnings() {
     let s = load("TransformTimes 0 2\nWorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\nShape \"sphere\"\nWorldEnd");
-    assert_eq!(s.scene.shapes[0].object_to_world, DMat4::IDENTITY);
+    let shape = &s.scene.shapes[0];
+    assert_eq!(shape.object_to_world, DMat4::IDENTITY);
+    let m = shape.motion.as_ref().expect("animated");
+    assert_eq!((m.start_time, m.end_time), (0.0, 2.0));
+    assert_eq!(m.end, DMat4::from_translation(glam::DVec3::X));
     let w = warnings(&s);
-    assert!(
-        w.contains("TransformTimes: motion blur is not supported"),
-        "{w}"
-    );
-    assert!(w.contains("animated shape transform"), "{w}");
+    assert!(!w.contains("TransformTimes"), "{w}");
+    // The renderer interpolates it: nothing to warn about.
+    assert!(!w.contains("animated"), "{w}");
 }
 
 #[test]
@@ -837,7 +839,9 @@ fn summary_counts_declared_material_kinds() {
         .summary
         .to_string();
     assert!(
-        plain.contains("materials:  1 (1 glass)\nwarnings:"),
+        plain.contains(
+            "materials:  1 (1 glass)\nmotion:     none (no motion structures built)\nwarnings:"
+        ),
         "{plain}"
     );
 }

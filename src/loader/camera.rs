@@ -79,6 +79,7 @@ pub fn camera(
     ctx.report_unused(p, &format!("Camera \"{}\"", name.value));
     CameraDesc {
         camera_to_world,
+        motion: None,
         kind,
         shutter_open: open,
         shutter_close: close,

@@ -1126,6 +1126,7 @@ pub fn camera(
 pub fn default_camera() -> CameraDesc {
     CameraDesc {
         camera_to_world: DMat4::IDENTITY,
+        motion: None,
         kind: CameraKind::Perspective {
             fov: 90.0,
             lens_radius: 0.0,

@@ -10,8 +10,9 @@ use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
 use crate::lang::Loc;
 use crate::render::bxdf::MAX_BXDFS;
 use crate::render::materials::Material;
+use crate::scene::motion;
 use crate::scene::*;
-use glam::{DMat4, DVec3, DVec4};
+use glam::{DMat3, DMat4, DVec3, DVec4};
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 use std::sync::Arc;
@@ -56,7 +57,7 @@ struct Frame {
 /// A shape recorded inside ObjectBegin, built when the object is first instanced.
 struct PendingShape {
     stmt: usize,
-    ctm: DMat4,
+    ctm: [DMat4; 2],
     graphics: Graphics,
     /// Resolved at the `Shape` statement, as pbrt-v3 does.
     media: MediumInterfaceDesc,
@@ -85,8 +86,11 @@ pub struct Builder<'s, 'c> {
     named_coords: HashMap<String, [DMat4; 2]>,
     graphics: Graphics,
     stack: Vec<Frame>,
-    // Options: the statement and the CTM it saw.
-    camera: Option<(usize, DMat4)>,
+    // Options: the statement and the CTMs (start, end) it saw.
+    camera: Option<(usize, [DMat4; 2])>,
+    /// `TransformTimes` (pbrt-v3's default 0, 1): the times of the start and
+    /// end CTMs.
+    transform_times: (f64, f64),
     pub(super) film: Option<usize>,
     filter: Option<usize>,
     sampler: Option<usize>,
@@ -154,6 +158,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             },
             stack: Vec::new(),
             camera: None,
+            transform_times: (0.0, 1.0),
             film: None,
             filter: None,
             sampler: None,
@@ -352,22 +357,26 @@ impl<'s, 'c> Builder<'s, 'c> {
                         ActiveKind::StartTime => [true, false],
                         ActiveKind::EndTime => [false, true],
                     };
-                    if k != ActiveKind::All {
-                        self.ctx.warn(s.loc, "ActiveTransform: motion blur is not supported; pbrs uses the start-time transforms", "animated transforms ignored");
-                    }
                 }
             }
+            // pbrt-v3 takes the two times as given (no ordering check):
+            // interpolation clamps to the start transform up to the start
+            // time and to the end one from the end time on. Non-finite
+            // times would interpolate to NaN: refused.
             K::TransformTimes => {
-                if nums != [0.0, 1.0] {
-                    self.ctx.warn(s.loc, "TransformTimes: motion blur is not supported; ignored", "ignored");
+                let (t0, t1) = (nums[0], nums[1]);
+                if !(t0.is_finite() && t1.is_finite()) {
+                    self.ctx.error(s.loc, "TransformTimes: the times must be finite numbers", "ignored", None);
+                } else {
+                    if t1 < t0 {
+                        self.ctx.warn(s.loc, format!("TransformTimes: the end time {t1} is before the start time {t0}; as pbrt-v3, times up to {t0} see the start transform and later ones the end transform (no motion in between)"), "this TransformTimes");
+                    }
+                    self.transform_times = (t0, t1);
                 }
             }
             K::Camera => {
-                self.camera = Some((i, self.ctm[0]));
+                self.camera = Some((i, self.ctm));
                 self.camera_outside = Some((self.graphics.media.1.clone(), s.loc));
-                if self.ctm[0] != self.ctm[1] {
-                    self.ctx.warn(s.loc, "animated camera transform: motion blur is not supported; the start transform is used", "this Camera");
-                }
                 let inv = self.ctm[0].inverse();
                 self.named_coords.insert("camera".into(), [inv, self.ctm[1].inverse()]);
             }
@@ -658,7 +667,13 @@ impl<'s, 'c> Builder<'s, 'c> {
                 let pending = std::mem::take(&mut def.shapes);
                 let mut shapes = Vec::new();
                 for p in &pending {
-                    shapes.extend(self.build_shape(p.stmt, p.ctm, &p.graphics, None, p.media));
+                    let mut ctm = p.ctm;
+                    if ctm[0] != ctm[1] {
+                        let loc = self.stmts[p.stmt].loc;
+                        self.ctx.warn(loc, "animated shape transform inside an object definition: pbrs does not nest motion in instances; the start transform is used (animate the ObjectInstance instead)", "this Shape");
+                        ctm[1] = ctm[0];
+                    }
+                    shapes.extend(self.build_shape(p.stmt, ctm, &p.graphics, None, p.media));
                 }
                 self.scene_objects.push(ObjectDesc {
                     name: n.value.clone(),
@@ -669,20 +684,18 @@ impl<'s, 'c> Builder<'s, 'c> {
                 i
             }
         };
-        if self.ctm[0] != self.ctm[1] {
-            self.ctx.warn(
-                n.loc,
-                "animated instance transform: the start transform is used",
-                "this ObjectInstance",
-            );
-        }
-        if !self.ctm[0].is_finite() {
+        if !self.ctm[0].is_finite() || !self.ctm[1].is_finite() {
             self.ctx.error(n.loc, "the instance transform has non-finite entries (overflow in the transform statements)", "this ObjectInstance", None);
             return;
+        }
+        let motion = self.animated(self.ctm);
+        if motion.is_some() {
+            self.check_motion(self.ctm, n.loc, "this ObjectInstance");
         }
         self.instances.push(InstanceDesc {
             object: index,
             instance_to_world: self.ctm[0],
+            motion,
         });
     }
 
@@ -697,28 +710,71 @@ impl<'s, 'c> Builder<'s, 'c> {
             if let Some((_, def)) = &mut self.current_object {
                 def.shapes.push(PendingShape {
                     stmt: i,
-                    ctm: self.ctm[0],
+                    ctm: self.ctm,
                     graphics,
                     media,
                 });
             }
             return;
         }
-        if self.ctm[0] != self.ctm[1] {
-            self.ctx.warn(s.loc, "animated shape transform: motion blur is not supported; the start transform is used", "this Shape");
-        }
         let graphics = self.graphics.clone();
-        let area = graphics.area_light.map(|(i, _)| i);
+        let mut area = graphics.area_light.map(|(i, _)| i);
+        if self.ctm[0] != self.ctm[1] {
+            if self.ctm[0].is_finite() && self.ctm[1].is_finite() {
+                self.check_motion(self.ctm, s.loc, "this Shape");
+            }
+            if area.take().is_some() {
+                self.ctx.warn(
+                    s.loc,
+                    "the current area light is ignored for an animated shape (as pbrt-v3)",
+                    "this Shape is not emissive",
+                );
+            }
+        }
         let media = self.medium_interface(&graphics);
-        if let Some(shape) = self.build_shape(i, self.ctm[0], &graphics, area, media) {
+        if let Some(shape) = self.build_shape(i, self.ctm, &graphics, area, media) {
             self.shapes.push(shape);
         }
+    }
+
+    /// Warnings for an animated transform pbrs renders other than the scene
+    /// may expect: a singular keyframe (the shape or instance is left out,
+    /// where pbrt-v3 would trace NaN rays) or a projective one (the
+    /// decomposition keeps only the affine part, as pbrt-v3's).
+    fn check_motion(&mut self, ctm: [DMat4; 2], loc: Loc, what: &str) {
+        for (m, which) in ctm.iter().zip(["start", "end"]) {
+            let det = DMat3::from_mat4(*m).determinant();
+            if !(det.is_finite() && det != 0.0) {
+                self.ctx.warn(loc, format!("the animated transform's {which} transform is singular: left out of the render"), what);
+                return;
+            }
+        }
+        if !(motion::is_affine(&ctm[0]) && motion::is_affine(&ctm[1])) {
+            self.ctx.warn(loc, "projective animated transform: interpolated as its affine part (as pbrt-v3's decomposition)", what);
+        }
+        Self::warn_mirror(self.ctx, ctm, loc, what);
+    }
+
+    /// pbrt-v3's decomposition leaves a mirror in its rotation, which a
+    /// quaternion cannot hold, so its in-between transforms are wrong (an
+    /// animated camera under `Scale -1 1 1` looks away from the scene);
+    /// pbrs keeps the mirror in the scale part and differs from pbrt-v3 there.
+    fn warn_mirror(ctx: &mut Ctx, ctm: [DMat4; 2], loc: Loc, what: &str) {
+        if ctm.iter().any(|m| DMat3::from_mat4(*m).determinant() < 0.0) {
+            ctx.warn(loc, "animated transform with a mirror (negative determinant): between the keyframes pbrt-v3 interpolates it wrongly (its rotation quaternion cannot hold the mirror); pbrs interpolates the mirror as part of the scale, so its image differs from pbrt-v3's", what);
+        }
+    }
+
+    /// The animated transform of a CTM pair, `None` if both are equal.
+    fn animated(&self, ctm: [DMat4; 2]) -> Option<Arc<AnimatedTransform>> {
+        let (t0, t1) = self.transform_times;
+        AnimatedTransform::new(ctm[0], t0, ctm[1], t1).map(Arc::new)
     }
 
     fn build_shape(
         &mut self,
         i: usize,
-        ctm: DMat4,
+        ctms: [DMat4; 2],
         g: &Graphics,
         area: Option<usize>,
         medium_interface: MediumInterfaceDesc,
@@ -727,7 +783,8 @@ impl<'s, 'c> Builder<'s, 'c> {
         let Directive::Entity { name, params } = &stmts[i].dir else {
             return None;
         };
-        if !ctm.is_finite() {
+        let ctm = ctms[0];
+        if !ctm.is_finite() || !ctms[1].is_finite() {
             self.ctx.error(stmts[i].loc, "the shape's transform has non-finite entries (overflow in the transform statements)", "this Shape", None);
             params.mark_all_used();
             return None;
@@ -774,6 +831,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         Some(ShapeDesc {
             geometry,
             object_to_world: ctm,
+            motion: self.animated(ctms),
             reverse_orientation: g.reverse,
             material,
             area_light,
@@ -969,11 +1027,24 @@ impl<'s, 'c> Builder<'s, 'c> {
         };
         // The film first: the realistic camera needs its size.
         let film = entities::film(self.ctx, ent(self.film));
-        let camera = entities::camera(
+        let mut camera = entities::camera(
             self.ctx,
-            self.camera.and_then(|(i, m)| ent(Some(i)).map(|e| (e, m))),
+            self.camera
+                .and_then(|(i, m)| ent(Some(i)).map(|e| (e, m[0]))),
             &film,
         );
+        if let Some((i, [start, end])) = self.camera {
+            if start != end {
+                // The start inverse was checked by `entities::camera`.
+                let end_inv = end.inverse();
+                if end_inv.is_finite() && end.determinant().abs() >= 1e-300 {
+                    camera.motion = self.animated([camera.camera_to_world, end_inv]);
+                    Self::warn_mirror(self.ctx, [start, end], stmts[i].loc, "this Camera");
+                } else {
+                    self.ctx.error(stmts[i].loc, "the camera's end transform (the CTM at Camera under ActiveTransform EndTime) is singular: it cannot be inverted", "this Camera", None);
+                }
+            }
+        }
         let filter = entities::filter(self.ctx, ent(self.filter));
         let sampler = entities::sampler(self.ctx, ent(self.sampler));
         let integrator = entities::integrator(self.ctx, ent(self.integrator));

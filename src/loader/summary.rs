@@ -37,6 +37,12 @@ pub struct Summary {
     pub object_shapes: usize,
     pub object_triangles: usize,
     pub instances: usize,
+    /// Animated world shapes, animated instances, and whether the camera
+    /// moves: the motion structures the render builds (none if all are 0).
+    pub moving_shapes: usize,
+    pub moving_instances: usize,
+    pub moving_camera: bool,
+    pub shutter: (f32, f32),
     pub warnings: usize,
     /// Media built, one line each: name, type, coefficients.
     pub media: Vec<String>,
@@ -189,6 +195,14 @@ impl Summary {
                 .sum::<usize>();
         }
         s.instances = scene.instances.len();
+        s.moving_shapes = scene.shapes.iter().filter(|x| x.motion.is_some()).count();
+        s.moving_instances = scene
+            .instances
+            .iter()
+            .filter(|x| x.motion.is_some())
+            .count();
+        s.moving_camera = scene.camera.motion.is_some();
+        s.shutter = (scene.camera.shutter_open, scene.camera.shutter_close);
         s
     }
 }
@@ -328,6 +342,19 @@ impl fmt::Display for Summary {
             for m in &self.media {
                 writeln!(f, "            {m}")?;
             }
+        }
+        if self.moving_shapes + self.moving_instances > 0 || self.moving_camera {
+            writeln!(
+                f,
+                "motion:     {} animated shapes, {} animated instances, {} camera, shutter {}..{} (motion structures built)",
+                self.moving_shapes,
+                self.moving_instances,
+                if self.moving_camera { "moving" } else { "still" },
+                self.shutter.0,
+                self.shutter.1
+            )?;
+        } else {
+            writeln!(f, "motion:     none (no motion structures built)")?;
         }
         write!(f, "warnings:   {}", self.warnings)
     }

@@ -228,7 +228,11 @@ fn render_tile(
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
-    let lens = scene.camera.uses_lens();
+    // Whether the camera sample's time and lens values are read (all
+    // samplers draw both, as pbrt-v3; Halton skips computing them when
+    // nothing reads them).
+    let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
+    let lens = scene.camera.uses_lens() || moving;
     // pbrt-v3 scales camera ray differentials by 1/√spp. Rays carry them
     // only in scenes whose materials can use them.
     let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();
@@ -237,6 +241,8 @@ fn render_tile(
         for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
             let cs = sampler.camera_sample(pixel, lens);
+            // Only moving geometry reads a ray's time.
+            let time = if moving { scene.camera.time(&cs) } else { 0.0 };
             let (ray, diff, weight) = if differentials {
                 let (ray, d, w) = scene.camera.generate_ray_differential(&cs, diff_scale);
                 (ray, Some(d), w)
@@ -247,7 +253,7 @@ fn render_tile(
             // pbrt-v3 computes no radiance for a sample the lens blocks
             // (weight 0), but the film still counts its filter weight.
             let mut l = if weight > 0.0 {
-                integrator.li(ray, diff, scene, &mut sampler, &mut scratch)
+                integrator.li(ray, time, diff, scene, &mut sampler, &mut scratch)
             } else {
                 Vec3::ZERO
             };

@@ -2,7 +2,7 @@
 //! geometry with a BVH, materials, lights and a camera. Only what the scene
 //! references is built; what was left out is recorded for `--stats`.
 
-use crate::render::accel::{Geometry, Instance, Object};
+use crate::render::accel::{Geometry, Instance, MovingInstance, Object};
 use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
@@ -141,8 +141,24 @@ impl RenderScene {
                 }
             }
         };
+        // An animated shape becomes a one-shape object in its own space
+        // placed by a moving instance, as pbrt-v3 builds it with the identity
+        // transform inside a `TransformedPrimitive` (never emissive: the
+        // loader dropped its area light, as pbrt-v3 does).
+        let mut moving = Vec::new();
+        let mut singular_moving = 0usize;
         for s in &desc.shapes {
-            add_shape(s, s.object_to_world);
+            match &s.motion {
+                None => add_shape(s, s.object_to_world),
+                Some(m) => {
+                    let obj =
+                        Arc::new(object(std::slice::from_ref(s), |_| DMat4::IDENTITY, &slots));
+                    match MovingInstance::new(obj, m.clone()) {
+                        Some(i) => moving.push(i),
+                        None => singular_moving += 1,
+                    }
+                }
+            }
         }
         // Each instanced object is built once, in its own space, with its own
         // BVH; instances refer to it (two-level BVH, no copies of geometry).
@@ -154,7 +170,7 @@ impl RenderScene {
                 if !desc.instances.iter().any(|inst| inst.object == i) {
                     return None;
                 }
-                Some(Arc::new(object(obj, &slots)))
+                Some(Arc::new(object(&obj.shapes, |s| s.object_to_world, &slots)))
             })
             .collect();
         let mut instances = Vec::with_capacity(desc.instances.len());
@@ -163,6 +179,13 @@ impl RenderScene {
             let Some(Some(obj)) = objects.get(inst.object) else {
                 continue;
             };
+            if let Some(m) = &inst.motion {
+                match MovingInstance::new(obj.clone(), m.clone()) {
+                    Some(i) => moving.push(i),
+                    None => singular_moving += 1,
+                }
+                continue;
+            }
             match Instance::new(obj.clone(), inst.instance_to_world) {
                 Some(i) => instances.push(i),
                 None => singular += 1,
@@ -173,6 +196,11 @@ impl RenderScene {
                 "{singular} instances with a singular transform left out"
             ));
         }
+        if singular_moving > 0 {
+            notes.push(format!(
+                "{singular_moving} animated shapes or instances with a singular start or end transform left out"
+            ));
+        }
         let instanced_triangles: u64 = instances.iter().map(|i| i.object().triangle_count()).sum();
         let object_triangles: u64 = objects.iter().flatten().map(|o| o.triangle_count()).sum();
         let emissive_shapes = desc
@@ -180,7 +208,7 @@ impl RenderScene {
             .iter()
             .filter(|s| s.area_light.is_some())
             .count();
-        let geometry = Geometry::with_instances(meshes, quadrics, instances);
+        let geometry = Geometry::with_motion(meshes, quadrics, instances, moving);
         if geometry.degenerate_triangles > 0 {
             notes.push(format!(
                 "{} zero-area triangles left out of the BVH",
@@ -289,6 +317,18 @@ impl RenderScene {
             area.len(),
             emissive_shapes
         ));
+        let camera = Camera::new(&desc.camera, &desc.film);
+        if geometry.moving_count() > 0 || camera.is_moving() {
+            notes.push(format!(
+                "motion: {} moving shapes or instances (BVH over their motion bounds), {} camera, shutter {}..{}",
+                geometry.moving_count(),
+                if camera.is_moving() { "moving" } else { "static" },
+                desc.camera.shutter_open,
+                desc.camera.shutter_close
+            ));
+        } else {
+            notes.push("motion: none (no motion structures built)".into());
+        }
         if geometry.instance_count() > 0 {
             notes.push(format!(
                 "instancing: {} instances of {} objects ({} triangles stored once, {} as instanced)",
@@ -298,7 +338,6 @@ impl RenderScene {
                 instanced_triangles
             ));
         }
-        let camera = Camera::new(&desc.camera, &desc.film);
         let material_needs_geom = materials.iter().map(Material::needs_geom).collect();
         let differentials = materials.iter().any(|m| m.needs_geom());
         let media: Vec<Medium> = desc.media.iter().map(Medium::new).collect();
@@ -327,19 +366,19 @@ impl RenderScene {
     }
 }
 
-/// Builds an object's shapes in object space and its BVH. Area lights are
-/// never set inside objects (pbrt-v3 ignores them there).
-fn object(obj: &scene::ObjectDesc, slots: &Slots) -> Object {
+/// Builds an object's shapes in object space (each placed there by
+/// `to_object`) and its BVH. Area lights are never set inside objects
+/// (pbrt-v3 ignores them there).
+fn object(shapes: &[ShapeDesc], to_object: impl Fn(&ShapeDesc) -> DMat4, slots: &Slots) -> Object {
     let mut meshes = Vec::new();
     let mut quadrics = Vec::new();
-    for s in &obj.shapes {
-        let m = slots.of(s);
+    for s in shapes {
+        let m4 = to_object(s);
+        let material = slots.of(s);
         match &s.geometry {
-            scene::Geometry::TriangleMesh(mesh) => {
-                meshes.push(world_mesh(mesh, s.object_to_world, s, m))
-            }
-            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, s.object_to_world, s, m)),
-            g => quadrics.extend(quadric(g, s.object_to_world, s, m)),
+            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s, material)),
+            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, m4, s, material)),
+            g => quadrics.extend(quadric(g, m4, s, material)),
         }
     }
     Object::new(meshes, quadrics)

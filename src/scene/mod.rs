@@ -8,11 +8,13 @@
 
 mod fourier;
 pub mod image;
+pub mod motion;
 mod params;
 mod textures;
 
 pub use fourier::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
 pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
+pub use motion::AnimatedTransform;
 pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};
 
@@ -109,6 +111,9 @@ pub struct CameraDesc {
     /// Camera space is pbrt's left-handed one: +z looks forward, +y up, +x right
     /// as seen in the image before any handedness flip in the CTM.
     pub camera_to_world: DMat4,
+    /// Camera-to-world over the shutter when the `Camera` directive saw two
+    /// different CTMs (`camera_to_world` is then its start transform).
+    pub motion: Option<Arc<AnimatedTransform>>,
     pub kind: CameraKind,
     pub shutter_open: f32,
     pub shutter_close: f32,
@@ -299,6 +304,10 @@ pub struct AreaLightDesc {
 pub struct ShapeDesc {
     pub geometry: Geometry,
     pub object_to_world: DMat4,
+    /// Object-to-world over time when the shape's start and end CTMs differ
+    /// (`object_to_world` is then the start transform). `None` for every
+    /// static shape.
+    pub motion: Option<Arc<AnimatedTransform>>,
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
@@ -464,4 +473,7 @@ pub struct InstanceDesc {
     /// Index into [`SceneDescription::objects`].
     pub object: usize,
     pub instance_to_world: DMat4,
+    /// Instance-to-world over time when the start and end CTMs differ
+    /// (`instance_to_world` is then the start transform).
+    pub motion: Option<Arc<AnimatedTransform>>,
 }

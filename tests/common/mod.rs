@@ -255,6 +255,7 @@ pub fn bsdf_of(
         },
         material: 0,
         light: None,
+        time: 0.0,
     };
     let geom = DiffGeom {
         uv: Vec2::new(0.5, 0.5),

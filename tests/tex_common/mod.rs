@@ -118,6 +118,7 @@ impl At {
                 },
                 material: 0,
                 light: None,
+                time: 0.0,
             },
             geom: DiffGeom {
                 uv,

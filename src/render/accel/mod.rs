@@ -19,6 +19,7 @@ use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ra
 use crate::render::shapes::{
     intersect_triangle, DiffGeom, Quadric, QuadricHit, SurfacePoint, TriangleMesh,
 };
+use crate::scene::AnimatedTransform;
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;
@@ -28,11 +29,13 @@ use std::time::Duration;
 
 const QUADRIC_TAG: u32 = u32::MAX;
 const INSTANCE_TAG: u32 = u32::MAX - 1;
+const MOVING_TAG: u32 = u32::MAX - 2;
 /// `Hit::instance` for a hit on world-space geometry.
 const NO_INSTANCE: u32 = u32::MAX;
 
 /// A primitive: triangle `index` of mesh `mesh`, quadric `index` when
-/// `mesh == QUADRIC_TAG`, or instance `index` when `mesh == INSTANCE_TAG`.
+/// `mesh == QUADRIC_TAG`, instance `index` when `mesh == INSTANCE_TAG`, or
+/// moving instance `index` when `mesh == MOVING_TAG`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PrimRef {
     mesh: u32,
@@ -55,6 +58,12 @@ impl PrimRef {
             index: i,
         }
     }
+    fn moving(i: u32) -> Self {
+        Self {
+            mesh: MOVING_TAG,
+            index: i,
+        }
+    }
 }
 
 /// What a closest-hit query found.
@@ -63,9 +72,14 @@ pub struct Hit {
     pub t: f32,
     /// The primitive hit (of the instance's object when `instance` is set).
     pub prim: PrimRef,
+    /// The instance hit: an index into the instances, or into the moving
+    /// instances with `MOVING_BIT` set, or `NO_INSTANCE`.
     instance: u32,
     local: HitLocal,
 }
+
+/// Set in `Hit::instance` for a moving instance.
+const MOVING_BIT: u32 = 1 << 31;
 
 #[derive(Clone, Copy, Debug)]
 enum HitLocal {
@@ -80,6 +94,9 @@ pub struct SurfaceHit {
     pub material: u32,
     /// The area light of this primitive, if it emits.
     pub light: Option<u32>,
+    /// The time of the ray that found it (pbrt-v3's `Interaction::time`):
+    /// the rays spawned here are traced at it.
+    pub time: f32,
 }
 
 /// The BVH over shapes in one space (world space for the scene
@@ -102,7 +119,7 @@ pub struct Object {
 impl Object {
     /// Builds the object's BVH over its shapes (given in object space).
     pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<Quadric>) -> Object {
-        let level = Level::build(&meshes, &quadrics, &[]);
+        let level = Level::build(&meshes, &quadrics, &[], &[]);
         Object {
             meshes,
             quadrics,
@@ -131,10 +148,10 @@ impl Object {
     }
 }
 
-/// A placement of an object: its transforms (f64 for the ray and point
+/// The transforms of an object placement (f64 for the ray and point
 /// mappings, f32 for normals and error bounds).
-pub struct Instance {
-    object: Arc<Object>,
+#[derive(Clone, Copy, Debug)]
+struct Placement {
     world_to_object: DMat4,
     object_to_world: DMat4,
     /// Linear part of object-to-world, entry-wise absolute, for error bounds.
@@ -147,9 +164,25 @@ pub struct Instance {
     linear: Mat3,
 }
 
-impl Instance {
+/// A placement of an object: its transforms.
+pub struct Instance {
+    object: Arc<Object>,
+    place: Placement,
+}
+
+/// An object placed by a transform that moves over the shutter (an
+/// animated `ObjectInstance`, or an animated shape, which pbrs makes a
+/// one-shape object as pbrt-v3 wraps it in a `TransformedPrimitive`). Rays
+/// map to object space by the transform interpolated at their time.
+pub struct MovingInstance {
+    object: Arc<Object>,
+    motion: Arc<AnimatedTransform>,
+}
+
+impl Placement {
     /// `None` if the transform cannot be inverted.
-    pub fn new(object: Arc<Object>, object_to_world: DMat4) -> Option<Instance> {
+    #[inline]
+    fn new(object_to_world: DMat4) -> Option<Placement> {
         let lin = DMat3::from_mat4(object_to_world);
         let det = lin.determinant();
         if !(det.is_finite() && det != 0.0 && object_to_world.is_finite()) {
@@ -160,8 +193,7 @@ impl Instance {
             return None;
         }
         let l = lin.as_mat3();
-        Some(Instance {
-            object,
+        Some(Placement {
             world_to_object,
             object_to_world,
             abs_linear: Mat3::from_cols(l.x_axis.abs(), l.y_axis.abs(), l.z_axis.abs()),
@@ -169,39 +201,6 @@ impl Instance {
             normal_matrix: lin.inverse().transpose().as_mat3(),
             linear: l,
         })
-    }
-
-    pub fn object(&self) -> &Object {
-        &self.object
-    }
-
-    /// World bounds: the object's box corners mapped to world space, rounded
-    /// outwards.
-    fn world_bounds(&self) -> Bounds3 {
-        let b = self.object.level.bounds;
-        let mut out = Bounds3::EMPTY;
-        for i in 0..8 {
-            let c = DVec3::new(
-                if i & 1 == 0 { b.min.x } else { b.max.x } as f64,
-                if i & 2 == 0 { b.min.y } else { b.max.y } as f64,
-                if i & 4 == 0 { b.min.z } else { b.max.z } as f64,
-            );
-            let w = self.object_to_world.transform_point3(c);
-            let lo = w.as_vec3();
-            let lo = Vec3::new(
-                next_float_down(lo.x),
-                next_float_down(lo.y),
-                next_float_down(lo.z),
-            );
-            let hi = w.as_vec3();
-            let hi = Vec3::new(
-                next_float_up(hi.x),
-                next_float_up(hi.y),
-                next_float_up(hi.z),
-            );
-            out = out.union_point(lo).union_point(hi);
-        }
-        out
     }
 
     /// The world ray in object space (same `t` parameterisation).
@@ -236,7 +235,7 @@ impl Instance {
     /// differs from a placed sphere as it does in pbrt-v3 (a placed sphere's
     /// normal is flipped by its transform's handedness; an instance's is not).
     #[inline]
-    fn to_world(&self, s: SurfacePoint, has_vertex_normals: bool) -> SurfacePoint {
+    fn point_to_world(&self, s: SurfacePoint, has_vertex_normals: bool) -> SurfacePoint {
         let p = self
             .object_to_world
             .transform_point3(s.p.as_dvec3())
@@ -272,11 +271,94 @@ impl Instance {
     }
 }
 
+/// An f64 box rounded outwards to f32.
+fn round_out(lo: DVec3, hi: DVec3) -> Bounds3 {
+    let (lo, hi) = (lo.as_vec3(), hi.as_vec3());
+    Bounds3::EMPTY
+        .union_point(Vec3::new(
+            next_float_down(lo.x),
+            next_float_down(lo.y),
+            next_float_down(lo.z),
+        ))
+        .union_point(Vec3::new(
+            next_float_up(hi.x),
+            next_float_up(hi.y),
+            next_float_up(hi.z),
+        ))
+}
+
+impl Instance {
+    /// `None` if the transform cannot be inverted.
+    pub fn new(object: Arc<Object>, object_to_world: DMat4) -> Option<Instance> {
+        Some(Instance {
+            object,
+            place: Placement::new(object_to_world)?,
+        })
+    }
+
+    pub fn object(&self) -> &Object {
+        &self.object
+    }
+
+    /// World bounds: the object's box corners mapped to world space, rounded
+    /// outwards.
+    fn world_bounds(&self) -> Bounds3 {
+        let b = self.object.level.bounds;
+        let mut out = Bounds3::EMPTY;
+        for i in 0..8 {
+            let c = DVec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x } as f64,
+                if i & 2 == 0 { b.min.y } else { b.max.y } as f64,
+                if i & 4 == 0 { b.min.z } else { b.max.z } as f64,
+            );
+            let w = self.place.object_to_world.transform_point3(c);
+            out = out.union(&round_out(w, w));
+        }
+        out
+    }
+}
+
+impl MovingInstance {
+    /// `None` if either keyframe transform cannot be inverted (a transform
+    /// that is singular only between the keyframes makes the object vanish
+    /// for the rays of those times).
+    pub fn new(object: Arc<Object>, motion: Arc<AnimatedTransform>) -> Option<MovingInstance> {
+        Placement::new(motion.start)?;
+        Placement::new(motion.end)?;
+        Some(MovingInstance { object, motion })
+    }
+
+    pub fn object(&self) -> &Object {
+        &self.object
+    }
+
+    /// The placement at `time`.
+    #[inline]
+    fn at(&self, time: f32) -> Option<Placement> {
+        Placement::new(self.motion.interpolate(time as f64))
+    }
+
+    /// A box holding the object's bounds over the whole motion (pbrt-v3's
+    /// `AnimatedTransform::MotionBounds`), rounded outwards.
+    fn world_bounds(&self) -> Bounds3 {
+        let b = self.object.level.bounds;
+        let (lo, hi) = self
+            .motion
+            .motion_bounds(b.min.as_dvec3(), b.max.as_dvec3());
+        round_out(lo, hi)
+    }
+}
+
 impl Level {
     /// Builds the BVH (in parallel, with obvhs's PLOC builder) over the shapes
     /// and the given extra boxes (instances). Zero-area triangles are left
     /// out; an empty level builds no BVH at all.
-    fn build(meshes: &[TriangleMesh], quadrics: &[Quadric], extra: &[Bounds3]) -> Level {
+    fn build(
+        meshes: &[TriangleMesh],
+        quadrics: &[Quadric],
+        extra: &[Bounds3],
+        moving: &[Bounds3],
+    ) -> Level {
         let mut prims = Vec::new();
         let mut aabbs = Vec::new();
         let mut bounds = Bounds3::EMPTY;
@@ -302,12 +384,18 @@ impl Level {
             prims.push(PrimRef::quadric(si as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
-        for (ii, b) in extra.iter().enumerate() {
+        let placed = extra
+            .iter()
+            .map(|b| (b, PrimRef::instance as fn(u32) -> PrimRef));
+        let moved = moving
+            .iter()
+            .map(|b| (b, PrimRef::moving as fn(u32) -> PrimRef));
+        for (ii, (b, tag)) in placed.enumerate().chain(moved.enumerate()) {
             if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
                 continue;
             }
             bounds = bounds.union(b);
-            prims.push(PrimRef::instance(ii as u32));
+            prims.push(tag(ii as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
         let bvh = if prims.is_empty() {
@@ -319,6 +407,7 @@ impl Level {
                 let p = prims[i];
                 (p.mesh != QUADRIC_TAG
                     && p.mesh != INSTANCE_TAG
+                    && p.mesh != MOVING_TAG
                     && meshes[p.mesh as usize].alpha.is_none())
                 .then(|| meshes[p.mesh as usize].vertices(p.index))
             });
@@ -344,12 +433,13 @@ struct Shapes<'a> {
 
 impl Shapes<'_> {
     /// Closest hit among this level's shapes with `t <= ray.t_max`;
-    /// instances are resolved by `instance_hit`.
+    /// instances are resolved by `instance_hit`, moving ones by `moving_hit`.
     #[inline(always)]
     fn intersect(
         &self,
         ray: &Ray,
         mut instance_hit: impl FnMut(u32, f32) -> Option<Hit>,
+        mut moving_hit: impl FnMut(u32, f32) -> Option<Hit>,
     ) -> Option<Hit> {
         let bvh = self.level.bvh.as_ref()?;
         // Quadrics and instances found so far (triangles come back as values).
@@ -366,6 +456,8 @@ impl Shapes<'_> {
                     instance: NO_INSTANCE,
                     local: HitLocal::Quadric(p),
                 })
+            } else if prim.mesh == MOVING_TAG {
+                moving_hit(prim.index, t_max)
             } else {
                 self.alpha_triangle(ray, prim, t_max, false)
             }?;
@@ -384,10 +476,16 @@ impl Shapes<'_> {
         }
     }
 
-    /// True if any of this level's shapes (or instances, by `instance_hit`)
-    /// blocks the ray before `ray.t_max`.
+    /// True if any of this level's shapes (or instances, by `instance_hit`,
+    /// or moving instances, by `moving_hit`) blocks the ray before
+    /// `ray.t_max`.
     #[inline(always)]
-    fn occluded(&self, ray: &Ray, mut instance_hit: impl FnMut(u32) -> bool) -> bool {
+    fn occluded(
+        &self,
+        ray: &Ray,
+        mut instance_hit: impl FnMut(u32) -> bool,
+        mut moving_hit: impl FnMut(u32) -> bool,
+    ) -> bool {
         let Some(bvh) = self.level.bvh.as_ref() else {
             return false;
         };
@@ -399,6 +497,8 @@ impl Shapes<'_> {
                 self.quadrics[prim.index as usize]
                     .intersect(ray.o, ray.d, ray.t_max)
                     .is_some()
+            } else if prim.mesh == MOVING_TAG {
+                moving_hit(prim.index)
             } else {
                 self.alpha_triangle(ray, prim, ray.t_max, true).is_some()
             }
@@ -440,6 +540,7 @@ impl Shapes<'_> {
                         point: m.surface_point(prim.index, b),
                         material: m.material,
                         light: m.first_light.map(|l| l + prim.index),
+                        time: 0.0,
                     },
                     m.n.is_some(),
                 )
@@ -451,6 +552,7 @@ impl Shapes<'_> {
                         point: s.surface_point(p),
                         material: s.material(),
                         light: s.light(),
+                        time: 0.0,
                     },
                     false,
                 )
@@ -467,7 +569,11 @@ pub struct Geometry {
     pub quadrics: Vec<Quadric>,
     top: Level,
     instances: Vec<Instance>,
-    /// World bounds of everything, instances included.
+    /// Instances and shapes with animated transforms (empty, and never
+    /// looked at, in a scene without motion).
+    moving: Vec<MovingInstance>,
+    /// World bounds of everything, instances included (moving ones over
+    /// their whole motion).
     pub bounds: Bounds3,
     /// Triangles left out because they have zero area (each object's counted
     /// once, however often it is instanced).
@@ -488,20 +594,40 @@ impl Geometry {
         quadrics: Vec<Quadric>,
         instances: Vec<Instance>,
     ) -> Geometry {
+        Geometry::with_motion(meshes, quadrics, instances, Vec::new())
+    }
+
+    /// `with_instances` with moving instances too: the scene-level BVH holds
+    /// each one's motion bounds.
+    pub fn with_motion(
+        meshes: Vec<TriangleMesh>,
+        quadrics: Vec<Quadric>,
+        instances: Vec<Instance>,
+        moving: Vec<MovingInstance>,
+    ) -> Geometry {
         let start = std::time::Instant::now();
         let instances: Vec<Instance> = instances
             .into_iter()
             .filter(|i| !i.object.is_empty())
             .collect();
+        let moving: Vec<MovingInstance> = moving
+            .into_iter()
+            .filter(|i| !i.object.is_empty())
+            .collect();
         let boxes: Vec<Bounds3> = instances.iter().map(Instance::world_bounds).collect();
-        let top = Level::build(&meshes, &quadrics, &boxes);
+        let moving_boxes: Vec<Bounds3> = moving.iter().map(MovingInstance::world_bounds).collect();
+        let top = Level::build(&meshes, &quadrics, &boxes, &moving_boxes);
         let mut degenerate = top.degenerate;
         let mut seen: Vec<*const Object> = Vec::new();
-        for i in &instances {
-            let p = Arc::as_ptr(&i.object);
+        let objects = instances
+            .iter()
+            .map(|i| &i.object)
+            .chain(moving.iter().map(|i| &i.object));
+        for o in objects {
+            let p = Arc::as_ptr(o);
             if !seen.contains(&p) {
                 seen.push(p);
-                degenerate += i.object.level.degenerate;
+                degenerate += o.level.degenerate;
             }
         }
         Geometry {
@@ -510,6 +636,7 @@ impl Geometry {
             bounds: top.bounds,
             top,
             instances,
+            moving,
             degenerate_triangles: degenerate,
             build_time: start.elapsed(),
         }
@@ -532,6 +659,11 @@ impl Geometry {
         self.instances.len()
     }
 
+    /// Moving instances (animated object instances and animated shapes).
+    pub fn moving_count(&self) -> usize {
+        self.moving.len()
+    }
+
     pub fn has_bvh(&self) -> bool {
         self.top.bvh.is_some()
     }
@@ -540,28 +672,92 @@ impl Geometry {
     /// traversal is inlined here, so that nothing is passed through memory
     /// on the way in: a struct written just before a call and read back
     /// with wider loads stalls store forwarding.)
-    #[inline(never)]
+    ///
+    /// At time 0: for a still scene (or a test); a path takes
+    /// [`Geometry::intersect_at`] with its time.
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.shapes().intersect(ray, |i, t_max| {
-            let inst = &self.instances[i as usize];
-            let mut r = inst.object_ray(ray);
-            r.t_max = t_max;
-            inst.object
-                .shapes()
-                .intersect(&r, |_, _| None)
-                .map(|h| Hit { instance: i, ..h })
-        })
+        self.intersect_at(ray, 0.0)
     }
 
-    /// True if anything blocks the ray before `t_max`.
+    /// Closest hit along the ray at scene time `time` (read only by moving
+    /// instances: a still scene never looks at it).
     #[inline(never)]
+    pub fn intersect_at(&self, ray: &Ray, time: f32) -> Option<Hit> {
+        self.shapes().intersect(
+            ray,
+            |i, t_max| {
+                let inst = &self.instances[i as usize];
+                let mut r = inst.place.object_ray(ray);
+                r.t_max = t_max;
+                inst.object
+                    .shapes()
+                    .intersect(&r, |_, _| None, |_, _| None)
+                    .map(|h| Hit { instance: i, ..h })
+            },
+            |i, t_max| self.moving_intersect(ray, time, i, t_max),
+        )
+    }
+
+    /// A moving instance's closest hit (the transform interpolated at the
+    /// ray's time, as pbrt-v3's `TransformedPrimitive::Intersect`).
+    #[inline(never)]
+    fn moving_intersect(&self, ray: &Ray, time: f32, i: u32, t_max: f32) -> Option<Hit> {
+        let inst = &self.moving[i as usize];
+        let mut r = inst.at(time)?.object_ray(ray);
+        r.t_max = t_max;
+        inst.object
+            .shapes()
+            .intersect(&r, |_, _| None, |_, _| None)
+            .map(|h| Hit {
+                instance: i | MOVING_BIT,
+                ..h
+            })
+    }
+
+    #[inline(never)]
+    fn moving_occluded(&self, ray: &Ray, time: f32, i: u32) -> bool {
+        let inst = &self.moving[i as usize];
+        let Some(place) = inst.at(time) else {
+            return false;
+        };
+        inst.object
+            .shapes()
+            .occluded(&place.object_ray(ray), |_| false, |_| false)
+    }
+
+    /// True if anything blocks the ray before `t_max`, at time 0 (see
+    /// [`Geometry::intersect`]).
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.shapes().occluded(ray, |i| {
-            let inst = &self.instances[i as usize];
-            inst.object
-                .shapes()
-                .occluded(&inst.object_ray(ray), |_| false)
-        })
+        self.occluded_at(ray, 0.0)
+    }
+
+    /// True if anything blocks the ray before `t_max` at scene time `time`.
+    #[inline(never)]
+    pub fn occluded_at(&self, ray: &Ray, time: f32) -> bool {
+        self.shapes().occluded(
+            ray,
+            |i| {
+                let inst = &self.instances[i as usize];
+                inst.object
+                    .shapes()
+                    .occluded(&inst.place.object_ray(ray), |_| false, |_| false)
+            },
+            |i| self.moving_occluded(ray, time, i),
+        )
+    }
+
+    /// The object and placement of an instance hit (a moving instance's at
+    /// the time of the ray that found it; `None` only if that transform has
+    /// become singular, which the hit itself rules out).
+    fn placed(&self, hit: &Hit, time: f32) -> Option<(&Object, Placement)> {
+        if hit.instance & MOVING_BIT == 0 {
+            let inst = &self.instances[hit.instance as usize];
+            return Some((&inst.object, inst.place));
+        }
+        let inst = &self.moving[(hit.instance & !MOVING_BIT) as usize];
+        Some((&inst.object, inst.at(time)?))
     }
 
     /// The differential geometry of a hit (uv, dp/du, …), for materials
@@ -571,25 +767,37 @@ impl Geometry {
         if hit.instance == NO_INSTANCE {
             return self.shapes().diff_geom(hit.prim, hit.local, s.point.ns);
         }
-        let inst = &self.instances[hit.instance as usize];
-        let shapes = inst.object.shapes();
+        let Some((object, place)) = self.placed(hit, s.time) else {
+            return DiffGeom::ZERO;
+        };
+        let shapes = object.shapes();
         let (local, _) = shapes.surface(hit.prim, hit.local);
-        inst.geom_to_world(shapes.diff_geom(hit.prim, hit.local, local.point.ns))
+        place.geom_to_world(shapes.diff_geom(hit.prim, hit.local, local.point.ns))
     }
 
-    /// Shading data of a hit.
+    /// Shading data of a hit found at time 0 (see [`Geometry::intersect`]).
     #[inline]
     pub fn surface(&self, hit: &Hit) -> SurfaceHit {
+        self.surface_at(hit, 0.0)
+    }
+
+    /// Shading data of a hit found by a ray at scene time `time`.
+    #[inline]
+    pub fn surface_at(&self, hit: &Hit, time: f32) -> SurfaceHit {
         if hit.instance == NO_INSTANCE {
-            return self.shapes().surface(hit.prim, hit.local).0;
+            let s = self.shapes().surface(hit.prim, hit.local).0;
+            return SurfaceHit { time, ..s };
         }
-        let inst = &self.instances[hit.instance as usize];
-        let (s, vertex_normals) = inst.object.shapes().surface(hit.prim, hit.local);
+        let (object, place) = self
+            .placed(hit, time)
+            .expect("a moving instance's hit has an invertible transform at its time");
+        let (s, vertex_normals) = object.shapes().surface(hit.prim, hit.local);
         SurfaceHit {
-            point: inst.to_world(s.point, vertex_normals),
+            point: place.point_to_world(s.point, vertex_normals),
             material: s.material,
             // Area lights inside objects are ignored (as pbrt-v3).
             light: None,
+            time,
         }
     }
 }

@@ -10,7 +10,7 @@
 //!
 //! | parameter | type | pbrt-v3 default |
 //! |---|---|---|
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (kept; pbrs has no motion blur yet) |
+//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
 //! | `lensradius`, `focaldistance`, `frameaspectratio`, `screenwindow` | float | read and ignored by pbrt-v3 (0, 1e30, xres/yres, —) |
 
 use crate::render::geometry::{Ray, RayDiff};

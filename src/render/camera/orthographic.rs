@@ -15,7 +15,7 @@
 //! | `focaldistance` | float | 1e6 |
 //! | `frameaspectratio` | float | xresolution / yresolution |
 //! | `screenwindow` | float[4] (xmin xmax ymin ymax, camera-space units) | [-frame, frame] × [-1, 1] if frame > 1, else [-1, 1] × [-1/frame, 1/frame] |
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (kept; pbrs has no motion blur yet) |
+//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
 
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;

@@ -12,7 +12,7 @@
 //! | `focaldistance` | float | 1e6 |
 //! | `frameaspectratio` | float | xresolution / yresolution |
 //! | `screenwindow` | float[4] (xmin xmax ymin ymax) | [-frame, frame] × [-1, 1] if frame > 1, else [-1, 1] × [-1/frame, 1/frame] |
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (kept; pbrs has no motion blur yet) |
+//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
 
 use super::world_ray;
 use crate::render::geometry::{Ray, RayDiff};
@@ -52,7 +52,7 @@ impl PerspectiveCamera {
     }
 
     /// True if `generate_ray` reads the sample's lens position (a thin lens;
-    /// time is never read: there is no motion blur).
+    /// the time is read by `Camera`, not here).
     #[inline]
     pub fn uses_lens(&self) -> bool {
         self.lens_radius > 0.0

@@ -26,7 +26,7 @@
 //! | `aperturediameter` | float (mm; clamped to the stop's diameter in the file) | 1 |
 //! | `focusdistance` | float (scene units, from the film) | 10 |
 //! | `simpleweighting` | bool | true |
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (kept; pbrs has no motion blur yet) |
+//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
 //!
 //! Lens file: rows of curvature radius (0 for the aperture stop), thickness
 //! to the next interface, index of refraction behind the interface (0 or 1

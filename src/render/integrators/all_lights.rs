@@ -157,7 +157,7 @@ pub(super) fn sample_all_lights_packed(
                         lane3(&ls.q_error, lane),
                         lane3(&pack.n, lane),
                     );
-                    if !scene.geometry.occluded(&shadow) {
+                    if !scene.geometry.occluded_at(&shadow, s.time) {
                         let li = lane3(&pack.l, lane);
                         let light_pdf = 1.0 * pdf_l[lane];
                         ld = f * li * power_heuristic(1, light_pdf, 1, scatter_pdf_l[lane])
@@ -172,9 +172,9 @@ pub(super) fn sample_all_lights_packed(
                     let weight = power_heuristic(1, pdf_b[lane], 1, light_pdf_b[lane]);
                     scratch.counts.closest += 1;
                     let ray = Ray::new(lane3(&o_b, lane), wi);
-                    let li = match scene.geometry.intersect(&ray) {
+                    let li = match scene.geometry.intersect_at(&ray, s.time) {
                         Some(h) => {
-                            let hs = scene.geometry.surface(&h);
+                            let hs = scene.geometry.surface_at(&h, s.time);
                             if hs.light == Some(light_index) {
                                 scene.lights[light_index as usize].emitted(hs.point.n, -wi)
                             } else {

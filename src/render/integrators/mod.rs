@@ -202,12 +202,15 @@ impl Integrator {
         }
     }
 
-    /// Radiance arriving at the camera along `ray`, with its differentials
-    /// if it has them.
+    /// Radiance arriving at the camera along `ray` at scene time `time`
+    /// (every ray of the path is traced at it), with its differentials if it
+    /// has them.
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn li(
         &self,
         ray: Ray,
+        time: f32,
         diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
@@ -220,6 +223,7 @@ impl Integrator {
                 lights,
             } => path_li(
                 ray,
+                time,
                 diff,
                 scene,
                 sampler,
@@ -234,6 +238,7 @@ impl Integrator {
                 lights,
             } => volpath::volpath_li(
                 ray,
+                time,
                 diff,
                 scene,
                 sampler,
@@ -243,7 +248,7 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.specular_tree_li(ray, diff, scene, sampler, scratch)
+                self.specular_tree_li(ray, time, diff, scene, sampler, scratch)
             }
         }
     }
@@ -258,6 +263,7 @@ impl Integrator {
     fn specular_tree_li(
         &self,
         ray: Ray,
+        time: f32,
         diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
@@ -276,11 +282,11 @@ impl Integrator {
         let mut bsdf = Bsdf::empty();
         while let Some(w) = stack.pop() {
             scratch.counts.closest += 1;
-            let Some(hit) = scene.geometry.intersect(&w.ray) else {
+            let Some(hit) = scene.geometry.intersect_at(&w.ray, time) else {
                 l += w.beta * escaped(scene, w.ray.d);
                 continue;
             };
-            let mut s = scene.geometry.surface(&hit);
+            let mut s = scene.geometry.surface_at(&hit, time);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 if w.pass < MAX_PASS_THROUGH {
@@ -365,7 +371,7 @@ impl Integrator {
                         let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
                         if f != Vec3::ZERO {
                             scratch.counts.shadow += 1;
-                            if !scene.geometry.occluded(&ls.shadow) {
+                            if !scene.geometry.occluded_at(&ls.shadow, s.time) {
                                 local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
                             }
                         }
@@ -525,6 +531,7 @@ fn escaped(scene: &RenderScene, d: Vec3) -> Vec3 {
 #[allow(clippy::too_many_arguments)]
 fn path_li(
     mut ray: Ray,
+    time: f32,
     diff: Option<RayDiff>,
     scene: &RenderScene,
     sampler: &mut Sampler,
@@ -549,7 +556,7 @@ fn path_li(
     let mut bsdf_pdf = 0.0f32;
     loop {
         scratch.counts.closest += 1;
-        let hit = scene.geometry.intersect(&ray);
+        let hit = scene.geometry.intersect_at(&ray, time);
         let Some(hit) = hit else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
@@ -564,7 +571,7 @@ fn path_li(
             }
             break;
         };
-        let mut s = scene.geometry.surface(&hit);
+        let mut s = scene.geometry.surface_at(&hit, time);
         let wo = -ray.d;
         if let Some(light_index) = s.light {
             let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
@@ -728,7 +735,7 @@ fn light_strategy(
         return Vec3::ZERO;
     }
     scratch.counts.shadow += 1;
-    if scene.geometry.occluded(&ls.shadow) {
+    if scene.geometry.occluded_at(&ls.shadow, s.time) {
         return Vec3::ZERO;
     }
     let light_pdf = pmf * ls.pdf;
@@ -836,9 +843,9 @@ fn estimate_direct(
                 }
                 let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
                 scratch.counts.closest += 1;
-                let li = match geom.intersect(&ray) {
+                let li = match geom.intersect_at(&ray, s.time) {
                     Some(h) => {
-                        let hs = geom.surface(&h);
+                        let hs = geom.surface_at(&h, s.time);
                         if hs.light == Some(light_index) {
                             light.emitted(hs.point.n, -bs.wi)
                         } else {

@@ -74,13 +74,14 @@ pub(super) fn medium_after(
 pub(super) fn transmittance(
     scene: &RenderScene,
     shadow: &Ray,
+    time: f32,
     medium: Option<u32>,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
 ) -> Vec3 {
     if !scene.has_pass_through {
         scratch.counts.shadow += 1;
-        if scene.geometry.occluded(shadow) {
+        if scene.geometry.occluded_at(shadow, time) {
             return Vec3::ZERO;
         }
         return match medium {
@@ -96,13 +97,13 @@ pub(super) fn transmittance(
     let mut tr = Vec3::ONE;
     for _ in 0..=MAX_PASS_THROUGH {
         scratch.counts.shadow += 1;
-        let Some(hit) = scene.geometry.intersect(&ray) else {
+        let Some(hit) = scene.geometry.intersect_at(&ray, time) else {
             if let Some(m) = medium {
                 tr *= scene.media[m as usize].tr(&ray, sampler);
             }
             return tr;
         };
-        let s = scene.geometry.surface(&hit);
+        let s = scene.geometry.surface_at(&hit, time);
         if !scene.materials[s.material as usize].is_none() {
             return Vec3::ZERO;
         }
@@ -142,6 +143,7 @@ pub(super) fn transmittance(
 fn sample_light(
     scene: &RenderScene,
     point: &SurfacePoint,
+    time: f32,
     scatter: Scatter,
     wo: Vec3,
     medium: impl Fn(Vec3) -> Option<u32>,
@@ -177,7 +179,7 @@ fn sample_light(
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let tr = transmittance(scene, &ls.shadow, medium(ls.wi), sampler, scratch);
+    let tr = transmittance(scene, &ls.shadow, time, medium(ls.wi), sampler, scratch);
     if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -192,6 +194,7 @@ fn sample_light(
 #[allow(clippy::too_many_arguments)]
 pub(super) fn volpath_li(
     mut ray: Ray,
+    time: f32,
     diff: Option<RayDiff>,
     scene: &RenderScene,
     sampler: &mut Sampler,
@@ -216,7 +219,7 @@ pub(super) fn volpath_li(
     let mut scatter_pdf = 0.0f32;
     loop {
         scratch.counts.closest += 1;
-        let hit = scene.geometry.intersect(&ray);
+        let hit = scene.geometry.intersect_at(&ray, time);
         if let Some(m) = medium {
             let med = &scene.media[m as usize];
             let segment = Ray {
@@ -244,6 +247,7 @@ pub(super) fn volpath_li(
                     * sample_light(
                         scene,
                         &point,
+                        time,
                         Scatter::Medium(phase),
                         wo,
                         |_| medium,
@@ -279,7 +283,7 @@ pub(super) fn volpath_li(
             }
             break;
         };
-        let mut s = scene.geometry.surface(&hit);
+        let mut s = scene.geometry.surface_at(&hit, time);
         let wo = -ray.d;
         if let Some(light_index) = s.light {
             let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
@@ -326,6 +330,7 @@ pub(super) fn volpath_li(
                 * sample_light(
                     scene,
                     &s.point,
+                    time,
                     Scatter::Surface(&bsdf, s.point.ns),
                     wo,
                     |wi| {

@@ -55,6 +55,7 @@ impl TriangleMesh {
             point,
             material: self.material,
             light: None,
+            time: 0.0,
         };
         let sc = ShadingContext {
             hit: &hit,
