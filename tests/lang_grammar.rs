@@ -222,3 +222,38 @@ fn reference_material_section_is_generated_from_the_table() {
         }
     }
 }
+
+/// The media section of REFERENCE.md is what the generator writes from
+/// `render::media::MEDIA` (`PBRS_WRITE_REFERENCE=1` rewrites it).
+#[test]
+fn reference_media_section_is_generated_from_the_table() {
+    use pbrs::loader::reference::{media_section, splice_between, MEDIA_BEGIN, MEDIA_END};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
+    let doc = std::fs::read_to_string(&path).unwrap();
+    let section = media_section();
+    let Some(expected) = splice_between(&doc, &section, MEDIA_BEGIN, MEDIA_END) else {
+        panic!("REFERENCE.md lacks the lines {MEDIA_BEGIN:?} and, after it, {MEDIA_END:?}");
+    };
+    if std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1") {
+        if expected != doc {
+            std::fs::write(&path, &expected).unwrap();
+        }
+        return;
+    }
+    assert!(
+        expected == doc,
+        "grammar/REFERENCE.md's media section differs from the media table; regenerate it with \
+         `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` and commit the diff"
+    );
+    for k in pbrs::render::media::MEDIA {
+        assert!(section.contains(&format!("### `{}`", k.name)), "{}", k.name);
+        for p in k.params {
+            assert!(
+                section.contains(&format!("| `{}` |", p.name)),
+                "{}: {}",
+                k.name,
+                p.name
+            );
+        }
+    }
+}

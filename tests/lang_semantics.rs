@@ -556,7 +556,11 @@ fn unsupported_shapes_and_directives_warn_and_load() {
         "{w}"
     );
     assert!(w.contains("did you mean \"cylinder\""), "{w}");
-    assert!(w.contains("participating media are not supported"), "{w}");
+    assert!(
+        w.contains("mem.pbrt:5:1: the scene has participating media but the \"path\" integrator ignores them"),
+        "{w}"
+    );
+    assert!(!w.contains("not supported by pbrs; ignored"), "{w}");
     assert!(w.contains("texture class \"ptex\" is not supported"), "{w}");
 }
 

@@ -58,7 +58,7 @@ pub fn string<'a>(p: &'a ParamList, name: &str) -> Option<(&'a str, Loc)> {
     one(p, name, |t| t == ParamType::String).map(|q| (q.strs()[0].as_str(), q.values_loc))
 }
 
-fn point3(p: &ParamList, name: &str, def: DVec3) -> DVec3 {
+pub(super) fn point3(p: &ParamList, name: &str, def: DVec3) -> DVec3 {
     one(p, name, |t| t == ParamType::Point3)
         .map(|q| DVec3::new(q.nums()[0], q.nums()[1], q.nums()[2]))
         .unwrap_or(def)
@@ -1421,7 +1421,7 @@ pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {
         ctx.warn(q.loc, "\"pixelbounds\" is not supported by pbrs: the whole film is rendered (use --cropwindow)", "ignored");
     }
     let d = match name.value.as_str() {
-        "path" => {
+        "path" | "volpath" => {
             let rr = float(p, "rrthreshold", 1.0) as f32;
             let strategy = match string(p, "lightsamplestrategy") {
                 None | Some(("spatial", _)) => LightSampleStrategy::Spatial,
@@ -1432,10 +1432,18 @@ pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {
                     LightSampleStrategy::Spatial
                 }
             };
-            IntegratorDesc::Path {
-                max_depth,
-                rr_threshold: rr,
-                light_sample_strategy: strategy,
+            if name.value == "volpath" {
+                IntegratorDesc::VolPath {
+                    max_depth,
+                    rr_threshold: rr,
+                    light_sample_strategy: strategy,
+                }
+            } else {
+                IntegratorDesc::Path {
+                    max_depth,
+                    rr_threshold: rr,
+                    light_sample_strategy: strategy,
+                }
             }
         }
         "directlighting" => {
@@ -1457,7 +1465,7 @@ pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {
             }
         }
         "whitted" => IntegratorDesc::Whitted { max_depth },
-        "volpath" | "bdpt" | "mlt" | "sppm" | "ambientocclusion" => {
+        "bdpt" | "mlt" | "sppm" | "ambientocclusion" => {
             p.mark_all_used();
             ctx.warn(name.loc, format!("integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth {max_depth}", name.value), "substituted by path");
             path(max_depth)

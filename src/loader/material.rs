@@ -429,6 +429,8 @@ pub fn read_params_as(
                 }
                 None
             }
+            // Media's kinds: no material or texture declares them.
+            ParamKind::Spectrum(_) | ParamKind::Point3(_) | ParamKind::Floats => None,
         };
         if let Some(v) = value {
             out.set(s.name, v);

@@ -17,6 +17,7 @@ pub mod entities;
 pub mod fourier;
 pub mod image;
 pub mod material;
+pub mod medium;
 pub mod meshfile;
 pub mod ply;
 pub mod reference;
@@ -181,6 +182,9 @@ fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
         ],
         ParamKind::SameValue(_) => &["float", "rgb", "color", "xyz", "blackbody", "spectrum"],
         ParamKind::Unsupported(_) => &[],
+        ParamKind::Spectrum(_) => &["rgb", "color", "xyz", "blackbody", "spectrum"],
+        ParamKind::Point3(_) => &["point3", "point"],
+        ParamKind::Floats => &["float"],
     }
 }
 
@@ -237,6 +241,9 @@ fn kind_name(kind: ParamKind) -> &'static str {
         ParamKind::SameTexture(_) => "texture",
         ParamKind::SameValue(_) => "value",
         ParamKind::Unsupported(_) => "ignored",
+        ParamKind::Spectrum(_) => "spectrum",
+        ParamKind::Point3(_) => "point3",
+        ParamKind::Floats => "float list",
     }
 }
 
@@ -400,6 +407,8 @@ fn build(ctx: &mut Ctx, stmts: &[crate::lang::Stmt]) -> Built {
         objects: std::mem::take(&mut b.scene_objects),
         instances: std::mem::take(&mut b.instances),
         skipped: std::mem::take(&mut b.skipped),
+        media: std::mem::take(&mut b.scene_media),
+        camera_medium: b.camera_medium,
     };
     let kinds = std::mem::take(&mut b.material_kinds);
     let textures = std::mem::take(&mut b.texture_state.by_class);

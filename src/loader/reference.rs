@@ -136,6 +136,15 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
         ParamKind::Filename => ("string: a file name".to_string(), None),
         ParamKind::SameTexture(d) => ("texture of the texture's type".to_string(), Some(num(d))),
         ParamKind::SameValue(d) => ("value of the texture's type".to_string(), Some(num(d))),
+        ParamKind::Spectrum(d) => (
+            "spectrum".to_string(),
+            Some(spectrum(SpectrumDefault::Rgb(d))),
+        ),
+        ParamKind::Point3([x, y, z]) => (
+            "point3".to_string(),
+            Some(format!("{} {} {}", num(x), num(y), num(z))),
+        ),
+        ParamKind::Floats => ("float list".to_string(), None),
     };
     (
         format!("{ty}{nonneg}"),
@@ -190,8 +199,44 @@ fn cell(s: &str) -> String {
 /// `doc` with its generated material section replaced by `section`, or
 /// `None` when the markers are missing or out of order.
 pub fn splice(doc: &str, section: &str) -> Option<String> {
-    let begin = doc.find(MATERIALS_BEGIN)?;
-    let end = doc[begin..].find(MATERIALS_END)? + begin + MATERIALS_END.len();
+    splice_between(doc, section, MATERIALS_BEGIN, MATERIALS_END)
+}
+
+/// The line that opens the generated media section.
+pub const MEDIA_BEGIN: &str = "<!-- BEGIN generated from render::media::MEDIA: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+/// The line that closes it.
+pub const MEDIA_END: &str = "<!-- END generated media -->";
+
+/// The media section, between its markers (both included), from
+/// [`MEDIA`](crate::render::media::MEDIA).
+pub fn media_section() -> String {
+    let mut out = String::new();
+    out.push_str(MEDIA_BEGIN);
+    out.push('\n');
+    for k in crate::render::media::MEDIA {
+        let _ = write!(out, "\n### `{}`\n\n{}\n", k.name, sentence(k.doc));
+        out.push_str("\n| parameter | type | default | meaning |\n|---|---|---|---|\n");
+        for p in k.params {
+            let (ty, default) = describe(p);
+            let _ = writeln!(out, "| `{}` | {ty} | {default} | {} |", p.name, cell(p.doc));
+        }
+    }
+    out.push('\n');
+    out.push_str(MEDIA_END);
+    out.push('\n');
+    out
+}
+
+/// `doc` with the part from the line `begin_marker` to the line
+/// `end_marker` (both included) replaced by `section`.
+pub fn splice_between(
+    doc: &str,
+    section: &str,
+    begin_marker: &str,
+    end_marker: &str,
+) -> Option<String> {
+    let begin = doc.find(begin_marker)?;
+    let end = doc[begin..].find(end_marker)? + begin + end_marker.len();
     let end = if doc[end..].starts_with('\n') {
         end + 1
     } else {

@@ -24,6 +24,9 @@ struct Graphics {
     textures: Rc<Textures>,
     area_light: Option<(usize, Loc)>,
     reverse: bool,
+    /// pbrt-v3's `currentInsideMedium`/`currentOutsideMedium` (names, ""
+    /// for none) and the `MediumInterface` statement that set them.
+    media: Rc<(String, String, Loc)>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -56,6 +59,8 @@ struct PendingShape {
     stmt: usize,
     ctm: [DMat4; 2],
     graphics: Graphics,
+    /// Resolved at the `Shape` statement, as pbrt-v3 does.
+    media: MediumInterfaceDesc,
 }
 
 struct ObjectDef {
@@ -117,6 +122,20 @@ pub struct Builder<'s, 'c> {
     pub instances: Vec<InstanceDesc>,
     pub skipped: Vec<String>,
     pub unsupported_shapes: usize,
+    /// Every medium `MakeNamedMedium` made, with its statement's location
+    /// and its index in `scene_media` once something refers to it.
+    medium_defs: Vec<(MediumDesc, Loc, Option<MediumId>)>,
+    /// The definition each name refers to now (a redefinition replaces it
+    /// for later statements, as pbrt-v3's `namedMedia[name] = medium`).
+    medium_names: HashMap<String, usize>,
+    /// Undefined medium names already reported, by the interface statement.
+    reported_media: HashSet<(String, u32, u32, u32)>,
+    pub scene_media: Vec<MediumDesc>,
+    pub camera_medium: Option<MediumId>,
+    /// The first `MediumInterface` statement (pbrt-v3's `haveScatteringMedia`).
+    pub first_medium_interface: Option<Loc>,
+    /// The outside medium named when the `Camera` statement was read.
+    camera_outside: Option<(String, Loc)>,
 }
 
 impl<'s, 'c> Builder<'s, 'c> {
@@ -135,6 +154,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 textures: Rc::new(Textures::default()),
                 area_light: None,
                 reverse: false,
+                media: Rc::new((String::new(), String::new(), Loc::default())),
             },
             stack: Vec::new(),
             camera: None,
@@ -166,6 +186,13 @@ impl<'s, 'c> Builder<'s, 'c> {
             instances: Vec::new(),
             skipped: Vec::new(),
             unsupported_shapes: 0,
+            medium_defs: Vec::new(),
+            medium_names: HashMap::new(),
+            reported_media: HashSet::new(),
+            scene_media: Vec::new(),
+            camera_medium: None,
+            first_medium_interface: None,
+            camera_outside: None,
         }
     }
 
@@ -349,6 +376,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             }
             K::Camera => {
                 self.camera = Some((i, self.ctm));
+                self.camera_outside = Some((self.graphics.media.1.clone(), s.loc));
                 let inv = self.ctm[0].inverse();
                 self.named_coords.insert("camera".into(), [inv, self.ctm[1].inverse()]);
             }
@@ -480,6 +508,14 @@ impl<'s, 'c> Builder<'s, 'c> {
                 if !self.ctm[0].is_finite() {
                     self.ctx.error(s.loc, "the light's transform has non-finite entries (overflow in the transform statements)", "this LightSource", None);
                 } else if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
+                    // pbrt-v3 resolves the interface for every light (its
+                    // media matter to bdpt only): undefined names are errors.
+                    let media = self.graphics.media.clone();
+                    for n in [&media.0, &media.1] {
+                        if !n.is_empty() && !self.medium_names.contains_key(n.as_str()) {
+                            self.medium_id(n, media.2);
+                        }
+                    }
                     self.lights.push(l);
                 }
                 self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
@@ -496,11 +532,26 @@ impl<'s, 'c> Builder<'s, 'c> {
                 }
             }
             K::Shape => self.shape(i, s),
-            K::MakeNamedMedium | K::MediumInterface => {
-                if let Some(p) = s.params() {
-                    p.mark_all_used();
+            K::MakeNamedMedium => {
+                let Directive::Entity { name, params } = &s.dir else { return };
+                if self.ctm[0] != self.ctm[1] {
+                    self.ctx.warn(s.loc, "animated medium transform: the start transform is used (as pbrt-v3)", "this MakeNamedMedium");
                 }
-                self.ctx.warn(s.loc, format!("`{}`: participating media are not supported by pbrs; ignored", s.kind.name()), "ignored");
+                if let Some(m) = super::medium::medium(self.ctx, name, params, self.ctm[0]) {
+                    if let Some(&old) = self.medium_names.get(&name.value) {
+                        let at = self.ctx.sources.position(self.medium_defs[old].1);
+                        self.ctx.warn(name.loc, format!("named medium \"{}\" redefined (first defined at {at}); later statements use the new definition", name.value), "redefinition");
+                    }
+                    self.medium_defs.push((m, name.loc, None));
+                    self.medium_names.insert(name.value.clone(), self.medium_defs.len() - 1);
+                }
+            }
+            K::MediumInterface => {
+                let Directive::MediumInterface(inside, outside) = &s.dir else { return };
+                // One name: the same medium on both sides (pbrt-v3's parser).
+                let outside = outside.as_ref().unwrap_or(inside);
+                self.graphics.media = Rc::new((inside.value.clone(), outside.value.clone(), s.loc));
+                self.first_medium_interface.get_or_insert(s.loc);
             }
             K::Include => {}
         }
@@ -553,6 +604,24 @@ impl<'s, 'c> Builder<'s, 'c> {
     }
 
     fn end_world(&mut self) {
+        // pbrt-v3 makes the camera at WorldEnd (RenderOptions::MakeCamera
+        // from pbrtWorldEnd) with the graphics state's medium interface of
+        // that moment: its outside medium is the camera's.
+        let graphics = self.graphics.clone();
+        let outside = graphics.media.1.clone();
+        self.camera_medium = self.medium_id(&outside, graphics.media.2);
+        if let Some((at_camera, loc)) = self.camera_outside.take() {
+            if at_camera != outside {
+                let shown = |n: &str| {
+                    if n.is_empty() {
+                        "none".to_string()
+                    } else {
+                        format!("\"{n}\"")
+                    }
+                };
+                self.ctx.warn(loc, format!("the camera's medium is the outside medium current at WorldEnd ({}), not the one current here ({}): pbrt-v3 makes the camera at WorldEnd, and pbrs does as pbrt-v3", shown(&outside), shown(&at_camera)), "camera medium");
+            }
+        }
         if let Some((name, def)) = self.current_object.take() {
             self.ctx.warn(def.loc, format!("object \"{name}\" is not closed by ObjectEnd before the end of the world block; its definition is dropped"), "ObjectBegin without ObjectEnd");
         }
@@ -571,6 +640,11 @@ impl<'s, 'c> Builder<'s, 'c> {
     }
 
     fn instance(&mut self, n: &Name) {
+        let media = self.graphics.media.clone();
+        if media.0 != media.1 {
+            let at = self.ctx.sources.position(media.2);
+            self.ctx.warn(n.loc, format!("the MediumInterface current here (set at {at}) does not apply to the instance (as pbrt-v3): its shapes keep the interfaces current at their Shape statements inside ObjectBegin"), "interface ignored for this instance");
+        }
         if let Some((outer, _)) = &self.current_object {
             let outer = outer.clone();
             self.ctx.error(n.loc, format!("ObjectInstance \"{}\" inside the definition of object \"{outer}\" (pbrt-v3 does not allow it)", n.value), "inside ObjectBegin", None);
@@ -599,7 +673,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                         self.ctx.warn(loc, "animated shape transform inside an object definition: pbrs does not nest motion in instances; the start transform is used (animate the ObjectInstance instead)", "this Shape");
                         ctm[1] = ctm[0];
                     }
-                    shapes.extend(self.build_shape(p.stmt, ctm, &p.graphics, None));
+                    shapes.extend(self.build_shape(p.stmt, ctm, &p.graphics, None, p.media));
                 }
                 self.scene_objects.push(ObjectDesc {
                     name: n.value.clone(),
@@ -626,16 +700,21 @@ impl<'s, 'c> Builder<'s, 'c> {
     }
 
     fn shape(&mut self, i: usize, s: &'s Stmt) {
-        if let Some((name, def)) = &mut self.current_object {
+        if let Some((name, _)) = &self.current_object {
             if self.graphics.area_light.is_some() {
                 let name = name.clone();
                 self.ctx.warn(s.loc, format!("area light inside the definition of object \"{name}\" is ignored (as pbrt-v3)"), "this shape is not emissive");
             }
-            def.shapes.push(PendingShape {
-                stmt: i,
-                ctm: self.ctm,
-                graphics: self.graphics.clone(),
-            });
+            let graphics = self.graphics.clone();
+            let media = self.medium_interface(&graphics);
+            if let Some((_, def)) = &mut self.current_object {
+                def.shapes.push(PendingShape {
+                    stmt: i,
+                    ctm: self.ctm,
+                    graphics,
+                    media,
+                });
+            }
             return;
         }
         let graphics = self.graphics.clone();
@@ -652,7 +731,8 @@ impl<'s, 'c> Builder<'s, 'c> {
                 );
             }
         }
-        if let Some(shape) = self.build_shape(i, self.ctm, &graphics, area) {
+        let media = self.medium_interface(&graphics);
+        if let Some(shape) = self.build_shape(i, self.ctm, &graphics, area, media) {
             self.shapes.push(shape);
         }
     }
@@ -697,6 +777,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         ctms: [DMat4; 2],
         g: &Graphics,
         area: Option<usize>,
+        medium_interface: MediumInterfaceDesc,
     ) -> Option<ShapeDesc> {
         let stmts = self.stmts;
         let Directive::Entity { name, params } = &stmts[i].dir else {
@@ -756,7 +837,56 @@ impl<'s, 'c> Builder<'s, 'c> {
             area_light,
             alpha,
             shadow_alpha,
+            medium_interface,
         })
+    }
+
+    /// pbrt-v3's `CreateMediumInterface`: the current inside and outside
+    /// media by name ("" is none); an undefined name is an error (once per
+    /// `MediumInterface` statement and name) and no medium.
+    fn medium_interface(&mut self, g: &Graphics) -> MediumInterfaceDesc {
+        let (inside, outside, loc) = &*g.media.clone();
+        MediumInterfaceDesc {
+            inside: self.medium_id(inside, *loc),
+            outside: self.medium_id(outside, *loc),
+        }
+    }
+
+    fn medium_id(&mut self, name: &str, loc: Loc) -> Option<MediumId> {
+        if name.is_empty() {
+            return None;
+        }
+        let Some(&def) = self.medium_names.get(name) else {
+            if self
+                .reported_media
+                .insert((name.to_string(), loc.file, loc.start, loc.chain))
+            {
+                let names: Vec<&str> = self.medium_names.keys().map(String::as_str).collect();
+                let help = closest_name(name, &names)
+                    .map(|c| format!("did you mean \"{c}\"?"))
+                    .or_else(|| {
+                        Some(if names.is_empty() {
+                            "no medium is defined before this point (MakeNamedMedium)".into()
+                        } else {
+                            format!("defined here: {}", names.join(", "))
+                        })
+                    });
+                self.ctx.error(
+                    loc,
+                    format!("named medium \"{name}\" undefined (pbrt-v3 reports the same error)"),
+                    "not defined by MakeNamedMedium before its use",
+                    help,
+                );
+            }
+            return None;
+        };
+        if let Some(id) = self.medium_defs[def].2 {
+            return Some(id);
+        }
+        let id = MediumId(self.scene_media.len() as u32);
+        self.scene_media.push(self.medium_defs[def].0.clone());
+        self.medium_defs[def].2 = Some(id);
+        Some(id)
     }
 
     fn area_light(&mut self, i: usize) -> AreaLightDesc {
@@ -918,6 +1048,23 @@ impl<'s, 'c> Builder<'s, 'c> {
         let filter = entities::filter(self.ctx, ent(self.filter));
         let sampler = entities::sampler(self.ctx, ent(self.sampler));
         let integrator = entities::integrator(self.ctx, ent(self.integrator));
+        if let Some(loc) = self.first_medium_interface {
+            // pbrt-v3's warning for integrators without volume scattering.
+            let name = match integrator {
+                IntegratorDesc::VolPath { .. } => None,
+                IntegratorDesc::Path { .. } => Some("path"),
+                IntegratorDesc::DirectLighting { .. } => Some("directlighting"),
+                IntegratorDesc::Whitted { .. } => Some("whitted"),
+            };
+            if let Some(name) = name {
+                self.ctx.warn(loc, format!("the scene has participating media but the \"{name}\" integrator ignores them (as pbrt-v3's): use \"volpath\" to render them"), "media ignored by this integrator");
+            }
+        }
+        for (m, loc, id) in &self.medium_defs {
+            if id.is_none() {
+                self.skipped.push(format!("named medium \"{}\" (defined at {}): not used by the camera or any shape, not built", m.name, self.ctx.sources.position(*loc)));
+            }
+        }
         if let Some((name, params)) = ent(self.accelerator) {
             params.mark_all_used();
             self.skipped.push(format!(

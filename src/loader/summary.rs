@@ -44,6 +44,12 @@ pub struct Summary {
     pub moving_camera: bool,
     pub shutter: (f32, f32),
     pub warnings: usize,
+    /// Media built, one line each: name, type, coefficients.
+    pub media: Vec<String>,
+    /// The camera's medium, if any.
+    pub camera_medium: Option<String>,
+    /// World shapes that are medium transitions (different media inside and out).
+    pub medium_boundaries: usize,
 }
 
 impl Summary {
@@ -128,7 +134,33 @@ impl Summary {
             }
             IntegratorDesc::DirectLighting { max_depth, strategy } => format!("directlighting, maxdepth {max_depth}, strategy {strategy:?}").to_lowercase(),
             IntegratorDesc::Whitted { max_depth } => format!("whitted, maxdepth {max_depth}"),
+            IntegratorDesc::VolPath { max_depth, rr_threshold, light_sample_strategy } => {
+                format!("volpath, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}").to_lowercase()
+            }
         };
+        for m in &scene.media {
+            let v = |c: glam::Vec3| format!("{} {} {}", c.x, c.y, c.z);
+            let kind = match &m.kind {
+                MediumKind::Homogeneous => "homogeneous".to_string(),
+                MediumKind::Grid { nx, ny, nz, .. } => format!("heterogeneous {nx}×{ny}×{nz}"),
+            };
+            s.media.push(format!(
+                "\"{}\": {kind}, sigma_a {}, sigma_s {}, g {}",
+                m.name,
+                v(m.sigma_a),
+                v(m.sigma_s),
+                m.g
+            ));
+        }
+        s.camera_medium = scene
+            .camera_medium
+            .and_then(|id| scene.media.get(id.0 as usize))
+            .map(|m| m.name.clone());
+        s.medium_boundaries = scene
+            .shapes
+            .iter()
+            .filter(|sh| sh.medium_interface.is_transition())
+            .count();
         for sh in &scene.shapes {
             s.shapes += 1;
             *s.shapes_by_type
@@ -296,6 +328,20 @@ impl fmt::Display for Summary {
                 "objects:    {} ({} shapes, {} triangles), {} instances",
                 self.objects, self.object_shapes, self.object_triangles, self.instances
             )?;
+        }
+        if !self.media.is_empty() {
+            writeln!(
+                f,
+                "media:      {} (camera in {}; {} shapes are medium boundaries)",
+                self.media.len(),
+                self.camera_medium
+                    .as_ref()
+                    .map_or("none".to_string(), |n| format!("\"{n}\"")),
+                self.medium_boundaries
+            )?;
+            for m in &self.media {
+                writeln!(f, "            {m}")?;
+            }
         }
         if self.moving_shapes + self.moving_instances > 0 || self.moving_camera {
             writeln!(

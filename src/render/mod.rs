@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod integrators;
 pub mod lights;
 pub mod materials;
+pub mod media;
 pub mod samplers;
 pub mod sampling;
 pub mod scene;

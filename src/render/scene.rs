@@ -7,12 +7,16 @@ use crate::render::camera::Camera;
 use crate::render::geometry::Frame;
 use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
 use crate::render::materials::{link_materials, Material};
+use crate::render::media::Medium;
 use crate::render::shapes::{
     AlphaMask, Cone, Curve, CurveCommon, Cylinder, Disk, Hyperboloid, Paraboloid, Quadric, Sphere,
     TriangleMesh,
 };
-use crate::scene::{self, AreaLightDesc, LightDesc, SceneDescription, ShapeDesc};
+use crate::scene::{
+    self, AreaLightDesc, LightDesc, MediumInterfaceDesc, SceneDescription, ShapeDesc,
+};
 use glam::{DMat3, DMat4, DVec3, Vec3};
+use std::collections::HashMap;
 use std::sync::Arc;
 
 pub struct RenderScene {
@@ -30,12 +34,72 @@ pub struct RenderScene {
     pub differentials: bool,
     /// What was built and what was skipped, for `--stats`.
     pub notes: Vec<String>,
+    /// The scene's media (indices are the description's `MediumId`s).
+    pub media: Vec<Medium>,
+    /// The medium the camera is in.
+    pub camera_medium: Option<u32>,
+    /// By material slot: the media on either side of the surfaces that
+    /// use it, for shapes that are medium transitions (`None`: rays keep
+    /// their medium). A shape that is a transition gets a slot of its own
+    /// per (material, interface), a copy of its material, so that hits
+    /// find their interface from the material index they carry anyway:
+    /// nothing is added to hits or primitives, and scenes without media
+    /// never look at this table.
+    pub surface_media: Vec<Option<SurfaceMedia>>,
+    /// Some material is `none` (rays pass through it).
+    pub has_pass_through: bool,
+}
+
+/// The media on the two sides of a surface (pbrt-v3's `MediumInterface`
+/// of a transition); `None` is vacuum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceMedia {
+    pub inside: Option<u32>,
+    pub outside: Option<u32>,
+}
+
+/// Material slots for the shapes that are medium transitions.
+struct Slots {
+    map: HashMap<(u32, MediumInterfaceDesc), u32>,
+}
+
+impl Slots {
+    fn of(&self, s: &ShapeDesc) -> u32 {
+        if s.medium_interface.is_transition() {
+            self.map[&(s.material.0, s.medium_interface)]
+        } else {
+            s.material.0
+        }
+    }
 }
 
 impl RenderScene {
     pub fn new(desc: &SceneDescription) -> RenderScene {
         let mut materials: Vec<Material> = desc.materials.iter().map(Material::new).collect();
         link_materials(&mut materials);
+        let mut surface_media: Vec<Option<SurfaceMedia>> = vec![None; materials.len()];
+        let mut slots = Slots {
+            map: HashMap::new(),
+        };
+        let all_shapes = desc
+            .shapes
+            .iter()
+            .chain(desc.objects.iter().flat_map(|o| o.shapes.iter()));
+        for s in all_shapes {
+            let mi = s.medium_interface;
+            if !mi.is_transition() {
+                continue;
+            }
+            slots.map.entry((s.material.0, mi)).or_insert_with(|| {
+                materials.push(materials[s.material.0 as usize].clone());
+                surface_media.push(Some(SurfaceMedia {
+                    inside: mi.inside.map(|m| m.0),
+                    outside: mi.outside.map(|m| m.0),
+                }));
+                (materials.len() - 1) as u32
+            });
+        }
+        let slots = slots;
         let mut meshes = Vec::new();
         let mut quadrics = Vec::new();
         let mut area: Vec<(AreaShape, AreaLightDesc)> = Vec::new();
@@ -46,7 +110,7 @@ impl RenderScene {
             match &s.geometry {
                 scene::Geometry::TriangleMesh(m) => {
                     let mesh_index = meshes.len() as u32;
-                    let mut tm = world_mesh(m, to_world, s);
+                    let mut tm = world_mesh(m, to_world, s, slots.of(s));
                     if let Some(a) = emit {
                         tm.first_light = Some(area.len() as u32);
                         for tri in 0..tm.triangle_count() {
@@ -62,9 +126,11 @@ impl RenderScene {
                     meshes.push(tm);
                 }
                 // Curves never emit (the loader warned).
-                scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, to_world, s)),
+                scene::Geometry::Curve(c) => {
+                    quadrics.extend(curve_pieces(c, to_world, s, slots.of(s)))
+                }
                 g => {
-                    let Some(mut q) = quadric(g, to_world, s) else {
+                    let Some(mut q) = quadric(g, to_world, s, slots.of(s)) else {
                         return;
                     };
                     if let Some(a) = emit {
@@ -85,7 +151,8 @@ impl RenderScene {
             match &s.motion {
                 None => add_shape(s, s.object_to_world),
                 Some(m) => {
-                    let obj = Arc::new(object(std::slice::from_ref(s), |_| DMat4::IDENTITY));
+                    let obj =
+                        Arc::new(object(std::slice::from_ref(s), |_| DMat4::IDENTITY, &slots));
                     match MovingInstance::new(obj, m.clone()) {
                         Some(i) => moving.push(i),
                         None => singular_moving += 1,
@@ -103,7 +170,7 @@ impl RenderScene {
                 if !desc.instances.iter().any(|inst| inst.object == i) {
                     return None;
                 }
-                Some(Arc::new(object(&obj.shapes, |s| s.object_to_world)))
+                Some(Arc::new(object(&obj.shapes, |s| s.object_to_world, &slots)))
             })
             .collect();
         let mut instances = Vec::with_capacity(desc.instances.len());
@@ -273,6 +340,15 @@ impl RenderScene {
         }
         let material_needs_geom = materials.iter().map(Material::needs_geom).collect();
         let differentials = materials.iter().any(|m| m.needs_geom());
+        let media: Vec<Medium> = desc.media.iter().map(Medium::new).collect();
+        if !media.is_empty() {
+            notes.push(format!(
+                "media: {} ({} material slots for medium boundaries)",
+                media.len(),
+                surface_media.iter().flatten().count()
+            ));
+        }
+        let has_pass_through = materials.iter().any(Material::is_none);
         RenderScene {
             geometry,
             materials,
@@ -282,6 +358,10 @@ impl RenderScene {
             camera,
             differentials,
             notes,
+            media,
+            camera_medium: desc.camera_medium.map(|m| m.0),
+            surface_media,
+            has_pass_through,
         }
     }
 }
@@ -289,15 +369,16 @@ impl RenderScene {
 /// Builds an object's shapes in object space (each placed there by
 /// `to_object`) and its BVH. Area lights are never set inside objects
 /// (pbrt-v3 ignores them there).
-fn object(shapes: &[ShapeDesc], to_object: impl Fn(&ShapeDesc) -> DMat4) -> Object {
+fn object(shapes: &[ShapeDesc], to_object: impl Fn(&ShapeDesc) -> DMat4, slots: &Slots) -> Object {
     let mut meshes = Vec::new();
     let mut quadrics = Vec::new();
     for s in shapes {
         let m4 = to_object(s);
+        let material = slots.of(s);
         match &s.geometry {
-            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s)),
-            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, m4, s)),
-            g => quadrics.extend(quadric(g, m4, s)),
+            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s, material)),
+            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, m4, s, material)),
+            g => quadrics.extend(quadric(g, m4, s, material)),
         }
     }
     Object::new(meshes, quadrics)
@@ -309,8 +390,9 @@ fn curve_pieces<'a>(
     c: &'a scene::CurveData,
     to_world: DMat4,
     s: &ShapeDesc,
+    material: u32,
 ) -> impl Iterator<Item = Quadric> + 'a {
-    let (reverse, material) = (s.reverse_orientation, s.material.0);
+    let reverse = s.reverse_orientation;
     c.segments.iter().flat_map(move |seg| {
         let common = Arc::new(CurveCommon::new(
             c.kind,
@@ -326,8 +408,8 @@ fn curve_pieces<'a>(
 
 /// An analytic shape in the space `to_world` maps to (`None` for meshes and
 /// curves).
-fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadric> {
-    let (reverse, material) = (s.reverse_orientation, s.material.0);
+fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc, material: u32) -> Option<Quadric> {
+    let reverse = s.reverse_orientation;
     Some(match *g {
         scene::Geometry::TriangleMesh(_) | scene::Geometry::Curve(_) => return None,
         scene::Geometry::Sphere {
@@ -384,8 +466,8 @@ fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc) -> Option<Quadri
 /// Transform an object-space mesh to world space (positions in f64 before
 /// rounding; normals by the inverse transpose), with the shape's material,
 /// orientation and alpha masks.
-fn world_mesh(m: &scene::MeshData, to_world: DMat4, s: &ShapeDesc) -> TriangleMesh {
-    let (reverse, material) = (s.reverse_orientation, s.material.0);
+fn world_mesh(m: &scene::MeshData, to_world: DMat4, s: &ShapeDesc, material: u32) -> TriangleMesh {
+    let reverse = s.reverse_orientation;
     let p = m
         .positions
         .iter()

@@ -40,9 +40,65 @@ pub struct SceneDescription {
     pub objects: Vec<ObjectDesc>,
     /// Placements of objects.
     pub instances: Vec<InstanceDesc>,
+    /// Participating media referenced by the camera or by a shape's
+    /// interface (by index: [`MediumId`]).
+    pub media: Vec<MediumDesc>,
+    /// The camera's medium (pbrt-v3: the outside medium of the graphics
+    /// state when the camera is made, at WorldEnd).
+    pub camera_medium: Option<MediumId>,
     /// Human-readable notes on what was left out and why (unreferenced named
     /// materials, objects never instanced, ...), for `--check` and `--stats`.
     pub skipped: Vec<String>,
+}
+
+/// Index into [`SceneDescription::media`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct MediumId(pub u32);
+
+/// A medium: pbrt-v3's `HomogeneousMedium` or `GridDensityMedium`, with
+/// `scale` already applied to both coefficients (per unit length).
+#[derive(Clone, Debug)]
+pub struct MediumDesc {
+    /// The name given to `MakeNamedMedium` (for messages and `--check`).
+    pub name: String,
+    pub sigma_a: Vec3,
+    pub sigma_s: Vec3,
+    /// Henyey–Greenstein asymmetry, in (-1, 1).
+    pub g: f32,
+    pub kind: MediumKind,
+}
+
+#[derive(Clone, Debug)]
+pub enum MediumKind {
+    Homogeneous,
+    /// A density grid over the unit cube of its own space, which
+    /// `medium_to_world` maps to the world (the CTM at `MakeNamedMedium`
+    /// times pbrt-v3's `Translate(p0) * Scale(p1 - p0)`). `density` has
+    /// `nx * ny * nz` values, x fastest.
+    Grid {
+        nx: u32,
+        ny: u32,
+        nz: u32,
+        density: Arc<Vec<f32>>,
+        medium_to_world: DMat4,
+    },
+}
+
+/// pbrt-v3's `MediumInterface` of a shape: the media on the side its
+/// normal points away from (`inside`) and towards (`outside`); `None` is
+/// vacuum. A shape whose two media are the same is no transition: rays
+/// keep the medium they are in when they cross it (as pbrt-v3's
+/// `GeometricPrimitive::Intersect`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct MediumInterfaceDesc {
+    pub inside: Option<MediumId>,
+    pub outside: Option<MediumId>,
+}
+
+impl MediumInterfaceDesc {
+    pub fn is_transition(&self) -> bool {
+        self.inside != self.outside
+    }
 }
 
 /// Index into [`SceneDescription::materials`].
@@ -207,6 +263,12 @@ pub enum IntegratorDesc {
     Whitted {
         max_depth: u32,
     },
+    /// pbrt-v3's `volpath`: the path tracer with participating media.
+    VolPath {
+        max_depth: u32,
+        rr_threshold: f32,
+        light_sample_strategy: LightSampleStrategy,
+    },
 }
 
 /// A material: its kind (a name in `render::materials::MATERIALS`) and the
@@ -255,6 +317,9 @@ pub struct ShapeDesc {
     /// pbrt-v3's `shadowalpha`: hits where it is 0 are ignored by shadow
     /// rays.
     pub shadow_alpha: Option<FloatTex>,
+    /// The media on either side (the `MediumInterface` current at the
+    /// shape).
+    pub medium_interface: MediumInterfaceDesc,
 }
 
 #[derive(Clone, Debug)]

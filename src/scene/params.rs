@@ -65,6 +65,12 @@ pub enum ParamKind {
     /// Known to pbrt-v3 but not evaluated by pbrs yet: the loader warns
     /// when it is given, naming the reason.
     Unsupported(&'static str),
+    /// A plain spectrum value (no texture), e.g. a medium's `sigma_a`.
+    Spectrum([f32; 3]),
+    /// A `point3` (or `point`) value.
+    Point3([f32; 3]),
+    /// A list of floats of any length, e.g. a grid medium's `density`.
+    Floats,
 }
 
 /// A constraint the loader checks on constant values (with a located
@@ -253,6 +259,34 @@ impl ParamSpec {
             name,
             kind: ParamKind::SameValue(default),
             range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn spectrum_value(
+        name: &'static str,
+        default: [f32; 3],
+        doc: &'static str,
+    ) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Spectrum(default),
+            range: Range::NonNegative,
+            doc,
+        }
+    }
+    pub const fn point3(name: &'static str, default: [f32; 3], doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Point3(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn floats(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Floats,
+            range: Range::NonNegative,
             doc,
         }
     }

@@ -1,5 +1,6 @@
 //! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
-//! power-heuristic MIS, Russian roulette), `directlighting` (strategy all or
+//! power-heuristic MIS, Russian roulette), `volpath` (the same with
+//! participating media, in [`volpath`]), `directlighting` (strategy all or
 //! one, specular lobes followed recursively) and `whitted`.
 
 use crate::render::accel::{Hit, SurfaceHit};
@@ -16,6 +17,7 @@ use crate::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
 use glam::{Vec2, Vec3};
 
 mod all_lights;
+mod volpath;
 
 /// Rays traced, counted per tile and summed at the end (no shared counters).
 #[derive(Clone, Copy, Debug, Default)]
@@ -84,6 +86,11 @@ pub enum Integrator {
     Whitted {
         max_depth: u32,
     },
+    VolPath {
+        max_depth: u32,
+        rr_threshold: f32,
+        lights: LightSampler,
+    },
 }
 
 impl Integrator {
@@ -128,6 +135,22 @@ impl Integrator {
                 },
             },
             IntegratorDesc::Whitted { max_depth } => Integrator::Whitted { max_depth },
+            IntegratorDesc::VolPath {
+                max_depth,
+                rr_threshold,
+                light_sample_strategy,
+            } => {
+                let kind = match light_sample_strategy {
+                    LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
+                    LightSampleStrategy::Power => LightSamplerKind::Power,
+                    LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
+                };
+                Integrator::VolPath {
+                    max_depth,
+                    rr_threshold,
+                    lights: LightSampler::new(kind, &scene.lights, &scene.geometry),
+                }
+            }
         }
     }
 
@@ -172,7 +195,9 @@ impl Integrator {
 
     pub fn light_sampler(&self) -> Option<&LightSampler> {
         match self {
-            Integrator::Path { lights, .. } | Integrator::Direct { lights, .. } => Some(lights),
+            Integrator::Path { lights, .. }
+            | Integrator::Direct { lights, .. }
+            | Integrator::VolPath { lights, .. } => Some(lights),
             Integrator::Whitted { .. } => None,
         }
     }
@@ -197,6 +222,21 @@ impl Integrator {
                 rr_threshold,
                 lights,
             } => path_li(
+                ray,
+                time,
+                diff,
+                scene,
+                sampler,
+                scratch,
+                *max_depth,
+                *rr_threshold,
+                lights,
+            ),
+            Integrator::VolPath {
+                max_depth,
+                rr_threshold,
+                lights,
+            } => volpath::volpath_li(
                 ray,
                 time,
                 diff,
@@ -338,7 +378,9 @@ impl Integrator {
                     }
                     max_depth
                 }
-                Integrator::Path { .. } => unreachable!("path is not recursive"),
+                Integrator::Path { .. } | Integrator::VolPath { .. } => {
+                    unreachable!("path and volpath are not recursive")
+                }
             };
             l += w.beta * local;
             if w.depth + 1 < max_depth {
