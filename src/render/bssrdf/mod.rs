@@ -5,10 +5,14 @@
 //! - [`tabulated`]: `TabulatedBSSRDF`'s Sr, Sample_Sr, Pdf_Sr and the
 //!   separable BSSRDF's Sw.
 //!
-//! Still to come (see the branch's WIP notes): probe-ray sampling of the
-//! exit point (Sample_Sp, Pdf_Sp), the Sw adapter BxDF and the integrator
+//! - [`probe`]: the geometry of probe-ray sampling (Sample_Sp's axis,
+//!   channel and segment; Pdf_Sp).
+//!
+//! The Sw adapter lobe is `bxdf::SwAdapter`. Still to come (see the
+//! branch's WIP notes): the probe intersection loop and the integrator
 //! hooks.
 
+pub mod probe;
 pub mod table;
 pub mod tabulated;
 

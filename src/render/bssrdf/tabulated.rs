@@ -130,9 +130,15 @@ impl<'a> TabulatedBssrdf<'a> {
     /// its cosine-weighted hemispherical integral is 1.
     #[inline]
     pub fn sw(&self, cos_theta: f32) -> f32 {
-        let c = 1.0 - 2.0 * fresnel_moment1(1.0 / self.eta);
-        (1.0 - fr_dielectric(cos_theta, 1.0, self.eta)) / (c * PI)
+        sw(self.eta, cos_theta)
     }
+}
+
+/// `Sw` for a boundary of index `eta` (see [`TabulatedBssrdf::sw`]).
+#[inline]
+pub fn sw(eta: f32, cos_theta: f32) -> f32 {
+    let c = 1.0 - 2.0 * fresnel_moment1(1.0 / eta);
+    (1.0 - fr_dielectric(cos_theta, 1.0, eta)) / (c * PI)
 }
 
 #[cfg(test)]
