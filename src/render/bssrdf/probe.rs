@@ -11,12 +11,16 @@
 //! the disk point, along the axis: from `p + r(x cosφ + y sinφ) − (l/2) z`
 //! to `+ (l/2) z`, `l = 2√(r_max² − r²)`.
 //!
-//! The intersection loop (tracing the probe with the scene's error-bounded
-//! spawn functions, keeping hits of the same material, choosing one
-//! uniformly) is the integrators' part: see `ProbeSegment`.
+//! [`find_exit`] traces the probe (pbrt-v3's intersection chain) with the
+//! error-bounded spawn functions, keeping hits of the entry point's
+//! material, and picks one uniformly. pbrt-v3 stores the chain in its
+//! arena; to allocate nothing, pbrs traces the probe twice: once to count
+//! the admissible hits, once to stop at the chosen one (same choice, same
+//! hit, twice the probe rays).
 
 use super::tabulated::TabulatedBssrdf;
-use crate::render::geometry::Frame;
+use crate::render::accel::{Geometry, SurfaceHit};
+use crate::render::geometry::{spawn_ray_to_point, Frame, Ray, SHADOW_EPSILON};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -73,6 +77,74 @@ pub fn probe_segment(
         u_choice: u1,
         channel: ch,
     })
+}
+
+/// Hits along one probe beyond which the walk stops (pbrt-v3 has no bound;
+/// a closed surface crosses a chord a handful of times).
+const MAX_PROBE_HITS: u32 = 64;
+
+/// Walks the probe from `seg.start` to `seg.end` at `time`, calling
+/// `visit(k, hit)` with the running count `k` of admissible hits (of
+/// `material`) for each; stops when `visit` returns true. Returns the
+/// number of admissible hits seen.
+fn walk(
+    geometry: &Geometry,
+    seg: &ProbeSegment,
+    material: u32,
+    time: f32,
+    mut visit: impl FnMut(u32, &SurfaceHit) -> bool,
+) -> u32 {
+    // The first ray leaves a point in space (pbrt-v3's bare Interaction:
+    // no error bounds, no offset).
+    let mut ray = Ray {
+        o: seg.start,
+        d: seg.end - seg.start,
+        t_max: 1.0 - SHADOW_EPSILON,
+    };
+    let mut found = 0;
+    for _ in 0..MAX_PROBE_HITS {
+        if ray.d == Vec3::ZERO {
+            break;
+        }
+        let Some(hit) = geometry.intersect_at(&ray, time) else {
+            break;
+        };
+        let s = geometry.surface_at(&hit, time);
+        if s.material == material {
+            if visit(found, &s) {
+                return found + 1;
+            }
+            found += 1;
+        }
+        ray = spawn_ray_to_point(s.point.p, s.point.p_error, s.point.n, seg.end);
+    }
+    found
+}
+
+/// pbrt-v3's choice of one exit point along the probe: the admissible hits
+/// (same `material` as the entry point) and the chosen one, or `None` if
+/// the probe finds none. The caller divides [`pdf_sp`] by the count.
+pub fn find_exit(
+    geometry: &Geometry,
+    seg: &ProbeSegment,
+    material: u32,
+    time: f32,
+) -> Option<(SurfaceHit, u32)> {
+    let n = walk(geometry, seg, material, time, |_, _| false);
+    if n == 0 {
+        return None;
+    }
+    let selected = ((seg.u_choice * n as f32) as u32).min(n - 1);
+    let mut chosen = None;
+    walk(geometry, seg, material, time, |k, s| {
+        if k == selected {
+            chosen = Some(*s);
+            true
+        } else {
+            false
+        }
+    });
+    chosen.map(|s| (s, n))
 }
 
 /// pbrt-v3's `Pdf_Sp`: the density (per unit area) of having sampled exit
