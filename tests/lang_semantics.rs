@@ -1,5 +1,8 @@
 //! Scene building semantics, as pbrt-v3 defines them (see grammar/REFERENCE.md).
 
+mod common;
+
+use common::{error_text as errors, load_text as load, warning_text as warnings};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
 use pbrs::scene::*;
@@ -10,30 +13,6 @@ fn tmpdir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("pbrs-lang-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn load(text: &str) -> LoadedScene {
-    load_scene_str(text, Path::new("mem.pbrt")).unwrap_or_else(|f| panic!("{f:?}"))
-}
-
-fn warnings(s: &LoadedScene) -> String {
-    s.warnings
-        .iter()
-        .map(|w| w.to_string())
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
-fn errors(text: &str) -> String {
-    match load_scene_str(text, Path::new("mem.pbrt")) {
-        Ok(_) => panic!("loaded:\n{text}"),
-        Err(f) => f
-            .errors
-            .iter()
-            .map(|w| w.to_string())
-            .collect::<Vec<_>>()
-            .join("\n"),
-    }
 }
 
 fn close(a: DVec3, b: DVec3) -> bool {

@@ -8,6 +8,9 @@
 //! matrix). The same computation with pbrt-v3's own CIE table differs by at
 //! most 4e-6, so the tolerance below also accepts pbrt-v3's numbers.
 
+mod common;
+
+use common::warning_text as warnings;
 use glam::Vec3;
 use pbrs::lang::FileLoader;
 use pbrs::loader::{load_scene_str, load_scene_with, LoadedScene};
@@ -20,14 +23,6 @@ const TOL: f32 = 1e-5;
 
 fn inputs() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inputs")
-}
-
-fn warnings(s: &LoadedScene) -> String {
-    s.warnings
-        .iter()
-        .map(|w| w.to_string())
-        .collect::<Vec<_>>()
-        .join("\n")
 }
 
 /// The matte Kd of a one-sphere scene with `kd` as its Kd parameter.

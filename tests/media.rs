@@ -6,8 +6,9 @@
 
 mod common;
 
+use common::{error_text as errors, load_text as load, warning_text as warnings};
+
 use glam::{DMat4, Vec2, Vec3};
-use pbrs::loader::{load_scene_str, LoadedScene};
 use pbrs::render::driver::{render, RenderOptions};
 use pbrs::render::film::compare::compare;
 use pbrs::render::film::Image;
@@ -16,32 +17,7 @@ use pbrs::render::media::{phase_hg, HenyeyGreenstein, Medium, MEDIA};
 use pbrs::render::samplers::Sampler;
 use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::scene::{MediumDesc, MediumKind, SamplerDesc, SamplerKind, SceneDescription};
-use std::path::Path;
 use std::sync::Arc;
-
-fn load(text: &str) -> LoadedScene {
-    load_scene_str(text, Path::new("mem.pbrt")).unwrap_or_else(|f| panic!("{f:?}"))
-}
-
-fn warnings(s: &LoadedScene) -> String {
-    s.warnings
-        .iter()
-        .map(|w| w.to_string())
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
-fn errors(text: &str) -> String {
-    match load_scene_str(text, Path::new("mem.pbrt")) {
-        Ok(_) => panic!("loaded, but should not:\n{text}"),
-        Err(f) => f
-            .errors
-            .iter()
-            .map(|e| e.to_string())
-            .collect::<Vec<_>>()
-            .join("\n"),
-    }
-}
 
 fn render_desc(desc: &SceneDescription, seed: u64) -> Image {
     let (img, stats) = render(

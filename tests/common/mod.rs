@@ -292,3 +292,31 @@ pub fn world_errors(path: &Path, body: &str) -> String {
             .join("\n"),
     }
 }
+
+/// A scene given as text (as if from the file `mem.pbrt`), which must load.
+pub fn load_text(text: &str) -> pbrs::loader::LoadedScene {
+    pbrs::loader::load_scene_str(text, Path::new("mem.pbrt")).unwrap_or_else(|f| panic!("{f:?}"))
+}
+
+/// A loaded scene's warnings, one message per line.
+pub fn warning_text(s: &pbrs::loader::LoadedScene) -> String {
+    s.warnings
+        .iter()
+        .map(|w| w.to_string())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The errors of a scene given as text (as if from `mem.pbrt`) that must not
+/// load, one message per line.
+pub fn error_text(text: &str) -> String {
+    match pbrs::loader::load_scene_str(text, Path::new("mem.pbrt")) {
+        Ok(_) => panic!("loaded, but should not:\n{text}"),
+        Err(f) => f
+            .errors
+            .iter()
+            .map(|e| e.to_string())
+            .collect::<Vec<_>>()
+            .join("\n"),
+    }
+}

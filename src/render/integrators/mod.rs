@@ -8,7 +8,9 @@ use crate::render::geometry::{spawn_ray, Ray, RayDiff};
 use crate::render::lights::{
     pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
 };
-use crate::render::materials::{Bsdf, BsdfContext, BxdfFlags, Material, ShadingContext};
+use crate::render::materials::{
+    Bsdf, BsdfContext, BsdfSample, BxdfFlags, Material, ShadingContext,
+};
 use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
@@ -93,6 +95,15 @@ pub enum Integrator {
     },
 }
 
+/// The light distribution a `lightsamplestrategy` names.
+fn light_sampler_kind(s: LightSampleStrategy) -> LightSamplerKind {
+    match s {
+        LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
+        LightSampleStrategy::Power => LightSamplerKind::Power,
+        LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
+    }
+}
+
 impl Integrator {
     /// Builds the integrator and only the light distribution it uses;
     /// `simd` allows the four-lane paths (which give the same image).
@@ -103,11 +114,7 @@ impl Integrator {
                 rr_threshold,
                 light_sample_strategy,
             } => {
-                let kind = match light_sample_strategy {
-                    LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
-                    LightSampleStrategy::Power => LightSamplerKind::Power,
-                    LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
-                };
+                let kind = light_sampler_kind(light_sample_strategy);
                 Integrator::Path {
                     max_depth,
                     rr_threshold,
@@ -140,11 +147,7 @@ impl Integrator {
                 rr_threshold,
                 light_sample_strategy,
             } => {
-                let kind = match light_sample_strategy {
-                    LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
-                    LightSampleStrategy::Power => LightSamplerKind::Power,
-                    LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
-                };
+                let kind = light_sampler_kind(light_sample_strategy);
                 Integrator::VolPath {
                     max_depth,
                     rr_threshold,
@@ -557,34 +560,14 @@ fn path_li(
     loop {
         scratch.counts.closest += 1;
         let hit = scene.geometry.intersect_at(&ray, time);
+        let from = prev.filter(|_| !specular_bounce);
         let Some(hit) = hit else {
-            for &i in &scene.infinite_lights {
-                let light = &scene.lights[i as usize];
-                let le = light.le(ray.d);
-                let w = match prev {
-                    Some(r) if !specular_bounce => {
-                        bsdf_mis_weight(scene, lights, &r, i, ray.d, bsdf_pdf)
-                    }
-                    _ => 1.0,
-                };
-                l += beta * le * w;
-            }
+            add_escaped_mis(&mut l, scene, lights, beta, from.as_ref(), ray.d, bsdf_pdf);
             break;
         };
         let mut s = scene.geometry.surface_at(&hit, time);
         let wo = -ray.d;
-        if let Some(light_index) = s.light {
-            let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
-            if le != Vec3::ZERO {
-                let w = match prev {
-                    Some(r) if !specular_bounce => {
-                        bsdf_mis_weight(scene, lights, &r, light_index, ray.d, bsdf_pdf)
-                    }
-                    _ => 1.0,
-                };
-                l += beta * le * w;
-            }
-        }
+        l += emitted_mis(scene, lights, beta, &s, from.as_ref(), ray.d, bsdf_pdf);
         if bounces >= max_depth {
             break;
         }
@@ -623,27 +606,103 @@ fn path_li(
         specular_bounce = bs.is_specular();
         bsdf_pdf = bs.pdf;
         prev = Some(s.point);
-        if bs.is_specular() && bs.is_transmission() {
-            let eta2 = bsdf.eta * bsdf.eta;
-            eta_scale *= if wo.dot(s.point.n) > 0.0 {
-                eta2
-            } else {
-                1.0 / eta2
-            };
-        }
+        eta_scale *= eta_scale_change(&bsdf, &bs, wo, s.point.n);
         ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-        // Russian roulette after bounce 3 on max(β·etaScale).
-        let rr = (beta * eta_scale).max_element();
-        if rr < rr_threshold && bounces > 3 {
-            let q = (1.0 - rr).max(0.05);
-            if sampler.get_1d() < q {
-                break;
-            }
-            beta /= 1.0 - q;
+        if roulette(&mut beta, eta_scale, rr_threshold, bounces, sampler) {
+            break;
         }
         bounces += 1;
     }
     l
+}
+
+/// Adds to `l` the radiance of the infinite lights along an escaped ray
+/// `d`, times the path throughput `beta`, each weighted against next-event
+/// estimation from `from` (the last scattering vertex, `None` after a
+/// specular bounce or for the camera ray: weight 1), whose sampled direction
+/// had density `pdf`.
+#[inline]
+fn add_escaped_mis(
+    l: &mut Vec3,
+    scene: &RenderScene,
+    lights: &LightSampler,
+    beta: Vec3,
+    from: Option<&SurfacePoint>,
+    d: Vec3,
+    pdf: f32,
+) {
+    for &i in &scene.infinite_lights {
+        let le = scene.lights[i as usize].le(d);
+        let w = match from {
+            Some(r) => bsdf_mis_weight(scene, lights, r, i, d, pdf),
+            None => 1.0,
+        };
+        *l += beta * le * w;
+    }
+}
+
+/// Emission of the area light at `s` (if any) towards the ray's origin
+/// along `d`, times `beta`, weighted as in [`add_escaped_mis`].
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn emitted_mis(
+    scene: &RenderScene,
+    lights: &LightSampler,
+    beta: Vec3,
+    s: &SurfaceHit,
+    from: Option<&SurfacePoint>,
+    d: Vec3,
+    pdf: f32,
+) -> Vec3 {
+    let Some(light_index) = s.light else {
+        return Vec3::ZERO;
+    };
+    let le = scene.lights[light_index as usize].emitted(s.point.n, -d);
+    if le == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let w = match from {
+        Some(r) => bsdf_mis_weight(scene, lights, r, light_index, d, pdf),
+        None => 1.0,
+    };
+    beta * le * w
+}
+
+/// The factor of pbrt-v3's `etaScale` for a sampled direction: η² or 1/η²
+/// through a specular transmission (by the side `wo` is on), else 1.
+#[inline]
+fn eta_scale_change(bsdf: &Bsdf, bs: &BsdfSample, wo: Vec3, n: Vec3) -> f32 {
+    if bs.is_specular() && bs.is_transmission() {
+        let eta2 = bsdf.eta * bsdf.eta;
+        if wo.dot(n) > 0.0 {
+            eta2
+        } else {
+            1.0 / eta2
+        }
+    } else {
+        1.0
+    }
+}
+
+/// pbrt-v3's Russian roulette after bounce 3 on max(β·etaScale): true if
+/// the path ends (else β is divided by the survival probability).
+#[inline]
+fn roulette(
+    beta: &mut Vec3,
+    eta_scale: f32,
+    rr_threshold: f32,
+    bounces: u32,
+    sampler: &mut Sampler,
+) -> bool {
+    let rr = (*beta * eta_scale).max_element();
+    if rr < rr_threshold && bounces > 3 {
+        let q = (1.0 - rr).max(0.05);
+        if sampler.get_1d() < q {
+            return true;
+        }
+        *beta /= 1.0 - q;
+    }
+    false
 }
 
 /// Power-heuristic weight of emission from light `light` reached by a BSDF

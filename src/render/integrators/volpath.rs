@@ -23,7 +23,9 @@
 //! more ray per vertex for its BSDF strategy and adds emission only after
 //! specular bounces; both are unbiased estimators of the same integral.
 
-use super::{bsdf_mis_weight, shade, Scratch, MAX_PASS_THROUGH};
+use super::{
+    add_escaped_mis, emitted_mis, eta_scale_change, roulette, shade, Scratch, MAX_PASS_THROUGH,
+};
 use crate::render::accel::SurfaceHit;
 use crate::render::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
 use crate::render::lights::LightSampler;
@@ -269,34 +271,22 @@ pub(super) fn volpath_li(
                 continue;
             }
         }
+        let from = prev.filter(|_| !specular_bounce);
         let Some(hit) = hit else {
-            for &i in &scene.infinite_lights {
-                let light = &scene.lights[i as usize];
-                let le = light.le(ray.d);
-                let w = match prev {
-                    Some(r) if !specular_bounce => {
-                        bsdf_mis_weight(scene, lights, &r, i, ray.d, scatter_pdf)
-                    }
-                    _ => 1.0,
-                };
-                l += beta * le * w;
-            }
+            add_escaped_mis(
+                &mut l,
+                scene,
+                lights,
+                beta,
+                from.as_ref(),
+                ray.d,
+                scatter_pdf,
+            );
             break;
         };
         let mut s = scene.geometry.surface_at(&hit, time);
         let wo = -ray.d;
-        if let Some(light_index) = s.light {
-            let le = scene.lights[light_index as usize].emitted(s.point.n, wo);
-            if le != Vec3::ZERO {
-                let w = match prev {
-                    Some(r) if !specular_bounce => {
-                        bsdf_mis_weight(scene, lights, &r, light_index, ray.d, scatter_pdf)
-                    }
-                    _ => 1.0,
-                };
-                l += beta * le * w;
-            }
-        }
+        l += emitted_mis(scene, lights, beta, &s, from.as_ref(), ray.d, scatter_pdf);
         if bounces >= max_depth {
             break;
         }
@@ -356,14 +346,7 @@ pub(super) fn volpath_li(
         specular_bounce = bs.is_specular();
         scatter_pdf = bs.pdf;
         prev = Some(s.point);
-        if bs.is_specular() && bs.is_transmission() {
-            let eta2 = bsdf.eta * bsdf.eta;
-            eta_scale *= if wo.dot(s.point.n) > 0.0 {
-                eta2
-            } else {
-                1.0 / eta2
-            };
-        }
+        eta_scale *= eta_scale_change(&bsdf, &bs, wo, s.point.n);
         if media_on {
             medium = medium_after(scene, &s, bs.wi, medium);
         }
@@ -374,25 +357,4 @@ pub(super) fn volpath_li(
         bounces += 1;
     }
     l
-}
-
-/// pbrt-v3's Russian roulette after bounce 3 on max(β·etaScale): true if
-/// the path ends (else β is divided by the survival probability).
-#[inline]
-fn roulette(
-    beta: &mut Vec3,
-    eta_scale: f32,
-    rr_threshold: f32,
-    bounces: u32,
-    sampler: &mut Sampler,
-) -> bool {
-    let rr = (*beta * eta_scale).max_element();
-    if rr < rr_threshold && bounces > 3 {
-        let q = (1.0 - rr).max(0.05);
-        if sampler.get_1d() < q {
-            return true;
-        }
-        *beta /= 1.0 - q;
-    }
-    false
 }
