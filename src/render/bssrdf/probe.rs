@@ -92,6 +92,7 @@ fn walk(
     seg: &ProbeSegment,
     material: u32,
     time: f32,
+    rays: &mut u64,
     mut visit: impl FnMut(u32, &SurfaceHit) -> bool,
 ) -> u32 {
     // The first ray leaves a point in space (pbrt-v3's bare Interaction:
@@ -106,6 +107,7 @@ fn walk(
         if ray.d == Vec3::ZERO {
             break;
         }
+        *rays += 1;
         let Some(hit) = geometry.intersect_at(&ray, time) else {
             break;
         };
@@ -124,19 +126,21 @@ fn walk(
 /// pbrt-v3's choice of one exit point along the probe: the admissible hits
 /// (same `material` as the entry point) and the chosen one, or `None` if
 /// the probe finds none. The caller divides [`pdf_sp`] by the count.
+/// `rays` counts the probe rays traced.
 pub fn find_exit(
     geometry: &Geometry,
     seg: &ProbeSegment,
     material: u32,
     time: f32,
+    rays: &mut u64,
 ) -> Option<(SurfaceHit, u32)> {
-    let n = walk(geometry, seg, material, time, |_, _| false);
+    let n = walk(geometry, seg, material, time, rays, |_, _| false);
     if n == 0 {
         return None;
     }
     let selected = ((seg.u_choice * n as f32) as u32).min(n - 1);
     let mut chosen = None;
-    walk(geometry, seg, material, time, |k, s| {
+    walk(geometry, seg, material, time, rays, |k, s| {
         if k == selected {
             chosen = Some(*s);
             true

@@ -43,7 +43,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::BUMPMAP,
 ];
 
-/// The table entry, ready for [`super::MATERIALS`] (see `subsurface.rs`).
+/// The entry of [`super::MATERIALS`].
 pub const KIND: MaterialKind = MaterialKind {
     name: "kdsubsurface",
     support: Support::Supported,

@@ -22,6 +22,7 @@ mod subsurface;
 mod translucent;
 mod uber;
 
+use crate::render::bssrdf::TabulatedBssrdf;
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
 pub use bump::bump;
 pub use disney::Disney;
@@ -79,25 +80,10 @@ pub static MATERIALS: &[MaterialKind] = &[
     disney::KIND,
     fourier::KIND,
     NONE_KIND,
-    // The BSSRDF's exit-point sampling is not in the integrators yet: until
-    // it is, these stay matte with a warning. `subsurface::KIND` and
-    // `kdsubsurface::KIND` (parameters, builders) replace them then.
-    unsupported(
-        "subsurface",
-        "the BSSRDF is not sampled by the integrators yet",
-    ),
-    unsupported(
-        "kdsubsurface",
-        "the BSSRDF is not sampled by the integrators yet",
-    ),
+    subsurface::KIND,
+    kdsubsurface::KIND,
     unsupported("hair", "the hair BSDF comes after curves"),
 ];
-
-/// Kinds implemented (parameters, builders, BSDF, coefficients) but not yet
-/// in [`MATERIALS`], because the integrators do not sample their BSSRDF
-/// yet: `subsurface` and `kdsubsurface`. They replace the `unsupported`
-/// entries of the same names when the integrator hooks land.
-pub static PENDING: &[MaterialKind] = &[subsurface::KIND, kdsubsurface::KIND];
 
 const NONE_KIND: MaterialKind = MaterialKind {
     name: "none",
@@ -269,6 +255,37 @@ impl Material {
             Material::KdSubsurface(m) => m.max_lobes(),
             Material::None => 0,
             Material::Bumped(b) => b.material.max_lobes(lobes_of),
+        }
+    }
+
+    /// True if the material has a BSSRDF under its boundary (`subsurface`,
+    /// `kdsubsurface`, bumped or not): the integrators then sample an exit
+    /// point after a transmission through it.
+    pub fn has_bssrdf(&self) -> bool {
+        match self {
+            Material::Subsurface(_) | Material::KdSubsurface(_) => true,
+            Material::Bumped(b) => b.material.has_bssrdf(),
+            _ => false,
+        }
+    }
+
+    /// The BSSRDF at a hit (pbrt-v3's `TabulatedBSSRDF` that
+    /// `ComputeScatteringFunctions` sets beside the BSDF), `None` for
+    /// materials without one. A `mix` of a subsurface material has none in
+    /// pbrs (pbrt-v3 keeps its first material's BSSRDF, whose probe rays
+    /// then never find a hit of that material, so its paths end there).
+    pub fn bssrdf<'a>(&'a self, sc: &ShadingContext) -> Option<TabulatedBssrdf<'a>> {
+        match self {
+            Material::Subsurface(m) => {
+                let (sa, ss) = m.coefficients(sc);
+                Some(TabulatedBssrdf::new(&m.table, sa, ss, m.eta))
+            }
+            Material::KdSubsurface(m) => {
+                let (sa, ss) = m.coefficients(sc);
+                Some(TabulatedBssrdf::new(&m.table, sa, ss, m.eta))
+            }
+            Material::Bumped(b) => b.material.bssrdf(sc),
+            _ => None,
         }
     }
 

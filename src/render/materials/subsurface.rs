@@ -67,9 +67,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::BUMPMAP,
 ];
 
-/// The table entry, ready for [`super::MATERIALS`] once the integrators
-/// sample the BSSRDF (until then the table keeps `subsurface` unsupported,
-/// rendered as matte with a warning).
+/// The entry of [`super::MATERIALS`].
 pub const KIND: MaterialKind = MaterialKind {
     name: "subsurface",
     support: Support::Supported,
