@@ -106,6 +106,16 @@ const CASES: &[Case] = &[
         "\"float uroughness\" 0.05 \"float vroughness\" 0.3 \"float index\" 1.7",
         (0.2, 1.0),
     ),
+    // subsurface and kdsubsurface: the BSDF is the dielectric boundary
+    // (their BSSRDF is sampled by the integrators; tests/subsurface.rs).
+    case("subsurface", "", (0.4, 1.0)),
+    nonreciprocal(
+        "subsurface",
+        "\"float uroughness\" 0.05 \"float vroughness\" 0.05 \"bool remaproughness\" \"false\"",
+        (0.3, 1.0),
+    ),
+    case("kdsubsurface", "\"float eta\" 1.5", (0.4, 1.0)),
+    nonreciprocal("kdsubsurface", "\"float uroughness\" 0.2", (0.3, 1.0)),
     case("plastic", "", (0.1, 0.6)),
     case("plastic", "\"rgb Kd\" [0 0 0] \"rgb Ks\" [1 1 1] \"float roughness\" 0.3", (0.0, 0.6)),
     case(

@@ -361,11 +361,10 @@ fn materials_and_substitutes() {
     );
     assert_eq!(m("\"none\"").0.kind, "none");
     assert_eq!(m("\"\"").0.kind, "none");
-    let (p, w) = m("\"kdsubsurface\" \"rgb Kd\" [0.1 0.2 0.3] \"float mfp\" 0.01");
+    let (p, w) = m("\"hair\" \"rgb Kd\" [0.1 0.2 0.3] \"float eumelanin\" 1.3");
     assert_eq!(matte_of(&p), (Vec3::new(0.1, 0.2, 0.3), 0.0));
     assert!(
-        w.contains("\"kdsubsurface\" is not supported by pbrs")
-            && w.contains("substituted by a matte"),
+        w.contains("\"hair\" is not supported by pbrs") && w.contains("substituted by a matte"),
         "{w}"
     );
     assert!(!w.contains("not used"), "{w}");
@@ -783,29 +782,29 @@ fn unused_material_parameters_say_what_was_meant() {
 #[test]
 fn summary_counts_declared_material_kinds() {
     use pbrs::render::materials::{kind, Support};
-    // The kdsubsurface has matte's default Kd, so its substitute equals the
+    // The hair's substitute has matte's default Kd, so it equals the
     // matte; it is still counted under its own kind.
-    let s = load("WorldBegin\nMaterial \"matte\"\nShape \"sphere\"\nMaterial \"glass\"\nShape \"sphere\"\nMaterial \"kdsubsurface\"\nShape \"sphere\"\nMaterial \"BUSH1\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\nWorldEnd");
+    let s = load("WorldBegin\nMaterial \"matte\"\nShape \"sphere\"\nMaterial \"glass\"\nShape \"sphere\"\nMaterial \"hair\"\nShape \"sphere\"\nMaterial \"BUSH1\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\nWorldEnd");
     let sum = &s.summary;
     let by: Vec<(&str, usize)> = sum
         .materials_by_type
         .iter()
         .map(|(k, v)| (*k, *v))
         .collect();
-    assert_eq!(by, [("glass", 1), ("kdsubsurface", 1), ("matte", 1)]);
+    assert_eq!(by, [("glass", 1), ("hair", 1), ("matte", 1)]);
     assert_eq!(sum.unknown_materials.get("BUSH1"), Some(&1));
     assert_eq!(s.scene.materials.len(), 4);
     let text = sum.to_string();
     assert!(
-        text.contains("materials:  4 (1 glass, 1 kdsubsurface, 1 matte, 1 \"BUSH1\" (unknown))"),
+        text.contains("materials:  4 (1 glass, 1 hair, 1 matte, 1 \"BUSH1\" (unknown))"),
         "{text}"
     );
-    let Some(Support::Unsupported(why)) = kind("kdsubsurface").map(|k| k.support) else {
-        panic!("kdsubsurface is in the table as unsupported");
+    let Some(Support::Unsupported(why)) = kind("hair").map(|k| k.support) else {
+        panic!("hair is in the table as unsupported");
     };
     assert!(
         text.contains(&format!(
-            "kdsubsurface: not supported by pbrs ({why}), rendered as matte"
+            "hair: not supported by pbrs ({why}), rendered as matte"
         )),
         "{text}"
     );

@@ -47,6 +47,7 @@ fn kinds(b: &Bsdf) -> Vec<&'static str> {
             Bxdf::DisneySheen(_) => "disney-sheen",
             Bxdf::DisneyClearcoat(_) => "disney-clearcoat",
             Bxdf::Fourier(_) => "fourier",
+            Bxdf::SwAdapter(_) => "sw-adapter",
         })
         .collect()
 }

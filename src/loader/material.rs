@@ -241,6 +241,11 @@ pub fn material(
             ctx.warn(spec.loc, format!("{what}: {msg}"), "disney");
         }
     }
+    if kind.name == "subsurface" {
+        for msg in materials::Subsurface::load_warnings(&params) {
+            ctx.warn(spec.loc, format!("{what}: {msg}"), "subsurface");
+        }
+    }
     (
         MaterialDesc {
             kind: kind.name,

@@ -134,6 +134,8 @@ pub struct Builder<'s, 'c> {
     pub camera_medium: Option<MediumId>,
     /// The first `MediumInterface` statement (pbrt-v3's `haveScatteringMedia`).
     pub first_medium_interface: Option<Loc>,
+    /// The first `subsurface`/`kdsubsurface` material a shape uses.
+    first_subsurface: Option<Loc>,
     /// The outside medium named when the `Camera` statement was read.
     camera_outside: Option<(String, Loc)>,
 }
@@ -192,6 +194,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             scene_media: Vec::new(),
             camera_medium: None,
             first_medium_interface: None,
+            first_subsurface: None,
             camera_outside: None,
         }
     }
@@ -925,6 +928,9 @@ impl<'s, 'c> Builder<'s, 'c> {
             textures: if overrides { textures } else { &spec.textures },
         };
         let (mut desc, kind, refs) = material::material(self.ctx, spec, &lookup);
+        if matches!(desc.kind, "subsurface" | "kdsubsurface") {
+            self.first_subsurface.get_or_insert(spec.loc);
+        }
         for r in refs {
             let id = match spec.named.get(&r.name) {
                 Some(named) => {
@@ -1058,6 +1064,16 @@ impl<'s, 'c> Builder<'s, 'c> {
             };
             if let Some(name) = name {
                 self.ctx.warn(loc, format!("the scene has participating media but the \"{name}\" integrator ignores them (as pbrt-v3's): use \"volpath\" to render them"), "media ignored by this integrator");
+            }
+        }
+        if let Some(loc) = self.first_subsurface {
+            let name = match integrator {
+                IntegratorDesc::VolPath { .. } | IntegratorDesc::Path { .. } => None,
+                IntegratorDesc::DirectLighting { .. } => Some("directlighting"),
+                IntegratorDesc::Whitted { .. } => Some("whitted"),
+            };
+            if let Some(name) = name {
+                self.ctx.warn(loc, format!("the \"{name}\" integrator does not sample subsurface scattering (as pbrt-v3's): this material renders as its dielectric boundary only; use \"path\" or \"volpath\""), "subsurface ignored by this integrator");
             }
         }
         for (m, loc, id) in &self.medium_defs {

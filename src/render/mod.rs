@@ -2,6 +2,7 @@
 //! samplers, integrators and film. It consumes a [`crate::scene::SceneDescription`].
 
 pub mod accel;
+pub mod bssrdf;
 pub mod bxdf;
 pub mod camera;
 pub mod driver;

@@ -19,6 +19,7 @@ mod microfacet;
 mod microfacet_lobes;
 mod oren_nayar;
 mod specular;
+mod sw_adapter;
 
 pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
 pub use disney::{
@@ -35,6 +36,7 @@ pub use microfacet::{
 pub use microfacet_lobes::{MicrofacetReflection, MicrofacetTransmission};
 pub use oren_nayar::OrenNayar;
 pub use specular::{refract, FresnelSpecular, SpecularReflection, SpecularTransmission};
+pub use sw_adapter::SwAdapter;
 
 use crate::render::sampling::cosine_sample_hemisphere;
 use glam::{Vec2, Vec3};
@@ -194,6 +196,7 @@ bxdfs! {
     DisneySheen(DisneySheen),
     DisneyClearcoat(DisneyClearcoat),
     Fourier(FourierBsdf<'a>),
+    SwAdapter(SwAdapter),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry

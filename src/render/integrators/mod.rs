@@ -4,7 +4,9 @@
 //! one, specular lobes followed recursively) and `whitted`.
 
 use crate::render::accel::{Hit, SurfaceHit};
-use crate::render::geometry::{spawn_ray, Ray, RayDiff};
+use crate::render::bssrdf::probe::{find_exit, pdf_sp, probe_segment};
+use crate::render::bxdf::SwAdapter;
+use crate::render::geometry::{spawn_ray, Frame, Ray, RayDiff};
 use crate::render::lights::{
     pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
 };
@@ -608,12 +610,87 @@ fn path_li(
         prev = Some(s.point);
         eta_scale *= eta_scale_change(&bsdf, &bs, wo, s.point.n);
         ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+        if bs.is_transmission() && material.has_bssrdf() {
+            // pbrt-v3's subsurface step: continue from a sampled exit
+            // point, with light sampled there, not counted as a bounce.
+            let frame = bsdf.frame;
+            let Some((pi, w, exit)) =
+                subsurface_exit(scene, &hit, &s, material, &frame, time, sampler, scratch)
+            else {
+                break;
+            };
+            beta *= w;
+            let wo = pi.point.ns;
+            l += beta * sample_light_mis(scene, &pi, &exit, wo, sampler, scratch, lights);
+            let Some(bs) = exit.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
+                break;
+            };
+            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+                break;
+            }
+            beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
+            specular_bounce = false;
+            bsdf_pdf = bs.pdf;
+            prev = Some(pi.point);
+            ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
+        }
         if roulette(&mut beta, eta_scale, rr_threshold, bounces, sampler) {
             break;
         }
         bounces += 1;
     }
     l
+}
+
+/// pbrt-v3's BSSRDF step (`SeparableBSSRDF::Sample_S`), taken by `path`
+/// and `volpath` after a BSDF sample that transmits through the boundary
+/// of a subsurface material at `s` (with shading frame `frame`): samples an
+/// exit point by a probe ray, and returns it with the weight Sp / pdf and
+/// the BSDF there (the Sw adapter lobe, wo along the exit's shading
+/// normal). `None` ends the path (no profile, no exit found, zero weight),
+/// as pbrt-v3's `break`.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn subsurface_exit<'a>(
+    scene: &RenderScene,
+    hit: &Hit,
+    s: &SurfaceHit,
+    material: &Material,
+    frame: &Frame,
+    time: f32,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Option<(SurfaceHit, Vec3, Bsdf<'a>)> {
+    let u1 = sampler.get_1d();
+    let u2 = sampler.get_2d();
+    let geom = if scene.material_needs_geom[s.material as usize] {
+        scene.geometry.diff_geom(hit, s)
+    } else {
+        DiffGeom::ZERO
+    };
+    let b = material.bssrdf(&ShadingContext {
+        hit: s,
+        geom: &geom,
+    })?;
+    let seg = probe_segment(&b, s.point.p, frame, u1, u2)?;
+    let (pi, found) = find_exit(
+        &scene.geometry,
+        &seg,
+        s.material,
+        time,
+        &mut scratch.counts.closest,
+    )?;
+    let sp = b.sr((s.point.p - pi.point.p).length());
+    let pdf = pdf_sp(&b, s.point.p, frame, pi.point.p, pi.point.n) / found as f32;
+    if sp == Vec3::ZERO || !(pdf > 0.0) {
+        return None;
+    }
+    let mut bsdf = Bsdf::new(Frame::from_normal(pi.point.ns), pi.point.n, b.eta);
+    bsdf.add(SwAdapter {
+        eta: b.eta,
+        radiance: true,
+    });
+    Some((pi, sp / pdf, bsdf))
 }
 
 /// Adds to `l` the radiance of the infinite lights along an escaped ray

@@ -24,7 +24,8 @@
 //! specular bounces; both are unbiased estimators of the same integral.
 
 use super::{
-    add_escaped_mis, emitted_mis, eta_scale_change, roulette, shade, Scratch, MAX_PASS_THROUGH,
+    add_escaped_mis, emitted_mis, eta_scale_change, roulette, shade, subsurface_exit, Scratch,
+    MAX_PASS_THROUGH,
 };
 use crate::render::accel::SurfaceHit;
 use crate::render::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
@@ -351,6 +352,55 @@ pub(super) fn volpath_li(
             medium = medium_after(scene, &s, bs.wi, medium);
         }
         ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+        if bs.is_transmission() && material.has_bssrdf() {
+            // pbrt-v3's subsurface step (as in `path`): continue from a
+            // sampled exit point, with light sampled there (through media),
+            // not counted as a bounce. As in pbrt-v3, the exit point is
+            // found by probe rays that carry no medium, so unless its shape
+            // has a medium transition the rays leaving it start in vacuum
+            // (pbrt-v3's `GeometricPrimitive::Intersect` gives a hit of a
+            // non-transition shape the probe ray's medium, none).
+            let frame = bsdf.frame;
+            let Some((pi, w, exit)) =
+                subsurface_exit(scene, &hit, &s, material, &frame, time, sampler, scratch)
+            else {
+                break;
+            };
+            beta *= w;
+            let wo = pi.point.ns;
+            l += beta
+                * sample_light(
+                    scene,
+                    &pi.point,
+                    time,
+                    Scatter::Surface(&exit, pi.point.ns),
+                    wo,
+                    |wi| {
+                        if media_on {
+                            medium_after(scene, &pi, wi, None)
+                        } else {
+                            None
+                        }
+                    },
+                    sampler,
+                    scratch,
+                    lights,
+                );
+            let Some(bs) = exit.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
+                break;
+            };
+            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+                break;
+            }
+            beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
+            specular_bounce = false;
+            scatter_pdf = bs.pdf;
+            prev = Some(pi.point);
+            if media_on {
+                medium = medium_after(scene, &pi, bs.wi, None);
+            }
+            ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
+        }
         if roulette(&mut beta, eta_scale, rr_threshold, bounces, sampler) {
             break;
         }

@@ -74,6 +74,19 @@ impl Glass {
         }
     }
 
+    /// The boundary of `subsurface` and `kdsubsurface`: `Kr`, `Kt` and the
+    /// roughness parameters from `p`, a constant index `eta`.
+    pub fn with_eta(p: &ParamValues, eta: f32) -> Glass {
+        Glass {
+            kr: p.spectrum_tex("Kr").expect("default"),
+            kt: p.spectrum_tex("Kt").expect("default"),
+            eta: FloatTex::Constant(eta),
+            u_roughness: p.float_tex("uroughness").expect("default"),
+            v_roughness: p.float_tex("vroughness").expect("default"),
+            remap_roughness: p.boolean("remaproughness"),
+        }
+    }
+
     pub fn anisotropic(&self) -> bool {
         super::may_differ(&self.u_roughness, &self.v_roughness)
     }

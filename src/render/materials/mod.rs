@@ -11,26 +11,31 @@ mod bump;
 mod disney;
 mod fourier;
 mod glass;
+mod kdsubsurface;
 mod matte;
 mod metal;
 mod mirror;
 mod mix;
 mod plastic;
 mod substrate;
+mod subsurface;
 mod translucent;
 mod uber;
 
+use crate::render::bssrdf::TabulatedBssrdf;
 pub use crate::render::bxdf::{Bsdf, BsdfSample, BxdfFlags};
 pub use bump::bump;
 pub use disney::Disney;
 pub use fourier::Fourier;
 pub use glass::Glass;
+pub use kdsubsurface::KdSubsurface;
 pub use matte::Matte;
 pub use metal::Metal;
 pub use mirror::Mirror;
 pub use mix::Mix;
 pub use plastic::Plastic;
 pub use substrate::Substrate;
+pub use subsurface::Subsurface;
 pub use translucent::Translucent;
 pub use uber::Uber;
 
@@ -75,14 +80,8 @@ pub static MATERIALS: &[MaterialKind] = &[
     disney::KIND,
     fourier::KIND,
     NONE_KIND,
-    unsupported(
-        "subsurface",
-        "subsurface scattering comes with participating media",
-    ),
-    unsupported(
-        "kdsubsurface",
-        "subsurface scattering comes with participating media",
-    ),
+    subsurface::KIND,
+    kdsubsurface::KIND,
     unsupported("hair", "the hair BSDF comes after curves"),
 ];
 
@@ -142,6 +141,10 @@ pub enum Material {
     Uber(Uber),
     Disney(Disney),
     Fourier(Fourier),
+    /// `subsurface` and `kdsubsurface`: the boundary's BSDF here; the
+    /// BSSRDF from their coefficients and table.
+    Subsurface(Arc<Subsurface>),
+    KdSubsurface(Arc<KdSubsurface>),
     /// `Material "none"`: no BSDF.
     None,
     /// A material with a `bumpmap`: its shading frame is bumped before its
@@ -202,6 +205,8 @@ impl Material {
             Material::Uber(m) => m.needs_geom(),
             Material::Disney(m) => m.needs_geom(),
             Material::Fourier(m) => m.needs_geom(),
+            Material::Subsurface(m) => m.needs_geom(),
+            Material::KdSubsurface(m) => m.needs_geom(),
             Material::None => false,
             Material::Bumped(_) => true,
         }
@@ -218,6 +223,8 @@ impl Material {
             Material::Uber(m) => m.anisotropic(),
             Material::Bumped(b) => b.material.anisotropic(),
             Material::Disney(m) => m.anisotropic(),
+            Material::Subsurface(m) => m.anisotropic(),
+            Material::KdSubsurface(m) => m.anisotropic(),
             // pbrt-v3's FourierBSDF is isotropic.
             Material::Matte(_)
             | Material::Plastic(_)
@@ -244,8 +251,41 @@ impl Material {
             Material::Uber(m) => m.max_lobes(),
             Material::Disney(m) => m.max_lobes(),
             Material::Fourier(m) => m.max_lobes(),
+            Material::Subsurface(m) => m.max_lobes(),
+            Material::KdSubsurface(m) => m.max_lobes(),
             Material::None => 0,
             Material::Bumped(b) => b.material.max_lobes(lobes_of),
+        }
+    }
+
+    /// True if the material has a BSSRDF under its boundary (`subsurface`,
+    /// `kdsubsurface`, bumped or not): the integrators then sample an exit
+    /// point after a transmission through it.
+    pub fn has_bssrdf(&self) -> bool {
+        match self {
+            Material::Subsurface(_) | Material::KdSubsurface(_) => true,
+            Material::Bumped(b) => b.material.has_bssrdf(),
+            _ => false,
+        }
+    }
+
+    /// The BSSRDF at a hit (pbrt-v3's `TabulatedBSSRDF` that
+    /// `ComputeScatteringFunctions` sets beside the BSDF), `None` for
+    /// materials without one. A `mix` of a subsurface material has none in
+    /// pbrs (pbrt-v3 keeps its first material's BSSRDF, whose probe rays
+    /// then never find a hit of that material, so its paths end there).
+    pub fn bssrdf<'a>(&'a self, sc: &ShadingContext) -> Option<TabulatedBssrdf<'a>> {
+        match self {
+            Material::Subsurface(m) => {
+                let (sa, ss) = m.coefficients(sc);
+                Some(TabulatedBssrdf::new(&m.table, sa, ss, m.eta))
+            }
+            Material::KdSubsurface(m) => {
+                let (sa, ss) = m.coefficients(sc);
+                Some(TabulatedBssrdf::new(&m.table, sa, ss, m.eta))
+            }
+            Material::Bumped(b) => b.material.bssrdf(sc),
+            _ => None,
         }
     }
 
@@ -336,6 +376,8 @@ impl Material {
             Material::Uber(m) => m.scatter(sc, bsdf),
             Material::Disney(m) => m.scatter(sc, bsdf),
             Material::Fourier(m) => m.scatter(sc, bsdf),
+            Material::Subsurface(m) => m.scatter(sc, ctx, bsdf),
+            Material::KdSubsurface(m) => m.scatter(sc, ctx, bsdf),
             Material::None => {}
             // The caller bumped the hit if this material leads the BSDF
             // (see `leading_bump`); a mix's second material's bump map

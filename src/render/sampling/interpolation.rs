@@ -79,6 +79,87 @@ pub fn catmull_rom_weights(nodes: &[f32], x: f32) -> Option<(isize, [f32; 4])> {
     Some((idx as isize - 1, w))
 }
 
+/// The finite-difference tangents pbrt-v3 gives the Catmull-Rom segment
+/// `i` of `values` over `x` (one-sided at the ends), scaled to the
+/// segment's width.
+#[inline]
+fn segment_tangents(x: &[f32], values: &[f32], i: usize) -> (f32, f32) {
+    let n = x.len();
+    let (x0, x1) = (x[i], x[i + 1]);
+    let (f0, f1) = (values[i], values[i + 1]);
+    let width = x1 - x0;
+    let d0 = if i > 0 {
+        width * (f1 - values[i - 1]) / (x1 - x[i - 1])
+    } else {
+        f1 - f0
+    };
+    let d1 = if i + 2 < n {
+        width * (values[i + 2] - f0) / (x[i + 2] - x0)
+    } else {
+        f1 - f0
+    };
+    (d0, d1)
+}
+
+/// pbrt-v3's `IntegrateCatmullRom`: the integral of the Catmull-Rom spline
+/// through `values` at the nodes `x` (at least 2, increasing), filling
+/// `cdf` (as long as `x`) with the running integral at each node.
+pub fn integrate_catmull_rom(x: &[f32], values: &[f32], cdf: &mut [f32]) -> f32 {
+    let mut sum = 0.0f32;
+    cdf[0] = 0.0;
+    for i in 0..x.len() - 1 {
+        let (f0, f1) = (values[i], values[i + 1]);
+        let width = x[i + 1] - x[i];
+        let (d0, d1) = segment_tangents(x, values, i);
+        sum += ((d0 - d1) * (1.0 / 12.0) + (f0 + f1) * 0.5) * width;
+        cdf[i + 1] = sum;
+    }
+    sum
+}
+
+/// pbrt-v3's `InvertCatmullRom`: the `x` at which the Catmull-Rom spline
+/// through the increasing `values` at the nodes `x` equals `u`; the first
+/// or last node when `u` is outside the values (or NaN).
+pub fn invert_catmull_rom(x: &[f32], values: &[f32], u: f32) -> f32 {
+    let n = x.len();
+    if u.is_nan() || u <= values[0] {
+        return x[0];
+    } else if u >= values[n - 1] {
+        return x[n - 1];
+    }
+    let i = find_interval(n, |i| values[i] <= u);
+    let (x0, x1) = (x[i], x[i + 1]);
+    let (f0, f1) = (values[i], values[i + 1]);
+    let (d0, d1) = segment_tangents(x, values, i);
+    let (mut a, mut b, mut t) = (0.0f32, 1.0f32, 0.5f32);
+    let mut steps = 0;
+    loop {
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+        let (t2, t3) = (t * t, t * t * t);
+        let big_f = (2.0 * t3 - 3.0 * t2 + 1.0) * f0
+            + (-2.0 * t3 + 3.0 * t2) * f1
+            + (t3 - 2.0 * t2 + t) * d0
+            + (t3 - t2) * d1;
+        let f = (6.0 * t2 - 6.0 * t) * f0
+            + (-6.0 * t2 + 6.0 * t) * f1
+            + (3.0 * t2 - 4.0 * t + 1.0) * d0
+            + (3.0 * t2 - 2.0 * t) * d1;
+        steps += 1;
+        if (big_f - u).abs() < 1e-6 || b - a < 1e-6 || steps >= MAX_STEPS {
+            break;
+        }
+        if big_f - u < 0.0 {
+            a = t;
+        } else {
+            b = t;
+        }
+        t -= (big_f - u) / f;
+    }
+    x0 + t * (x1 - x0)
+}
+
 /// A sample of [`sample_catmull_rom_2d`].
 #[derive(Clone, Copy, Debug)]
 pub struct SplineSample {
@@ -373,5 +454,38 @@ mod tests {
             assert!((s.pdf - s.value / total).abs() < 1e-5);
         }
         assert!(sample_catmull_rom_2d(&nodes, &nodes, &values, &cdf, 1.5, 0.5).is_none());
+    }
+    #[test]
+    fn integrate_catmull_rom_is_exact_for_lines_and_fills_the_cdf() {
+        let x = [0.0f32, 0.5, 1.5, 2.0, 4.0];
+        let values: Vec<f32> = x.iter().map(|&x| 3.0 * x + 1.0).collect();
+        let mut cdf = [0.0f32; 5];
+        let total = integrate_catmull_rom(&x, &values, &mut cdf);
+        assert!((total - (1.5 * 16.0 + 4.0)).abs() < 1e-4, "{total}");
+        for (xi, c) in x.iter().zip(cdf) {
+            assert!((c - (1.5 * xi * xi + xi)).abs() < 1e-4, "{xi}: {c}");
+        }
+    }
+
+    #[test]
+    fn invert_catmull_rom_round_trips() {
+        let x: Vec<f32> = (0..20).map(|i| i as f32 / 19.0).collect();
+        let values: Vec<f32> = x.iter().map(|&x| x * x * (3.0 - x) + 0.1 * x).collect();
+        for k in 1..100 {
+            let xt = k as f32 / 100.0;
+            // The spline's value at xt, through its weights.
+            let (offset, w) = catmull_rom_weights(&x, xt).unwrap();
+            let mut u = 0.0;
+            for (i, wi) in w.iter().enumerate() {
+                if *wi != 0.0 {
+                    u += wi * values[(offset + i as isize) as usize];
+                }
+            }
+            let back = invert_catmull_rom(&x, &values, u);
+            assert!((back - xt).abs() < 1e-4, "{xt} -> {u} -> {back}");
+        }
+        assert_eq!(invert_catmull_rom(&x, &values, -1.0), 0.0);
+        assert_eq!(invert_catmull_rom(&x, &values, 10.0), 1.0);
+        assert_eq!(invert_catmull_rom(&x, &values, f32::NAN), 0.0);
     }
 }
