@@ -144,7 +144,11 @@ farm() {
             [ $SECONDS -lt $end ] || { log "task $kill_task never started"; return 1; }
             sleep 0.1
         done
-        sleep 1 # midway through its render
+        # Stop it early in its render (before it can finish on a fast
+        # machine), then kill it: a crash or an OOM kill midway.
+        sleep 0.3
+        kill -STOP "$(cat "$pidfile")" ||
+            { log "task $kill_task's renderer ended before it could be killed"; return 1; }
         kill -KILL "$(cat "$pidfile")"
         log "killed task $kill_task's renderer (pid $(cat "$pidfile")) midway"
     fi
