@@ -14,6 +14,7 @@ mod cat;
 mod check;
 pub mod converge;
 pub mod display;
+pub mod merge;
 mod render;
 
 /// Exit status of a usage error (clap's own).
@@ -122,6 +123,30 @@ pub struct Args {
     /// warnings; errors are always printed.
     #[arg(long, value_name = "N", help_heading = "Logging (pbrt-v3)")]
     pub minloglevel: Option<i32>,
+    /// Render farm: render only tile K of --tiles N (bands of rows, numbered
+    /// from 0 as Slurm's SLURM_ARRAY_TASK_ID and Kubernetes'
+    /// JOB_COMPLETION_INDEX) into an EXR part for `pbrs merge`. `env` takes
+    /// K from SLURM_ARRAY_TASK_ID, else JOB_COMPLETION_INDEX.
+    #[arg(
+        long,
+        value_name = "K",
+        requires = "tiles",
+        help_heading = "Render farm"
+    )]
+    pub tile: Option<String>,
+    /// Render farm: the number of tiles the frame is split into; `env` takes
+    /// it from SLURM_ARRAY_TASK_COUNT.
+    #[arg(
+        long,
+        value_name = "N",
+        requires = "tile",
+        help_heading = "Render farm"
+    )]
+    pub tiles: Option<String>,
+    /// Render farm: render only sample indices A..B (B excluded) of every
+    /// pixel into an EXR part that keeps the film's f64 sums, for `pbrs merge`.
+    #[arg(long, num_args = 2, value_names = ["A", "B"], conflicts_with = "tile", help_heading = "Render farm")]
+    pub spp_range: Option<Vec<u32>>,
 }
 
 impl Args {
@@ -135,6 +160,9 @@ impl Args {
 pub enum Command {
     /// Error against run time: progressive renders compared with a reference.
     Converge(converge::ConvergeArgs),
+    /// Merge the parts of a frame (--tile/--tiles or --spp-range renders)
+    /// into its image: tiles give the single-machine image bit for bit.
+    Merge(merge::MergeArgs),
 }
 
 /// Runs the command line; returns the process exit status.
@@ -146,8 +174,10 @@ pub fn main() -> i32 {
 pub fn run(argv: Vec<OsString>) -> i32 {
     let argv = args::normalize(argv, &Args::command());
     let mut args = Args::parse_from(argv);
-    if let Some(Command::Converge(c)) = &args.command {
-        return converge::run(c);
+    match &args.command {
+        Some(Command::Converge(c)) => return converge::run(c),
+        Some(Command::Merge(m)) => return merge::run(m),
+        None => {}
     }
     if args.scenes.is_empty() {
         use std::io::IsTerminal;

@@ -5,8 +5,11 @@
 use super::display::Display;
 use super::Args;
 use crate::loader::{load_scene_files_each, print_diagnostics};
-use crate::render::driver::{peak_memory_bytes, render_observed, ChunkDone, RenderOptions};
-use crate::render::film::io::{check_output_path, write_image};
+use crate::render::driver::{
+    peak_memory_bytes, render_observed, render_part, ChunkDone, RenderOptions,
+};
+use crate::render::film::io::{check_output_path, format_for_path, write_image, ImageFormat};
+use crate::render::film::part::PartKind;
 use crate::render::film::Image;
 use crate::scene::{LightDesc, SamplerKind, SceneDescription};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -164,6 +167,91 @@ fn apply_overrides(
     Ok(())
 }
 
+/// The part of the frame the command line asks for (--tile/--tiles,
+/// --spp-range), checked against the scene; None for the whole frame.
+fn part_request(args: &Args, desc: &SceneDescription) -> Result<Option<PartKind>, String> {
+    let env_number = |names: &[&str], flag: &str| -> Result<u32, String> {
+        for n in names {
+            if let Ok(v) = std::env::var(n) {
+                return v.trim().parse().map_err(|_| {
+                    format!("--{flag} env: ${n} is {v:?}, not a non-negative integer")
+                });
+            }
+        }
+        Err(format!(
+            "--{flag} env: none of ${} is set",
+            names.join(", $")
+        ))
+    };
+    let number = |v: &str, names: &[&str], flag: &str| -> Result<u32, String> {
+        if v == "env" {
+            env_number(names, flag)
+        } else {
+            v.parse()
+                .map_err(|_| format!("--{flag} takes a non-negative integer or `env`, not {v:?}"))
+        }
+    };
+    let kind = match (&args.tile, &args.tiles, &args.spp_range) {
+        (Some(k), Some(n), None) => {
+            let k = number(k, &["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"], "tile")?;
+            let n = number(n, &["SLURM_ARRAY_TASK_COUNT"], "tiles")?;
+            PartKind::Tile { index: k, count: n }
+        }
+        (None, None, Some(r)) => {
+            let (a, b) = (r[0], r[1]);
+            let spp = desc.sampler.pixel_samples;
+            if a >= b || b > spp {
+                return Err(format!(
+                    "--spp-range {a} {b} is not a range of the {spp} samples per pixel (0 <= A < B <= {spp})"
+                ));
+            }
+            PartKind::Samples { start: a, end: b }
+        }
+        (None, None, None) => return Ok(None),
+        _ => return Err("--tile needs --tiles; --spp-range excludes them".into()),
+    };
+    if args.write_partial_images || args.partial_interval.is_some() || args.display_server.is_some()
+    {
+        return Err("--write-partial-images, --partial-interval and --display-server do not work with --tile or --spp-range".into());
+    }
+    if format_for_path(&desc.film.filename)? != ImageFormat::Exr {
+        return Err(format!(
+            "{}: a part is written as OpenEXR: give an .exr --outfile",
+            desc.film.filename.display()
+        ));
+    }
+    Ok(Some(kind))
+}
+
+/// Renders one part of the frame and writes it (atomically, replacing an
+/// older copy: a rerun task overwrites its part).
+fn render_part_cli(args: &Args, desc: &SceneDescription, kind: PartKind, started: Instant) -> i32 {
+    let out = &desc.film.filename;
+    let opts = RenderOptions {
+        threads: args.threads.filter(|&n| n > 0),
+        seed: args.seed,
+        ..Default::default()
+    };
+    let stats = match render_part(desc, &opts, kind, out) {
+        Ok(s) => s,
+        Err(e) => return fail(e),
+    };
+    if !args.quiet {
+        let ready = started.elapsed().saturating_sub(stats.render_time);
+        eprintln!(
+            "{}: {kind}, {} spp, {} threads; load + build + write {:.3} s (build {:.3} s), render {:.3} s, {} samples",
+            out.display(),
+            desc.sampler.pixel_samples,
+            stats.threads,
+            ready.as_secs_f64(),
+            stats.build_time.as_secs_f64(),
+            stats.render_time.as_secs_f64(),
+            stats.samples
+        );
+    }
+    0
+}
+
 /// Writes partial images on a thread of its own (at most one waiting), so a
 /// slow disk never holds the render; joined before the final image is
 /// written, so a late partial write cannot replace it.
@@ -221,6 +309,7 @@ impl PartialWriter {
 }
 
 pub fn run(args: &Args) -> i32 {
+    let started = Instant::now();
     let label = scenes_label(args);
     let scenes = match load_scene_files_each(&args.scenes) {
         Ok(l) => l,
@@ -242,7 +331,7 @@ pub fn run(args: &Args) -> i32 {
         if args.warnings() {
             print_diagnostics(&loaded.warnings);
         }
-        let status = render_one(args, loaded.scene, loaded.film_has_cropwindow);
+        let status = render_one(args, loaded.scene, loaded.film_has_cropwindow, started);
         if status != 0 {
             return status;
         }
@@ -251,16 +340,29 @@ pub fn run(args: &Args) -> i32 {
 }
 
 /// Renders one scene with the command line's overrides and writes its image.
-fn render_one(args: &Args, mut desc: SceneDescription, film_has_cropwindow: bool) -> i32 {
+fn render_one(
+    args: &Args,
+    mut desc: SceneDescription,
+    film_has_cropwindow: bool,
+    started: Instant,
+) -> i32 {
     // Command-line overrides, validated before any work is done.
     // A value the flags cannot take is a usage error.
-    if let Err(e) = apply_overrides(args, &mut desc, film_has_cropwindow) {
-        eprintln!("error: {e}");
-        return super::USAGE_ERROR;
-    }
+    let part = match apply_overrides(args, &mut desc, film_has_cropwindow)
+        .and_then(|()| part_request(args, &desc))
+    {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return super::USAGE_ERROR;
+        }
+    };
     let out = desc.film.filename.clone();
     if let Err(e) = check_output_path(&out) {
         return fail(format!("cannot write {}: {e}", out.display()));
+    }
+    if let Some(kind) = part {
+        return render_part_cli(args, &desc, kind, started);
     }
 
     let show_progress = !args.quiet && std::io::stderr().is_terminal();

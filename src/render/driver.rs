@@ -2,6 +2,7 @@
 //! 16×16 tiles in parallel with rayon, merge them in a fixed order (so the
 //! image is bit-identical for any thread count), and count what happened.
 
+use crate::render::film::part::{self, PartHeader, PartKind};
 use crate::render::film::{luminance, Film, FilmTile, Image};
 use crate::render::geometry::Bounds2i;
 use crate::render::integrators::{Integrator, RayCounts, Scratch};
@@ -126,8 +127,30 @@ impl Renderer {
         samples: std::ops::Range<u32>,
         on_chunk: &mut dyn FnMut(&ChunkDone),
     ) {
+        self.render_region_observed(samples, None, on_chunk);
+    }
+
+    /// [`Renderer::render_samples_observed`], taking samples only in the
+    /// pixels of `region` (sample-space pixel coordinates; None: all). The
+    /// tiles, their order, the order of pixels and samples within a tile and
+    /// the merge order are those of the full render, with the pixels outside
+    /// `region` skipped: every film pixel that only samples inside `region`
+    /// can reach gets exactly the full render's sums, bit for bit (a render
+    /// farm's tile: see [`crate::render::film::part`]).
+    pub fn render_region_observed(
+        &mut self,
+        samples: std::ops::Range<u32>,
+        region: Option<Bounds2i>,
+        on_chunk: &mut dyn FnMut(&ChunkDone),
+    ) {
         let t1 = Instant::now();
-        let tiles = self.film.tiles(16);
+        let mut tiles = self.film.tiles(16);
+        if let Some(r) = region {
+            tiles.retain(|t| {
+                let i = t.intersect(&r);
+                i.width() > 0 && i.height() > 0
+            });
+        }
         let total = tiles.len();
         // Chunks bound the memory held by finished tiles awaiting their merge.
         let chunk = (self.stats.threads * 8).max(1);
@@ -138,7 +161,17 @@ impl Renderer {
             let rendered: Vec<(FilmTile, TileCounts)> = self.pool.install(|| {
                 group
                     .par_iter()
-                    .map(|&tb| render_tile(scene, integrator, film, sampler, tb, samples.clone()))
+                    .map(|&tb| {
+                        render_tile(
+                            scene,
+                            integrator,
+                            film,
+                            sampler,
+                            tb,
+                            region,
+                            samples.clone(),
+                        )
+                    })
                     .collect()
             });
             for (tile, c) in rendered {
@@ -158,6 +191,11 @@ impl Renderer {
             });
         }
         self.stats.render_time += t1.elapsed();
+    }
+
+    /// The sampler's samples per pixel.
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.sampler.samples_per_pixel()
     }
 
     /// The film as rendered so far.
@@ -214,6 +252,39 @@ pub fn render_observed(
     Ok((r.image(), r.stats()))
 }
 
+/// Renders part `kind` of the frame `desc` describes (a tile or a range of
+/// sample indices, see [`crate::render::film::part`]) and writes it to
+/// `path` atomically (replacing an older copy). Returns the statistics.
+pub fn render_part(
+    desc: &SceneDescription,
+    opts: &RenderOptions,
+    kind: PartKind,
+    path: &std::path::Path,
+) -> Result<RenderStats, String> {
+    let mut r = Renderer::new(desc, opts)?;
+    let spp = r.samples_per_pixel();
+    let header = PartHeader::new(desc, r.film(), opts.seed, kind);
+    match kind {
+        PartKind::Tile { index, count } => {
+            part::check_tile(r.film(), index, count)?;
+            let rect = part::tile_rect(r.film().pixel_bounds(), index, count);
+            let region = part::sample_region(r.film(), rect);
+            r.render_region_observed(0..spp, Some(region), &mut |_| {});
+            part::write_tile_part(path, &header, r.film())?;
+        }
+        PartKind::Samples { start, end } => {
+            if start >= end || end > spp {
+                return Err(format!(
+                    "{kind} is not a range of the {spp} samples per pixel"
+                ));
+            }
+            r.render_samples_observed(start..end, &mut |_| {});
+            part::write_samples_part(path, &header, r.film())?;
+        }
+    }
+    Ok(r.stats())
+}
+
 // Not inlined: a stable symbol for profilers (callgrind --toggle-collect).
 #[inline(never)]
 fn render_tile(
@@ -222,9 +293,16 @@ fn render_tile(
     film: &Film,
     proto: &Sampler,
     bounds: Bounds2i,
+    region: Option<Bounds2i>,
     samples: std::ops::Range<u32>,
 ) -> (FilmTile, TileCounts) {
+    // The film tile of the whole tile (as the full render), samples taken
+    // only in the region's pixels.
     let mut tile = film.tile(bounds);
+    let pixels = match region {
+        Some(r) => bounds.intersect(&r),
+        None => bounds,
+    };
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
@@ -237,7 +315,7 @@ fn render_tile(
     // only in scenes whose materials can use them.
     let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();
     let differentials = scene.differentials;
-    for pixel in bounds.iter() {
+    for pixel in pixels.iter() {
         for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
             let cs = sampler.camera_sample(pixel, lens);

@@ -10,6 +10,7 @@
 pub mod compare;
 pub mod filter;
 pub mod io;
+pub mod part;
 
 pub use filter::Filter;
 
@@ -258,7 +259,7 @@ impl Film {
 
 /// One pixel's value: `max(0, Σ wL / Σ w) × scale`, 0 where `Σ w == 0`.
 #[inline]
-fn pixel_rgb(p: &PixelSums, scale: f64) -> [f32; 3] {
+pub(crate) fn pixel_rgb(p: &PixelSums, scale: f64) -> [f32; 3] {
     if p.weight != 0.0 {
         let inv = 1.0 / p.weight;
         p.contrib.map(|c| ((c * inv).max(0.0) * scale) as f32)
