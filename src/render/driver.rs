@@ -179,9 +179,17 @@ impl Renderer {
                 "light selection: {:?} over {} lights that emit{}",
                 ls.kind(),
                 ls.active_count(),
-                match ls.kind() {
-                    crate::render::lights::LightSamplerKind::Spatial =>
+                match (ls.kind(), ls.bvh_shape()) {
+                    (crate::render::lights::LightSamplerKind::Spatial, _) =>
                         format!(", {} voxel distributions built", ls.voxels_built()),
+                    (_, Some((tree, inf, depth))) => format!(
+                        ", {tree} in a light BVH of depth {depth}, {inf} at infinity{}",
+                        if ls.spatial_fallback() {
+                            format!(" (\"spatial\" asked for: past {} lights pbrt-v3's voxel distributions would cost 128 estimates × every light per voxel, so the light BVH chooses instead)", crate::render::lights::SPATIAL_MAX_LIGHTS)
+                        } else {
+                            String::new()
+                        }
+                    ),
                     _ => String::new(),
                 }
             ));

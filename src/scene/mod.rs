@@ -241,6 +241,8 @@ pub enum LightSampleStrategy {
     Uniform,
     Power,
     Spatial,
+    /// A light BVH (a pbrs extension: pbrt-v4's BVHLightSampler).
+    Bvh,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
