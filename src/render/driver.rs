@@ -309,13 +309,7 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
     }
 }
 
-/// Memory available to new allocations (Linux `MemAvailable`), if known.
-pub fn available_memory_bytes() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
+pub use crate::scene::memory::available_memory_bytes;
 
 /// Peak resident memory of this process in bytes (Linux), if known.
 pub fn peak_memory_bytes() -> Option<u64> {

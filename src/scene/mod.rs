@@ -8,6 +8,7 @@
 
 mod fourier;
 pub mod image;
+pub mod memory;
 pub mod motion;
 mod params;
 mod textures;
