@@ -485,7 +485,7 @@ fn sah_split(range: &mut [(u32, LightBounds)], bounds: &Bounds3, cb: &Bounds3) -
     let d = cb.diagonal();
     let mut best = (f32::INFINITY, 0usize, 0usize);
     for dim in 0..3 {
-        if !(d[dim] > 0.0) {
+        if d[dim] <= 0.0 || d[dim].is_nan() {
             continue;
         }
         let bucket = |c: Vec3| {
