@@ -74,3 +74,19 @@ fn a_few_coincident_copies_keep_ploc_and_all_scenes_render() {
     let centre = img.pixel(8, 8);
     assert!(centre.x > 0.0, "centre pixel {centre:?}");
 }
+
+/// The memory budget names the amount and what needs it, and lets through
+/// what fits.
+#[test]
+fn memory_budget_names_the_amount() {
+    use pbrs::scene::memory::{available_memory_bytes, check_budget};
+    if available_memory_bytes().is_none() {
+        return; // not Linux: no budget known
+    }
+    let e = check_budget("the mesh's 1e12 vertices", 1 << 50).unwrap_err();
+    assert!(
+        e.contains("the mesh's 1e12 vertices needs 1048576.0 GiB") && e.contains("available"),
+        "{e}"
+    );
+    assert!(check_budget("a small thing", 1 << 20).is_ok());
+}
