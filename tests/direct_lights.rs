@@ -54,7 +54,9 @@ fn pick_frequencies(
     let mut pmf = vec![0.0; sc.lights.len()];
     for k in 0..n {
         let u = (k as f32 + 0.5) / n as f32;
-        let (i, p_i) = ls.sample(p, u, &sc.lights, &sc.geometry).expect("a light");
+        let (i, p_i) = ls
+            .sample(p, Vec3::ZERO, u, &sc.lights, &sc.geometry)
+            .expect("a light");
         let i = i as usize;
         freq[i] += 1.0 / n as f64;
         if pmf[i] == 0.0 {
@@ -164,12 +166,19 @@ fn one_light_is_uniform_for_every_strategy() {
         LightSamplerKind::Uniform,
         LightSamplerKind::Power,
         LightSamplerKind::Spatial,
+        LightSamplerKind::Bvh,
     ] {
         let ls = LightSampler::new(kind, &sc.lights, &sc.geometry);
         assert_eq!(ls.kind(), LightSamplerKind::Uniform, "{kind:?}");
         for u in [0.0, 0.3, 0.999_999] {
             let (i, pmf) = ls
-                .sample(Vec3::new(0.3, -1.5, 0.2), u, &sc.lights, &sc.geometry)
+                .sample(
+                    Vec3::new(0.3, -1.5, 0.2),
+                    Vec3::ZERO,
+                    u,
+                    &sc.lights,
+                    &sc.geometry,
+                )
                 .unwrap();
             assert_eq!((i, pmf), (0, 1.0), "{kind:?}");
         }

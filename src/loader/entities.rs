@@ -1427,8 +1427,9 @@ pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {
                 None | Some(("spatial", _)) => LightSampleStrategy::Spatial,
                 Some(("uniform", _)) => LightSampleStrategy::Uniform,
                 Some(("power", _)) => LightSampleStrategy::Power,
+                Some(("bvh", _)) => LightSampleStrategy::Bvh,
                 Some((other, loc)) => {
-                    ctx.warn(loc, format!("unknown light sample strategy \"{other}\": \"spatial\" is used (as pbrt-v3)"), "expected uniform, power or spatial");
+                    ctx.warn(loc, format!("unknown light sample strategy \"{other}\": \"spatial\" is used (as pbrt-v3)"), "expected uniform, power, spatial or bvh");
                     LightSampleStrategy::Spatial
                 }
             };

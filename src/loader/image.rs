@@ -134,7 +134,11 @@ fn check_size(w: u64, h: u64) -> Result<(), String> {
         return Err(format!("the image is empty ({w}×{h} pixels)"));
     }
     match w.checked_mul(h) {
-        Some(n) if n <= MAX_IMAGE_PIXELS => Ok(()),
+        // Decoded to f32 RGBA at most, plus the MIP pyramid (a third more).
+        Some(n) if n <= MAX_IMAGE_PIXELS => crate::scene::memory::check_budget(
+            &format!("the image ({w}×{h} pixels)"),
+            n * 16 * 4 / 3,
+        ),
         _ => Err(format!(
             "the image declares {w}×{h} pixels, more than pbrs reads ({MAX_IMAGE_PIXELS} pixels)"
         )),

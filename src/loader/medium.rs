@@ -205,6 +205,14 @@ fn grid(
         );
         return None;
     }
+    if let Err(why) = crate::scene::memory::check_budget(
+        &format!("{what}: the {} × {} × {} density grid", n[0], n[1], n[2]),
+        (voxels as u64).saturating_mul(4),
+    ) {
+        p.mark_all_used();
+        ctx.error(dq.values_loc, why, "too large for this machine", None);
+        return None;
+    }
     let mut density: Vec<f32> = values.iter().map(|&v| v as f32).collect();
     if density.iter().any(|d| !(d.is_finite() && *d >= 0.0)) {
         ctx.warn(

@@ -283,6 +283,13 @@ pub fn read_ply(data: &[u8]) -> Result<PlyMesh, String> {
             ]
             .iter()
             .find_map(|(a, b)| Some([idx(a)?, idx(b)?]));
+            // Positions as read (f32 ×3), then the render's copy, normals and uvs.
+            let per =
+                24 + if normal.is_some() { 24 } else { 0 } + if uv.is_some() { 16 } else { 0 };
+            crate::scene::memory::check_budget(
+                &format!("the mesh's {} vertices", el.count),
+                (el.count as u64).saturating_mul(per),
+            )?;
             mesh.positions.reserve(el.count);
             let mut normals = Vec::with_capacity(if normal.is_some() { el.count } else { 0 });
             let mut uvs = Vec::with_capacity(if uv.is_some() { el.count } else { 0 });

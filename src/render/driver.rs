@@ -217,9 +217,17 @@ impl Renderer {
                 "light selection: {:?} over {} lights that emit{}",
                 ls.kind(),
                 ls.active_count(),
-                match ls.kind() {
-                    crate::render::lights::LightSamplerKind::Spatial =>
+                match (ls.kind(), ls.bvh_shape()) {
+                    (crate::render::lights::LightSamplerKind::Spatial, _) =>
                         format!(", {} voxel distributions built", ls.voxels_built()),
+                    (_, Some((tree, inf, depth))) => format!(
+                        ", {tree} in a light BVH of depth {depth}, {inf} at infinity{}",
+                        if ls.spatial_fallback() {
+                            format!(" (\"spatial\" asked for: past {} lights pbrt-v3's voxel distributions would cost 128 estimates × every light per voxel, so the light BVH chooses instead)", crate::render::lights::SPATIAL_MAX_LIGHTS)
+                        } else {
+                            String::new()
+                        }
+                    ),
                     _ => String::new(),
                 }
             ));
@@ -379,13 +387,7 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
     }
 }
 
-/// Memory available to new allocations (Linux `MemAvailable`), if known.
-pub fn available_memory_bytes() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
+pub use crate::scene::memory::available_memory_bytes;
 
 /// Peak resident memory of this process in bytes (Linux), if known.
 pub fn peak_memory_bytes() -> Option<u64> {

@@ -215,6 +215,12 @@ impl RenderScene {
                 geometry.degenerate_triangles
             ));
         }
+        if geometry.build_work.bounded {
+            notes.push(format!(
+                "BVH: {} primitives share one box, so the scene level was built by binned SAH with median splits (bounded O(n log n)) instead of PLOC",
+                geometry.build_work.largest_coincident
+            ));
+        }
         if !geometry.has_bvh() {
             notes.push("no geometry: no BVH built".into());
         }

@@ -8,6 +8,7 @@
 
 mod fourier;
 pub mod image;
+pub mod memory;
 pub mod motion;
 mod params;
 mod textures;
@@ -241,6 +242,8 @@ pub enum LightSampleStrategy {
     Uniform,
     Power,
     Spatial,
+    /// A light BVH (a pbrs extension: pbrt-v4's BVHLightSampler).
+    Bvh,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

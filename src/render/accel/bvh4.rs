@@ -28,6 +28,25 @@ use obvhs::bvh2::Bvh2;
 use obvhs::ploc::PlocBuilder;
 use obvhs::BvhBuildParams;
 
+use super::split;
+
+/// Above this many primitives with one box, PLOC's cost grows as n times
+/// that count (see [`split`]); such levels use the bounded builder. Runs of
+/// a few coincident boxes (a mesh repeated twice) cost PLOC nothing much.
+const COINCIDENT_LIMIT: usize = 32;
+
+/// What a BVH build did (for `--stats` and tests).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildWork {
+    /// The bounded builder was used (many coincident primitives).
+    pub bounded: bool,
+    /// Most primitives sharing one box.
+    pub largest_coincident: usize,
+    /// Primitive touches counted: the coincidence check and the bounded
+    /// builder's passes (PLOC is not instrumented), and one per node made.
+    pub work: u64,
+}
+
 /// A child reference with this bit set is a leaf.
 const LEAF: u32 = 1 << 31;
 /// Most primitives in a leaf (one SIMD pack).
@@ -132,21 +151,45 @@ impl Bvh4 {
     /// triangle with vertices `triangle(i)` or something else for `None`).
     /// Returns the BVH and the primitives in BVH order (BVH position `p`
     /// holds primitive `order[p]`). `aabbs` must not be empty.
-    pub(super) fn build(
+    /// Builds over the boxes (primitive `i` has box `aabbs[i]`, and is a
+    /// triangle with vertices `triangle(i)` or something else for `None`).
+    /// Returns the BVH, the primitives in BVH order (BVH position `p` holds
+    /// primitive `order[p]`) and how it went: whether the bounded builder of
+    /// [`split`] was used, and the primitive touches it counted. `aabbs`
+    /// must not be empty.
+    pub(super) fn build_counted(
         aabbs: &[Aabb],
         params: BvhBuildParams,
         triangle: impl Fn(usize) -> Option<[Vec3; 3]>,
-    ) -> (Bvh4, Vec<u32>) {
+    ) -> (Bvh4, Vec<u32>, BuildWork) {
         assert!(!aabbs.is_empty());
-        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
-            params.ploc_search_distance,
-            aabbs,
-            (0..aabbs.len() as u32).collect(),
-            params.sort_precision,
-            params.search_depth_threshold,
-        );
-        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-        Self::from_bvh2(&bvh2, triangle)
+        let mut work = 0u64;
+        let run = split::largest_coincident_run(aabbs, &mut work);
+        let bounded = run > COINCIDENT_LIMIT;
+        let bvh2 = if bounded {
+            split::build(aabbs, &mut work)
+        } else {
+            let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+                params.ploc_search_distance,
+                aabbs,
+                (0..aabbs.len() as u32).collect(),
+                params.sort_precision,
+                params.search_depth_threshold,
+            );
+            ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+            bvh2
+        };
+        work += bvh2.nodes.len() as u64;
+        let (bvh, order) = Self::from_bvh2(&bvh2, triangle);
+        (
+            bvh,
+            order,
+            BuildWork {
+                bounded,
+                largest_coincident: run,
+                work,
+            },
+        )
     }
 
     fn from_bvh2(bvh2: &Bvh2, triangle: impl Fn(usize) -> Option<[Vec3; 3]>) -> (Bvh4, Vec<u32>) {
@@ -571,9 +614,10 @@ mod tests {
             .collect();
         aabbs.extend_from_slice(others);
         let n = tris.len();
-        Bvh4::build(&aabbs, BvhBuildParams::medium_build(), |i| {
+        let (bvh, order, _) = Bvh4::build_counted(&aabbs, BvhBuildParams::medium_build(), |i| {
             (i < n).then(|| tris[i])
-        })
+        });
+        (bvh, order)
     }
 
     /// Brute-force closest hit: (t, primitive).

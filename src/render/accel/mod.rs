@@ -14,6 +14,9 @@
 //! both levels and the closest hit is found across levels by `t` alone.
 
 mod bvh4;
+mod split;
+
+pub use bvh4::BuildWork;
 
 use crate::render::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
 use crate::render::shapes::{
@@ -107,6 +110,7 @@ struct Level {
     bvh: Option<Bvh4>,
     bounds: Bounds3,
     degenerate: u64,
+    build: BuildWork,
 }
 
 /// An object definition, built once and shared by all its instances.
@@ -409,12 +413,13 @@ impl Level {
             prims.push(tag(ii as u32));
             aabbs.push(Aabb::new(b.min.into(), b.max.into()));
         }
+        let mut build = BuildWork::default();
         let bvh = if prims.is_empty() {
             None
         } else {
             // Triangles of meshes with alpha masks are left to the
             // callbacks (like quadrics), so that only they pay for the test.
-            let (bvh, order) = Bvh4::build(&aabbs, build_params(aabbs.len()), |i| {
+            let (bvh, order, work) = Bvh4::build_counted(&aabbs, build_params(aabbs.len()), |i| {
                 let p = prims[i];
                 (p.mesh != QUADRIC_TAG
                     && p.mesh != INSTANCE_TAG
@@ -423,6 +428,7 @@ impl Level {
                 .then(|| meshes[p.mesh as usize].vertices(p.index))
             });
             prims = order.iter().map(|&i| prims[i as usize]).collect();
+            build = work;
             Some(bvh)
         };
         Level {
@@ -430,6 +436,7 @@ impl Level {
             bvh,
             bounds,
             degenerate,
+            build,
         }
     }
 }
@@ -589,6 +596,8 @@ pub struct Geometry {
     /// Triangles left out because they have zero area (each object's counted
     /// once, however often it is instanced).
     pub degenerate_triangles: u64,
+    /// The scene level's build (whether it needed the bounded builder).
+    pub build_work: BuildWork,
     pub build_time: Duration,
 }
 
@@ -628,6 +637,7 @@ impl Geometry {
         let boxes: Vec<Bounds3> = instances.iter().map(Instance::world_bounds).collect();
         let moving_boxes: Vec<Bounds3> = moving.iter().map(MovingInstance::world_bounds).collect();
         let top = Level::build(&meshes, &quadrics, &boxes, &moving_boxes);
+        let build_work = top.build;
         let mut degenerate = top.degenerate;
         let mut seen: Vec<*const Object> = Vec::new();
         let objects = instances
@@ -649,6 +659,7 @@ impl Geometry {
             instances,
             moving,
             degenerate_triangles: degenerate,
+            build_work,
             build_time: start.elapsed(),
         }
     }

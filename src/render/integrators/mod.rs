@@ -103,6 +103,7 @@ fn light_sampler_kind(s: LightSampleStrategy) -> LightSamplerKind {
         LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
         LightSampleStrategy::Power => LightSamplerKind::Power,
         LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
+        LightSampleStrategy::Bvh => LightSamplerKind::Bvh,
     }
 }
 
@@ -794,7 +795,9 @@ fn bsdf_mis_weight(
     wi: Vec3,
     bsdf_pdf: f32,
 ) -> f32 {
-    let pmf = lights.pmf(r.p, light, &scene.lights, &scene.geometry);
+    // The context of the vertex the BSDF sample left (pbrt-v4's
+    // PMF(prevIntrCtx, light)).
+    let pmf = lights.pmf(r.p, r.n, light, &scene.lights, &scene.geometry);
     if pmf == 0.0 {
         return 1.0;
     }
@@ -820,7 +823,8 @@ fn sample_light_mis(
     }
     let u = sampler.get_1d();
     let u_light = sampler.get_2d();
-    let Some((light_index, pmf)) = lights.sample(s.point.p, u, &scene.lights, &scene.geometry)
+    let Some((light_index, pmf)) =
+        lights.sample(s.point.p, s.point.n, u, &scene.lights, &scene.geometry)
     else {
         return Vec3::ZERO;
     };
@@ -896,7 +900,8 @@ fn sample_one_light(
         return Vec3::ZERO;
     }
     let u = sampler.get_1d();
-    let Some((light, pmf)) = lights.sample(s.point.p, u, &scene.lights, &scene.geometry) else {
+    let Some((light, pmf)) = lights.sample(s.point.p, s.point.n, u, &scene.lights, &scene.geometry)
+    else {
         return Vec3::ZERO;
     };
     let u_light = sampler.get_2d();

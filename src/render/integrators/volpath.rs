@@ -159,7 +159,9 @@ fn sample_light(
     }
     let u = sampler.get_1d();
     let u_light = sampler.get_2d();
-    let Some((light_index, pmf)) = lights.sample(point.p, u, &scene.lights, &scene.geometry) else {
+    let Some((light_index, pmf)) =
+        lights.sample(point.p, point.n, u, &scene.lights, &scene.geometry)
+    else {
         return Vec3::ZERO;
     };
     let light = &scene.lights[light_index as usize];

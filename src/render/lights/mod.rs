@@ -3,11 +3,12 @@
 //! map, [`infinite`]); and the distributions that choose which light to
 //! sample.
 
+pub mod bvh;
 mod distribution;
 pub mod infinite;
 mod pack;
 
-pub use distribution::{LightSampler, LightSamplerKind};
+pub use distribution::{LightSampler, LightSamplerKind, SPATIAL_MAX_LIGHTS};
 pub use infinite::{EnvMap, EnvSampling};
 pub use pack::{dot3, lane3, pack_triangle_lights, splat3, TriangleLightPack, Vec3x4};
 

@@ -1,0 +1,28 @@
+//! The machine's memory, for budgets: an input that would need more memory
+//! than is available (a film, a mesh, an image, a voxel grid) is an error
+//! naming the amount before anything is allocated, not an abort later.
+
+/// Memory available to new allocations (Linux `MemAvailable`), if known.
+pub fn available_memory_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+fn gib(b: u64) -> f64 {
+    b as f64 / (1u64 << 30) as f64
+}
+
+/// Ok if `need` bytes fit in 90% of the available memory (or it is not
+/// known); else "WHAT needs N GiB, more than the M GiB of memory available".
+pub fn check_budget(what: &str, need: u64) -> Result<(), String> {
+    match available_memory_bytes() {
+        Some(avail) if need > avail / 10 * 9 => Err(format!(
+            "{what} needs {:.1} GiB, more than the {:.1} GiB of memory available",
+            gib(need),
+            gib(avail)
+        )),
+        _ => Ok(()),
+    }
+}
