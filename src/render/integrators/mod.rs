@@ -683,7 +683,7 @@ fn subsurface_exit<'a>(
     )?;
     let sp = b.sr((s.point.p - pi.point.p).length());
     let pdf = pdf_sp(&b, s.point.p, frame, pi.point.p, pi.point.n) / found as f32;
-    if sp == Vec3::ZERO || !(pdf > 0.0) {
+    if sp == Vec3::ZERO || pdf.is_nan() || pdf <= 0.0 {
         return None;
     }
     let mut bsdf = Bsdf::new(Frame::from_normal(pi.point.ns), pi.point.n, b.eta);
