@@ -623,12 +623,9 @@ fn path_li(
             beta *= w;
             let wo = pi.point.ns;
             l += beta * sample_light_mis(scene, &pi, &exit, wo, sampler, scratch, lights);
-            let Some(bs) = exit.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
+            let Some(bs) = sample_exit(&pi, &exit, sampler) else {
                 break;
             };
-            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
-                break;
-            }
             beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
             specular_bounce = false;
             bsdf_pdf = bs.pdf;
@@ -692,6 +689,15 @@ fn subsurface_exit<'a>(
         radiance: true,
     });
     Some((pi, sp / pdf, bsdf))
+}
+
+/// The continuation from a BSSRDF exit point `pi`: a sample of its Sw lobe
+/// `exit` (wo along the exit's shading normal); `None` ends the path (no
+/// sample, zero value or density), as in pbrt-v3.
+#[inline]
+fn sample_exit(pi: &SurfaceHit, exit: &Bsdf, sampler: &mut Sampler) -> Option<BsdfSample> {
+    let bs = exit.sample(pi.point.ns, sampler.get_2d(), BxdfFlags::ALL)?;
+    (bs.f != Vec3::ZERO && bs.pdf != 0.0).then_some(bs)
 }
 
 /// Adds to `l` the radiance of the infinite lights along an escaped ray

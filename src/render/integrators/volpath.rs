@@ -24,8 +24,8 @@
 //! specular bounces; both are unbiased estimators of the same integral.
 
 use super::{
-    add_escaped_mis, emitted_mis, eta_scale_change, roulette, shade, subsurface_exit, Scratch,
-    MAX_PASS_THROUGH,
+    add_escaped_mis, emitted_mis, eta_scale_change, roulette, sample_exit, shade, subsurface_exit,
+    Scratch, MAX_PASS_THROUGH,
 };
 use crate::render::accel::SurfaceHit;
 use crate::render::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
@@ -388,12 +388,9 @@ pub(super) fn volpath_li(
                     scratch,
                     lights,
                 );
-            let Some(bs) = exit.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
+            let Some(bs) = sample_exit(&pi, &exit, sampler) else {
                 break;
             };
-            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
-                break;
-            }
             beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
             specular_bounce = false;
             scatter_pdf = bs.pdf;
