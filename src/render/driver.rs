@@ -3,14 +3,15 @@
 //! image is bit-identical for any thread count), and count what happened.
 
 use crate::render::film::part::{self, PartHeader, PartKind};
-use crate::render::film::{luminance, Film, FilmTile, Image};
+use crate::render::film::{luminance, Film, FilmTile, Image, TileMaker};
 use crate::render::geometry::Bounds2i;
 use crate::render::integrators::{Integrator, RayCounts, Scratch};
 use crate::render::samplers::Sampler;
 use crate::render::scene::RenderScene;
 use crate::scene::SceneDescription;
 use glam::Vec3;
-use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 /// Options that do not change the expected image.
@@ -152,44 +153,77 @@ impl Renderer {
             });
         }
         let total = tiles.len();
-        // Chunks bound the memory held by finished tiles awaiting their merge.
+        // Workers take tiles in order from a shared counter and send them
+        // here as they finish; this thread merges them in tile order (so the
+        // image is the same for any thread count) and reports after each
+        // group of `chunk` tiles. Nothing waits at the end of a group: a
+        // thread that finishes a tile takes the next one at once.
         let chunk = (self.stats.threads * 8).max(1);
-        let mut done = 0usize;
         let (scene, integrator, sampler) = (&self.scene, &self.integrator, &self.sampler);
-        for group in tiles.chunks(chunk) {
-            let film = &self.film;
-            let rendered: Vec<(FilmTile, TileCounts)> = self.pool.install(|| {
-                group
-                    .par_iter()
-                    .map(|&tb| {
-                        render_tile(
+        let maker = self.film.tile_maker();
+        let next = AtomicUsize::new(0);
+        let (tx, rx) = mpsc::channel::<(usize, FilmTile, TileCounts)>();
+        let pool = &self.pool;
+        let film = &mut self.film;
+        let stats = &mut self.stats;
+        std::thread::scope(|ts| {
+            let tiles = &tiles;
+            let (next, maker) = (&next, &maker);
+            ts.spawn(move || {
+                pool.broadcast(|_| {
+                    let tx = tx.clone();
+                    loop {
+                        let k = next.fetch_add(1, Ordering::Relaxed);
+                        let Some(&tb) = tiles.get(k) else { break };
+                        let (tile, c) = render_tile(
                             scene,
                             integrator,
-                            film,
+                            maker,
                             sampler,
                             tb,
                             region,
                             samples.clone(),
-                        )
-                    })
-                    .collect()
+                        );
+                        if tx.send((k, tile, c)).is_err() {
+                            break;
+                        }
+                    }
+                });
+                drop(tx);
             });
-            for (tile, c) in rendered {
-                self.film.merge_tile(tile);
-                self.stats.rays.add(&c.rays);
-                self.stats.samples += c.samples;
-                self.stats.nan_samples += c.nan;
-                self.stats.inf_samples += c.inf;
-                self.stats.negative_samples += c.negative;
+            // Finished tiles waiting for an earlier one (few: tiles are
+            // handed out in order).
+            let mut waiting: Vec<Option<(FilmTile, TileCounts)>> = Vec::new();
+            let mut merged = 0usize;
+            let mut reported = 0usize;
+            for (k, tile, c) in rx.iter() {
+                let slot = k - merged;
+                if waiting.len() <= slot {
+                    waiting.resize_with(slot + 1, || None);
+                }
+                waiting[slot] = Some((tile, c));
+                let ready = waiting.iter().take_while(|w| w.is_some()).count();
+                for (tile, c) in waiting.drain(..ready).flatten() {
+                    film.merge_tile(tile);
+                    stats.rays.add(&c.rays);
+                    stats.samples += c.samples;
+                    stats.nan_samples += c.nan;
+                    stats.inf_samples += c.inf;
+                    stats.negative_samples += c.negative;
+                }
+                merged += ready;
+                while merged - reported >= chunk || (merged == total && reported < total) {
+                    let end = (reported + chunk).min(merged);
+                    on_chunk(&ChunkDone {
+                        done: end,
+                        total,
+                        tiles: &tiles[reported..end],
+                        film,
+                    });
+                    reported = end;
+                }
             }
-            done += group.len();
-            on_chunk(&ChunkDone {
-                done,
-                total,
-                tiles: group,
-                film: &self.film,
-            });
-        }
+        });
         self.stats.render_time += t1.elapsed();
     }
 
@@ -298,7 +332,7 @@ pub fn render_part(
 fn render_tile(
     scene: &RenderScene,
     integrator: &Integrator,
-    film: &Film,
+    film: &TileMaker,
     proto: &Sampler,
     bounds: Bounds2i,
     region: Option<Bounds2i>,

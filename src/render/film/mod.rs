@@ -163,23 +163,17 @@ impl Film {
 
     /// A tile for samples taken in `tile_sample_bounds` (pbrt-v3's `GetFilmTile`).
     pub fn tile(&self, tile_sample_bounds: Bounds2i) -> FilmTile {
-        let r = self.filter.radius();
-        let half = Vec2::splat(0.5);
-        let p0 = (tile_sample_bounds.min.as_vec2() - half - r)
-            .ceil()
-            .as_ivec2();
-        let p1 = (tile_sample_bounds.max.as_vec2() - half + r)
-            .floor()
-            .as_ivec2()
-            + IVec2::ONE;
-        let pixel_bounds = Bounds2i::new(p0, p1).intersect(&self.pixel_bounds);
-        FilmTile {
-            pixel_bounds,
-            radius: r,
-            inv_radius: Vec2::ONE / r,
+        self.tile_maker().tile(tile_sample_bounds)
+    }
+
+    /// What making a tile needs of the film, without its pixels (so that
+    /// tiles can be made while the film is being merged into).
+    pub fn tile_maker(&self) -> TileMaker {
+        TileMaker {
+            radius: self.filter.radius(),
+            pixel_bounds: self.pixel_bounds,
             filter_table: self.filter_table,
             max_sample_luminance: self.max_sample_luminance,
-            pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
         }
     }
 
@@ -265,6 +259,40 @@ pub(crate) fn pixel_rgb(p: &PixelSums, scale: f64) -> [f32; 3] {
         p.contrib.map(|c| ((c * inv).max(0.0) * scale) as f32)
     } else {
         [0.0; 3]
+    }
+}
+
+/// Makes film tiles: [`Film::tile`] without a borrow of the film.
+#[derive(Clone, Debug)]
+pub struct TileMaker {
+    radius: Vec2,
+    pixel_bounds: Bounds2i,
+    filter_table: [f32; TABLE_SIZE],
+    max_sample_luminance: f32,
+}
+
+impl TileMaker {
+    /// The tile of sample bounds `tile_sample_bounds`: the film pixels its
+    /// samples' filter footprints reach.
+    pub fn tile(&self, tile_sample_bounds: Bounds2i) -> FilmTile {
+        let r = self.radius;
+        let half = Vec2::splat(0.5);
+        let p0 = (tile_sample_bounds.min.as_vec2() - half - r)
+            .ceil()
+            .as_ivec2();
+        let p1 = (tile_sample_bounds.max.as_vec2() - half + r)
+            .floor()
+            .as_ivec2()
+            + IVec2::ONE;
+        let pixel_bounds = Bounds2i::new(p0, p1).intersect(&self.pixel_bounds);
+        FilmTile {
+            pixel_bounds,
+            radius: r,
+            inv_radius: Vec2::ONE / r,
+            filter_table: self.filter_table,
+            max_sample_luminance: self.max_sample_luminance,
+            pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
+        }
     }
 }
 

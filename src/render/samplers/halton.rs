@@ -3,7 +3,7 @@
 
 use super::lowdiscrepancy::{
     inverse_radical_inverse, multiplicative_inverse, radical_inverse, radical_inverse_base2,
-    DigitBase, PermutationTables, PRIME_TABLE_SIZE,
+    DigitBase, PermutationTables, BLOCK_DIM_END, BLOCK_LANES, PRIME_TABLE_SIZE,
 };
 use super::ArrayStore;
 use crate::render::geometry::Bounds2i;
@@ -39,6 +39,12 @@ pub struct HaltonSampler {
     dimension: u32,
     array_end_dim: u32,
     arrays: ArrayStore,
+    /// Dimensions `block_dim ..` of index `block_index`, computed
+    /// `BLOCK_LANES` at a time (`block_len` of them valid; 0 when empty).
+    block: [f32; BLOCK_LANES],
+    block_dim: u32,
+    block_len: u32,
+    block_index: u64,
 }
 
 impl HaltonSampler {
@@ -78,6 +84,10 @@ impl HaltonSampler {
             dimension: 0,
             array_end_dim: ARRAY_START_DIM,
             arrays: ArrayStore::default(),
+            block: [0.0; BLOCK_LANES],
+            block_dim: 0,
+            block_len: 0,
+            block_index: 0,
         }
     }
 
@@ -130,14 +140,14 @@ impl HaltonSampler {
     /// pbrt-v3's `SampleDimension`, extended past the last prime with
     /// hashed values.
     #[inline]
-    fn sample_dimension(&self, index: u64, dim: u32) -> f32 {
+    fn sample_dimension(&mut self, index: u64, dim: u32) -> f32 {
         if self.sample_at_pixel_center && dim < 2 {
             return 0.5;
         }
         match dim {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
             1 => radical_inverse(&BASE3, self.scale1.as_ref().map_or(index, |s| s.div(index))),
-            d if (d as usize) < PRIME_TABLE_SIZE => self.tables.scrambled(d as usize, index),
+            d if (d as usize) < PRIME_TABLE_SIZE => self.scrambled(index, d),
             d => hash_to_unit(mix64(
                 mix64(index ^ self.seed_hash)
                     .wrapping_add((d as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)),
@@ -145,14 +155,37 @@ impl HaltonSampler {
         }
     }
 
+    /// Scrambled dimension `dim` (2 ..< PRIME_TABLE_SIZE) at `index`, from
+    /// the block of `BLOCK_LANES` consecutive dimensions computed together
+    /// (the dimensions of one sample are used in order, so a block serves
+    /// the next several calls); bit-identical to `tables.scrambled`. Only
+    /// the current sample's own index uses blocks: array entries past the
+    /// first have indices of their own and take one dimension each.
+    #[inline]
+    fn scrambled(&mut self, index: u64, dim: u32) -> f32 {
+        let k = dim.wrapping_sub(self.block_dim);
+        if k < self.block_len && index == self.block_index {
+            return self.block[k as usize];
+        }
+        if (dim as usize) < BLOCK_DIM_END
+            && index == self.interval_index
+            && index <= u32::MAX as u64
+        {
+            self.tables
+                .scrambled_block(dim as usize, index, &mut self.block);
+            self.block_dim = dim;
+            self.block_len = (BLOCK_DIM_END - dim as usize).min(BLOCK_LANES) as u32;
+            self.block_index = index;
+            return self.block[0];
+        }
+        self.tables.scrambled(dim as usize, index)
+    }
+
     /// Dimensions `dim` and `dim + 1` at `index` (one call for both).
     #[inline(never)]
-    fn sample_2d_dimensions(&self, index: u64, dim: u32) -> Vec2 {
+    fn sample_2d_dimensions(&mut self, index: u64, dim: u32) -> Vec2 {
         if dim >= 2 && ((dim + 1) as usize) < PRIME_TABLE_SIZE {
-            Vec2::new(
-                self.tables.scrambled(dim as usize, index),
-                self.tables.scrambled(dim as usize + 1, index),
-            )
+            Vec2::new(self.scrambled(index, dim), self.scrambled(index, dim + 1))
         } else {
             Vec2::new(
                 self.sample_dimension(index, dim),

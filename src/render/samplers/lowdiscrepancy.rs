@@ -240,6 +240,51 @@ pub struct PermutationTables {
     perms: Vec<u16>,
     pairs: Vec<u16>,
     dims: Vec<ScrambledDim>,
+    lanes: BlockLanes,
+}
+
+/// Dimensions `2..BLOCK_DIM_END` (bases 5 ..= 127, all with pair tables)
+/// can be computed `BLOCK_LANES` at a time by `scrambled_block`.
+pub const BLOCK_DIM_END: usize = 31;
+/// Dimensions per `scrambled_block` call: 8 lanes, two AVX2 vectors of f64.
+pub const BLOCK_LANES: usize = 8;
+
+/// Per-dimension constants of the pair-table dimensions as structure of
+/// arrays (indexed by dimension, padded by `BLOCK_LANES` past
+/// `BLOCK_DIM_END` with harmless values), so that a block of consecutive
+/// dimensions loads each constant as one vector.
+#[derive(Debug, Default)]
+struct BlockLanes {
+    base: Vec<f64>,
+    base2: Vec<f64>,
+    inv_base: Vec<f64>,
+    inv_base2: Vec<f64>,
+    tail: Vec<f64>,
+    /// Start of the dimension's pair table in `pairs`.
+    pairs: Vec<i32>,
+}
+
+impl BlockLanes {
+    fn new(dims: &[ScrambledDim]) -> Self {
+        let mut l = Self::default();
+        for d in 0..BLOCK_DIM_END + BLOCK_LANES {
+            // Dimensions 0 and 1 and the padding reuse dimension 2's
+            // constants; their lanes are computed and ignored.
+            let s = &dims[if (2..BLOCK_DIM_END).contains(&d) {
+                d
+            } else {
+                2
+            }];
+            debug_assert_ne!(s.pairs, NO_PAIRS);
+            l.base.push(s.b.base as f64);
+            l.base2.push(s.b.base2 as f64);
+            l.inv_base.push(s.b.inv_base);
+            l.inv_base2.push(s.b.inv_base2);
+            l.tail.push(s.tail);
+            l.pairs.push(s.pairs as i32);
+        }
+        l
+    }
 }
 
 impl PermutationTables {
@@ -281,7 +326,16 @@ impl PermutationTables {
             });
             off += p as usize;
         }
-        Self { perms, pairs, dims }
+        // The AVX2 gather reads 32 bits at a 16-bit entry: one entry of
+        // padding keeps the last read inside the table.
+        pairs.push(0);
+        let lanes = BlockLanes::new(&dims);
+        Self {
+            perms,
+            pairs,
+            dims,
+            lanes,
+        }
     }
 
     /// Shared tables for a seed: seed 0 gives pbrt-v3's own permutations
@@ -329,6 +383,109 @@ impl PermutationTables {
             let perm = &self.perms[d.perm as usize..d.perm as usize + d.b.base as usize];
             scrambled_radical_inverse(&d.b, perm, d.tail, a)
         }
+    }
+}
+
+impl PermutationTables {
+    /// `scrambled(first + k, a)` for `k < BLOCK_LANES` into `out[k]`, bit
+    /// for bit, with the dimensions in SIMD lanes; `first` in
+    /// `2..BLOCK_DIM_END` and `a <= u32::MAX`. Lanes at or past
+    /// `BLOCK_DIM_END` hold unspecified values.
+    #[inline]
+    pub fn scrambled_block(&self, first: usize, a: u64, out: &mut [f32; BLOCK_LANES]) {
+        assert!((2..BLOCK_DIM_END).contains(&first) && a <= u32::MAX as u64);
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        // SAFETY: AVX2 is enabled at compile time; the constant loads stay
+        // inside `lanes` (padded by BLOCK_LANES past BLOCK_DIM_END) and
+        // every gather index is a pair-table entry of a dimension below
+        // BLOCK_DIM_END (the table is padded for the 32-bit read).
+        unsafe {
+            self.scrambled_block_avx2(first, a as u32, out)
+        }
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        for (k, v) in out.iter_mut().enumerate() {
+            *v = self.scrambled((first + k).min(BLOCK_DIM_END - 1), a);
+        }
+    }
+
+    /// `scrambled_radical_inverse_pairs` in eight lanes: the same steps
+    /// per lane (two digits while `a >= base²`, then one or two), the
+    /// reversed digits held exactly in f64 (below 2^40), quotients by
+    /// correctly rounded division (exact when floored, for `a < 2^53`).
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    #[inline]
+    unsafe fn scrambled_block_avx2(&self, first: usize, a: u32, out: &mut [f32; BLOCK_LANES]) {
+        use std::arch::x86_64::*;
+        let l = &self.lanes;
+        let ld = |v: &Vec<f64>, k: usize| _mm256_loadu_pd(v.as_ptr().add(first + k));
+        let (b_lo, b_hi) = (ld(&l.base, 0), ld(&l.base, 4));
+        let (b2_lo, b2_hi) = (ld(&l.base2, 0), ld(&l.base2, 4));
+        let (ib_lo, ib_hi) = (ld(&l.inv_base, 0), ld(&l.inv_base, 4));
+        let (ib2_lo, ib2_hi) = (ld(&l.inv_base2, 0), ld(&l.inv_base2, 4));
+        let off_lo = _mm_loadu_si128(l.pairs.as_ptr().add(first) as *const __m128i);
+        let off_hi = _mm_loadu_si128(l.pairs.as_ptr().add(first + 4) as *const __m128i);
+        let table = self.pairs.as_ptr() as *const i32;
+        let low16 = _mm_set1_epi32(0xffff);
+        // Entry `i` of a dimension's pair table, for 4 lanes.
+        let gather = |i: __m256d, off: __m128i| {
+            let idx = _mm_add_epi32(_mm256_cvttpd_epi32(i), off);
+            _mm256_cvtepi32_pd(_mm_and_si128(_mm_i32gather_epi32::<2>(table, idx), low16))
+        };
+        let mut a_lo = _mm256_set1_pd(a as f64);
+        let mut a_hi = a_lo;
+        let mut rev_lo = _mm256_setzero_pd();
+        let mut rev_hi = rev_lo;
+        let mut inv_lo = _mm256_set1_pd(1.0);
+        let mut inv_hi = inv_lo;
+        loop {
+            let m_lo = _mm256_cmp_pd::<_CMP_GE_OQ>(a_lo, b2_lo);
+            let m_hi = _mm256_cmp_pd::<_CMP_GE_OQ>(a_hi, b2_hi);
+            if _mm256_movemask_pd(_mm256_or_pd(m_lo, m_hi)) == 0 {
+                break;
+            }
+            let q_lo = _mm256_floor_pd(_mm256_div_pd(a_lo, b2_lo));
+            let q_hi = _mm256_floor_pd(_mm256_div_pd(a_hi, b2_hi));
+            let r_lo = _mm256_sub_pd(a_lo, _mm256_mul_pd(q_lo, b2_lo));
+            let r_hi = _mm256_sub_pd(a_hi, _mm256_mul_pd(q_hi, b2_hi));
+            let d_lo = gather(r_lo, off_lo);
+            let d_hi = gather(r_hi, off_hi);
+            let nr_lo = _mm256_add_pd(_mm256_mul_pd(rev_lo, b2_lo), d_lo);
+            let nr_hi = _mm256_add_pd(_mm256_mul_pd(rev_hi, b2_hi), d_hi);
+            rev_lo = _mm256_blendv_pd(rev_lo, nr_lo, m_lo);
+            rev_hi = _mm256_blendv_pd(rev_hi, nr_hi, m_hi);
+            inv_lo = _mm256_blendv_pd(inv_lo, _mm256_mul_pd(inv_lo, ib2_lo), m_lo);
+            inv_hi = _mm256_blendv_pd(inv_hi, _mm256_mul_pd(inv_hi, ib2_hi), m_hi);
+            a_lo = _mm256_blendv_pd(a_lo, q_lo, m_lo);
+            a_hi = _mm256_blendv_pd(a_hi, q_hi, m_hi);
+        }
+        // The last one or two digits: entry `a` (two digits) when
+        // `a >= base`, else entry `base² + a` (one digit) when `a != 0`.
+        let zero = _mm256_setzero_pd();
+        let two_lo = _mm256_cmp_pd::<_CMP_GE_OQ>(a_lo, b_lo);
+        let two_hi = _mm256_cmp_pd::<_CMP_GE_OQ>(a_hi, b_hi);
+        let nz_lo = _mm256_cmp_pd::<_CMP_GT_OQ>(a_lo, zero);
+        let nz_hi = _mm256_cmp_pd::<_CMP_GT_OQ>(a_hi, zero);
+        let i_lo = _mm256_blendv_pd(_mm256_add_pd(a_lo, b2_lo), a_lo, two_lo);
+        let i_hi = _mm256_blendv_pd(_mm256_add_pd(a_hi, b2_hi), a_hi, two_hi);
+        let d_lo = gather(i_lo, off_lo);
+        let d_hi = gather(i_hi, off_hi);
+        let mul_lo = _mm256_blendv_pd(b_lo, b2_lo, two_lo);
+        let mul_hi = _mm256_blendv_pd(b_hi, b2_hi, two_hi);
+        let im_lo = _mm256_blendv_pd(ib_lo, ib2_lo, two_lo);
+        let im_hi = _mm256_blendv_pd(ib_hi, ib2_hi, two_hi);
+        let nr_lo = _mm256_add_pd(_mm256_mul_pd(rev_lo, mul_lo), d_lo);
+        let nr_hi = _mm256_add_pd(_mm256_mul_pd(rev_hi, mul_hi), d_hi);
+        rev_lo = _mm256_blendv_pd(rev_lo, nr_lo, nz_lo);
+        rev_hi = _mm256_blendv_pd(rev_hi, nr_hi, nz_hi);
+        inv_lo = _mm256_blendv_pd(inv_lo, _mm256_mul_pd(inv_lo, im_lo), nz_lo);
+        inv_hi = _mm256_blendv_pd(inv_hi, _mm256_mul_pd(inv_hi, im_hi), nz_hi);
+        let v_lo = _mm256_mul_pd(inv_lo, _mm256_add_pd(rev_lo, ld(&l.tail, 0)));
+        let v_hi = _mm256_mul_pd(inv_hi, _mm256_add_pd(rev_hi, ld(&l.tail, 4)));
+        let cap = _mm_set1_ps(ONE_MINUS_EPSILON);
+        let f_lo = _mm_min_ps(_mm256_cvtpd_ps(v_lo), cap);
+        let f_hi = _mm_min_ps(_mm256_cvtpd_ps(v_hi), cap);
+        _mm_storeu_ps(out.as_mut_ptr(), f_lo);
+        _mm_storeu_ps(out.as_mut_ptr().add(4), f_hi);
     }
 }
 
@@ -426,6 +583,35 @@ mod tests {
                     scrambled_radical_inverse(b, perm, tail, a).to_bits(),
                     "dim {dim} a {a}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn blocks_are_bit_identical() {
+        for seed in [0u64, 9] {
+            let t = PermutationTables::shared(seed);
+            let mut r = Pcg32::with_sequence(13);
+            let mut out = [0f32; BLOCK_LANES];
+            for first in 2..BLOCK_DIM_END {
+                for k in 0..3000u64 {
+                    let a = match k % 3 {
+                        0 => k,
+                        1 => r.uniform_u32() as u64,
+                        _ => u32::MAX as u64 - k,
+                    };
+                    t.scrambled_block(first, a, &mut out);
+                    for (j, &v) in out.iter().enumerate() {
+                        if first + j < BLOCK_DIM_END {
+                            assert_eq!(
+                                v.to_bits(),
+                                t.scrambled(first + j, a).to_bits(),
+                                "dim {} a {a}",
+                                first + j
+                            );
+                        }
+                    }
+                }
             }
         }
     }
