@@ -5,8 +5,8 @@
 use crate::render::film::part::{self, PartHeader, PartKind};
 use crate::render::film::{luminance, Film, FilmTile, Image, TileMaker};
 use crate::render::geometry::Bounds2i;
-use crate::render::integrators::{Integrator, RayCounts, Scratch};
-use crate::render::samplers::Sampler;
+use crate::render::integrators::{Batch, Integrator, RayCounts, Scratch};
+use crate::render::samplers::{CameraSample, Sampler};
 use crate::render::scene::RenderScene;
 use crate::scene::SceneDescription;
 use glam::Vec3;
@@ -21,8 +21,9 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Seed for the sampler's scrambling and random dimensions.
     pub seed: u64,
-    /// Scalar code only: no four-lane fast paths (they give the same image
-    /// bit for bit; tests compare the two).
+    /// Scalar code only: no four-lane fast paths and no batches, each
+    /// sample rendered from its camera ray to its end before the next (they
+    /// give the same image bit for bit; tests compare the two).
     pub scalar: bool,
 }
 
@@ -80,6 +81,8 @@ pub struct Renderer {
     sampler: Sampler,
     pool: rayon::ThreadPool,
     stats: RenderStats,
+    /// Samples in flight per thread (1: the scalar loop).
+    batch: usize,
 }
 
 impl Renderer {
@@ -107,6 +110,7 @@ impl Renderer {
             sampler,
             pool,
             stats,
+            batch: if opts.scalar { 1 } else { BATCH },
         })
     }
 
@@ -160,6 +164,7 @@ impl Renderer {
         // thread that finishes a tile takes the next one at once.
         let chunk = (self.stats.threads * 8).max(1);
         let (scene, integrator, sampler) = (&self.scene, &self.integrator, &self.sampler);
+        let batch = self.batch;
         let maker = self.film.tile_maker();
         let next = AtomicUsize::new(0);
         let (tx, rx) = mpsc::channel::<(usize, FilmTile, TileCounts)>();
@@ -175,15 +180,28 @@ impl Renderer {
                     loop {
                         let k = next.fetch_add(1, Ordering::Relaxed);
                         let Some(&tb) = tiles.get(k) else { break };
-                        let (tile, c) = render_tile(
-                            scene,
-                            integrator,
-                            maker,
-                            sampler,
-                            tb,
-                            region,
-                            samples.clone(),
-                        );
+                        let (tile, c) = if batch > 1 {
+                            render_tile_batched(
+                                scene,
+                                integrator,
+                                maker,
+                                sampler,
+                                tb,
+                                region,
+                                samples.clone(),
+                                batch,
+                            )
+                        } else {
+                            render_tile(
+                                scene,
+                                integrator,
+                                maker,
+                                sampler,
+                                tb,
+                                region,
+                                samples.clone(),
+                            )
+                        };
                         if tx.send((k, tile, c)).is_err() {
                             break;
                         }
@@ -377,24 +395,109 @@ fn render_tile(
             } else {
                 Vec3::ZERO
             };
-            // pbrt-v3: samples with NaN, infinite or negative radiance are
-            // zeroed (their weight is kept) and counted.
-            if l.is_nan() {
-                c.nan += 1;
-                l = Vec3::ZERO;
-            } else if !l.is_finite() {
-                c.inf += 1;
-                l = Vec3::ZERO;
-            } else if luminance(l) < -1e-5 {
-                c.negative += 1;
-                l = Vec3::ZERO;
-            }
+            l = sanitise(l, &mut c);
             tile.add_sample(cs.p_film, l, weight);
             c.samples += 1;
         }
     }
     c.rays = scratch.counts();
     (tile, c)
+}
+
+/// Samples in flight per thread in the batched renderer: enough
+/// independent paths for the core to overlap one's memory and division
+/// latencies with another's work, few enough that their state (about 300
+/// bytes a lane, the sampler included) stays in the first-level cache.
+pub const BATCH: usize = 16;
+
+/// [`render_tile`] with `lanes` samples at a time: their camera rays, then
+/// the integrator's batch ([`Integrator::li_batch`]), then the film, in
+/// the scalar loop's order (so the tile's sums are the same bit for bit).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn render_tile_batched(
+    scene: &RenderScene,
+    integrator: &Integrator,
+    film: &TileMaker,
+    proto: &Sampler,
+    bounds: Bounds2i,
+    region: Option<Bounds2i>,
+    samples: std::ops::Range<u32>,
+    lanes: usize,
+) -> (FilmTile, TileCounts) {
+    let mut tile = film.tile(bounds);
+    let pixels = match region {
+        Some(r) => bounds.intersect(&r),
+        None => bounds,
+    };
+    let mut b = Batch::new(lanes, proto);
+    let mut cs = vec![CameraSample::default(); lanes];
+    let mut weights = vec![0.0f32; lanes];
+    let mut scratch = Scratch::default();
+    let mut c = TileCounts::default();
+    let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
+    let lens = scene.camera.uses_lens() || moving;
+    let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();
+    let differentials = scene.differentials;
+    let mut todo = pixels
+        .iter()
+        .flat_map(|p| samples.clone().map(move |i| (p, i)))
+        .peekable();
+    while todo.peek().is_some() {
+        // Camera rays.
+        b.len = 0;
+        for (pixel, i) in todo.by_ref().take(lanes) {
+            let j = b.len;
+            let sampler = &mut b.samplers[j];
+            sampler.start_pixel_sample(pixel, i);
+            cs[j] = sampler.camera_sample(pixel, lens);
+            b.times[j] = if moving {
+                scene.camera.time(&cs[j])
+            } else {
+                0.0
+            };
+            let (ray, diff, weight) = if differentials {
+                let (ray, d, w) = scene.camera.generate_ray_differential(&cs[j], diff_scale);
+                (ray, Some(d), w)
+            } else {
+                let (ray, w) = scene.camera.generate_ray(&cs[j]);
+                (ray, None, w)
+            };
+            b.rays[j] = ray;
+            b.diffs[j] = diff;
+            weights[j] = weight;
+            b.live[j] = weight > 0.0;
+            b.len += 1;
+        }
+        // Radiance.
+        integrator.li_batch(&mut b, scene, &mut scratch);
+        // The film, in sample order.
+        for j in 0..b.len {
+            let l = sanitise(b.l[j], &mut c);
+            tile.add_sample(cs[j].p_film, l, weights[j]);
+            c.samples += 1;
+        }
+    }
+    c.rays = scratch.counts();
+    (tile, c)
+}
+
+/// pbrt-v3: samples with NaN, infinite or negative radiance are zeroed
+/// (their weight is kept) and counted.
+#[inline]
+fn sanitise(l: Vec3, c: &mut TileCounts) -> Vec3 {
+    if l.is_nan() {
+        c.nan += 1;
+        Vec3::ZERO
+    } else if !l.is_finite() {
+        c.inf += 1;
+        Vec3::ZERO
+    } else if luminance(l) < -1e-5 {
+        c.negative += 1;
+        Vec3::ZERO
+    } else {
+        l
+    }
 }
 
 /// Bytes per film pixel over a render: f64 sums (32), the final linear image

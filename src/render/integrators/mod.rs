@@ -54,6 +54,44 @@ struct Work {
     pass: u32,
 }
 
+/// The samples a thread renders together (see [`Integrator::li_batch`]):
+/// per lane its sampler, camera ray and result, in structure-of-arrays
+/// form. Made once per tile; nothing in it allocates per batch.
+pub struct Batch {
+    /// Lanes in use.
+    pub len: usize,
+    pub samplers: Vec<Sampler>,
+    pub rays: Vec<Ray>,
+    pub diffs: Vec<Option<RayDiff>>,
+    pub times: Vec<f32>,
+    /// Lanes whose camera ray carries radiance (weight > 0).
+    pub live: Vec<bool>,
+    /// The radiance of each lane.
+    pub l: Vec<Vec3>,
+    hits: Vec<Option<Hit>>,
+    states: Vec<PathState>,
+    active: Vec<u32>,
+}
+
+impl Batch {
+    /// A batch of `lanes` lanes, each with a copy of `sampler`.
+    pub fn new(lanes: usize, sampler: &Sampler) -> Batch {
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        Batch {
+            len: 0,
+            samplers: vec![sampler.clone(); lanes],
+            rays: vec![ray; lanes],
+            diffs: vec![None; lanes],
+            times: vec![0.0; lanes],
+            live: vec![false; lanes],
+            l: vec![Vec3::ZERO; lanes],
+            hits: vec![None; lanes],
+            states: vec![PathState::new(ray, None); lanes],
+            active: Vec::with_capacity(lanes),
+        }
+    }
+}
+
 /// Per-tile scratch space, so the per-sample path never allocates.
 #[derive(Default)]
 pub struct Scratch {
@@ -254,7 +292,104 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.specular_tree_li(ray, time, diff, scene, sampler, scratch)
+                self.specular_tree_li(ray, None, time, diff, scene, sampler, scratch)
+            }
+        }
+    }
+
+    /// [`Integrator::li`] for the camera rays of a batch of samples, lane by
+    /// lane the same values bit for bit: `path` advances all the batch's
+    /// paths one vertex at a time (all closest hits, then all shading and
+    /// light sampling), directlighting and whitted trace all camera rays
+    /// first, volpath renders lane by lane. Each lane has its own sampler,
+    /// positioned at its sample; lanes with `live` false get no radiance.
+    pub fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
+        let n = b.len;
+        match self {
+            Integrator::Path {
+                max_depth,
+                rr_threshold,
+                lights,
+            } => {
+                b.active.clear();
+                for j in 0..n {
+                    b.l[j] = Vec3::ZERO;
+                    if b.live[j] {
+                        b.states[j] = PathState::new(b.rays[j], b.diffs[j]);
+                        b.active.push(j as u32);
+                    }
+                }
+                let mut bsdf = Bsdf::empty();
+                while !b.active.is_empty() {
+                    for &j in &b.active {
+                        let j = j as usize;
+                        scratch.counts.closest += 1;
+                        b.hits[j] = scene.geometry.intersect_at(&b.states[j].ray, b.times[j]);
+                    }
+                    let mut kept = 0;
+                    for k in 0..b.active.len() {
+                        let j = b.active[k] as usize;
+                        let p = PathParams {
+                            scene,
+                            time: b.times[j],
+                            max_depth: *max_depth,
+                            rr_threshold: *rr_threshold,
+                            lights,
+                        };
+                        if path_step(
+                            &mut b.states[j],
+                            b.hits[j],
+                            &p,
+                            &mut b.samplers[j],
+                            scratch,
+                            &mut bsdf,
+                        ) {
+                            b.active[kept] = j as u32;
+                            kept += 1;
+                        } else {
+                            b.l[j] = b.states[j].l;
+                        }
+                    }
+                    b.active.truncate(kept);
+                }
+            }
+            Integrator::Direct { .. } | Integrator::Whitted { .. } => {
+                for j in 0..n {
+                    if b.live[j] {
+                        b.hits[j] = scene.geometry.intersect_at(&b.rays[j], b.times[j]);
+                    }
+                }
+                for j in 0..n {
+                    b.l[j] = if b.live[j] {
+                        self.specular_tree_li(
+                            b.rays[j],
+                            Some(b.hits[j]),
+                            b.times[j],
+                            b.diffs[j],
+                            scene,
+                            &mut b.samplers[j],
+                            scratch,
+                        )
+                    } else {
+                        Vec3::ZERO
+                    };
+                }
+            }
+            Integrator::VolPath { .. } => {
+                for j in 0..n {
+                    b.l[j] = if b.live[j] {
+                        self.li(
+                            b.rays[j],
+                            b.times[j],
+                            b.diffs[j],
+                            scene,
+                            &mut b.samplers[j],
+                            scratch,
+                        )
+                    } else {
+                        Vec3::ZERO
+                    };
+                }
             }
         }
     }
@@ -266,9 +401,11 @@ impl Integrator {
     /// transmission, as pbrt-v3 recurses; both specular samples of a vertex
     /// are drawn when it is expanded (the same distribution as pbrt-v3, which
     /// draws the transmission sample after the reflection subtree).
+    #[allow(clippy::too_many_arguments)]
     fn specular_tree_li(
         &self,
         ray: Ray,
+        first_hit: Option<Option<Hit>>,
         time: f32,
         diff: Option<RayDiff>,
         scene: &RenderScene,
@@ -277,7 +414,9 @@ impl Integrator {
     ) -> Vec3 {
         let mut stack = std::mem::take(&mut scratch.work);
         stack.clear();
-        stack.push(Work {
+        // The camera ray's vertex is taken without going through the stack
+        // (most samples have no other).
+        let mut root = Some(Work {
             ray,
             diff,
             beta: Vec3::ONE,
@@ -286,9 +425,14 @@ impl Integrator {
         });
         let mut l = Vec3::ZERO;
         let mut bsdf = Bsdf::empty();
-        while let Some(w) = stack.pop() {
+        let mut first_hit = first_hit;
+        while let Some(w) = root.take().or_else(|| stack.pop()) {
             scratch.counts.closest += 1;
-            let Some(hit) = scene.geometry.intersect_at(&w.ray, time) else {
+            let hit = match first_hit.take() {
+                Some(h) => h,
+                None => scene.geometry.intersect_at(&w.ray, time),
+            };
+            let Some(hit) = hit else {
                 l += w.beta * escaped(scene, w.ray.d);
                 continue;
             };
@@ -536,7 +680,7 @@ fn escaped(scene: &RenderScene, d: Vec3) -> Vec3 {
 /// next-event estimation happens below it).
 #[allow(clippy::too_many_arguments)]
 fn path_li(
-    mut ray: Ray,
+    ray: Ray,
     time: f32,
     diff: Option<RayDiff>,
     scene: &RenderScene,
@@ -546,98 +690,177 @@ fn path_li(
     rr_threshold: f32,
     lights: &LightSampler,
 ) -> Vec3 {
-    let mut l = Vec3::ZERO;
+    let mut st = PathState::new(ray, diff);
     let mut bsdf = Bsdf::empty();
-    let mut beta = Vec3::ONE;
-    // Only the camera ray has differentials: pbrt-v3's path tracer spawns
-    // every later ray without them, specular bounces included.
-    let mut diff = diff;
-    let mut specular_bounce = false;
-    let mut eta_scale = 1.0f32;
-    let mut bounces = 0u32;
-    let mut pass = 0u32;
-    // The last scattering vertex and the BSDF density of the direction
-    // sampled there (for the MIS weight of emission found along it).
-    let mut prev: Option<SurfacePoint> = None;
-    let mut bsdf_pdf = 0.0f32;
+    let p = PathParams {
+        scene,
+        time,
+        max_depth,
+        rr_threshold,
+        lights,
+    };
     loop {
         scratch.counts.closest += 1;
-        let hit = scene.geometry.intersect_at(&ray, time);
-        let from = prev.filter(|_| !specular_bounce);
-        let Some(hit) = hit else {
-            add_escaped_mis(&mut l, scene, lights, beta, from.as_ref(), ray.d, bsdf_pdf);
-            break;
-        };
-        let mut s = scene.geometry.surface_at(&hit, time);
-        let wo = -ray.d;
-        l += emitted_mis(scene, lights, beta, &s, from.as_ref(), ray.d, bsdf_pdf);
-        if bounces >= max_depth {
+        let hit = scene.geometry.intersect_at(&st.ray, time);
+        if !path_step(&mut st, hit, &p, sampler, scratch, &mut bsdf) {
             break;
         }
-        let material = &scene.materials[s.material as usize];
-        if material.is_none() {
-            // Pass through without counting a bounce (pbrt-v3: bounces--).
-            pass += 1;
-            if pass > MAX_PASS_THROUGH {
-                break;
-            }
-            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
-            diff = None;
-            continue;
-        }
-        shade(
-            scene,
-            &hit,
-            &mut s,
-            material,
-            true,
-            diff.as_ref(),
-            &mut bsdf,
-        );
-        diff = None;
-        if bsdf.has_non_specular() {
-            l += beta * sample_light_mis(scene, &s, &bsdf, wo, sampler, scratch, lights);
-        }
-        let u = sampler.get_2d();
-        let Some(bs) = bsdf.sample(wo, u, BxdfFlags::ALL) else {
-            break;
-        };
-        if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
-            break;
-        }
-        beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
-        specular_bounce = bs.is_specular();
-        bsdf_pdf = bs.pdf;
-        prev = Some(s.point);
-        eta_scale *= eta_scale_change(&bsdf, &bs, wo, s.point.n);
-        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-        if bs.is_transmission() && material.has_bssrdf() {
-            // pbrt-v3's subsurface step: continue from a sampled exit
-            // point, with light sampled there, not counted as a bounce.
-            let frame = bsdf.frame;
-            let Some((pi, w, exit)) =
-                subsurface_exit(scene, &hit, &s, material, &frame, time, sampler, scratch)
-            else {
-                break;
-            };
-            beta *= w;
-            let wo = pi.point.ns;
-            l += beta * sample_light_mis(scene, &pi, &exit, wo, sampler, scratch, lights);
-            let Some(bs) = sample_exit(&pi, &exit, sampler) else {
-                break;
-            };
-            beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
-            specular_bounce = false;
-            bsdf_pdf = bs.pdf;
-            prev = Some(pi.point);
-            ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
-        }
-        if roulette(&mut beta, eta_scale, rr_threshold, bounces, sampler) {
-            break;
-        }
-        bounces += 1;
     }
-    l
+    st.l
+}
+
+/// A path of `path` between two vertices: what [`path_step`] carries from
+/// one intersection to the next (the batched renderer keeps one per lane).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathState {
+    /// The ray to trace next.
+    ray: Ray,
+    /// Its differentials (only the camera ray has them: pbrt-v3's path
+    /// tracer spawns every later ray without them, specular bounces
+    /// included).
+    diff: Option<RayDiff>,
+    /// Radiance gathered so far.
+    pub l: Vec3,
+    beta: Vec3,
+    specular_bounce: bool,
+    eta_scale: f32,
+    bounces: u32,
+    pass: u32,
+    /// The last scattering vertex and the BSDF density of the direction
+    /// sampled there (for the MIS weight of emission found along it).
+    prev: Option<SurfacePoint>,
+    bsdf_pdf: f32,
+}
+
+impl PathState {
+    #[inline]
+    pub(crate) fn new(ray: Ray, diff: Option<RayDiff>) -> PathState {
+        PathState {
+            ray,
+            diff,
+            l: Vec3::ZERO,
+            beta: Vec3::ONE,
+            specular_bounce: false,
+            eta_scale: 1.0,
+            bounces: 0,
+            pass: 0,
+            prev: None,
+            bsdf_pdf: 0.0,
+        }
+    }
+}
+
+/// What every step of a `path` render shares.
+pub(crate) struct PathParams<'a> {
+    scene: &'a RenderScene,
+    time: f32,
+    max_depth: u32,
+    rr_threshold: f32,
+    lights: &'a LightSampler,
+}
+
+/// One vertex of the path tracer: `hit` is the intersection of `st.ray`
+/// (already traced and counted). Gathers emission and a light sample, then
+/// samples the next direction into `st.ray`; false when the path ends.
+#[inline(always)]
+fn path_step<'a>(
+    st: &mut PathState,
+    hit: Option<Hit>,
+    p: &PathParams<'a>,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+    bsdf: &mut Bsdf<'a>,
+) -> bool {
+    let (scene, time, lights) = (p.scene, p.time, p.lights);
+    let ray = st.ray;
+    let from = st.prev.filter(|_| !st.specular_bounce);
+    let Some(hit) = hit else {
+        add_escaped_mis(
+            &mut st.l,
+            scene,
+            lights,
+            st.beta,
+            from.as_ref(),
+            ray.d,
+            st.bsdf_pdf,
+        );
+        return false;
+    };
+    let mut s = scene.geometry.surface_at(&hit, time);
+    let wo = -ray.d;
+    st.l += emitted_mis(
+        scene,
+        lights,
+        st.beta,
+        &s,
+        from.as_ref(),
+        ray.d,
+        st.bsdf_pdf,
+    );
+    if st.bounces >= p.max_depth {
+        return false;
+    }
+    let material = &scene.materials[s.material as usize];
+    if material.is_none() {
+        // Pass through without counting a bounce (pbrt-v3: bounces--).
+        st.pass += 1;
+        if st.pass > MAX_PASS_THROUGH {
+            return false;
+        }
+        st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+        st.diff = None;
+        return true;
+    }
+    shade(scene, &hit, &mut s, material, true, st.diff.as_ref(), bsdf);
+    st.diff = None;
+    if bsdf.has_non_specular() {
+        st.l += st.beta * sample_light_mis(scene, &s, bsdf, wo, sampler, scratch, lights);
+    }
+    let u = sampler.get_2d();
+    let Some(bs) = bsdf.sample(wo, u, BxdfFlags::ALL) else {
+        return false;
+    };
+    if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+        return false;
+    }
+    st.beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
+    st.specular_bounce = bs.is_specular();
+    st.bsdf_pdf = bs.pdf;
+    st.prev = Some(s.point);
+    st.eta_scale *= eta_scale_change(bsdf, &bs, wo, s.point.n);
+    st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+    if bs.is_transmission() && material.has_bssrdf() {
+        // pbrt-v3's subsurface step: continue from a sampled exit
+        // point, with light sampled there, not counted as a bounce.
+        let frame = bsdf.frame;
+        let Some((pi, w, exit)) =
+            subsurface_exit(scene, &hit, &s, material, &frame, time, sampler, scratch)
+        else {
+            return false;
+        };
+        st.beta *= w;
+        let wo = pi.point.ns;
+        st.l += st.beta * sample_light_mis(scene, &pi, &exit, wo, sampler, scratch, lights);
+        let Some(bs) = sample_exit(&pi, &exit, sampler) else {
+            return false;
+        };
+        st.beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
+        st.specular_bounce = false;
+        st.bsdf_pdf = bs.pdf;
+        st.prev = Some(pi.point);
+        st.ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
+    }
+    if roulette(
+        &mut st.beta,
+        st.eta_scale,
+        p.rr_threshold,
+        st.bounces,
+        sampler,
+    ) {
+        return false;
+    }
+    st.bounces += 1;
+    true
 }
 
 /// pbrt-v3's BSSRDF step (`SeparableBSSRDF::Sample_S`), taken by `path`

@@ -431,6 +431,22 @@ impl PermutationTables {
             let idx = _mm_add_epi32(_mm256_cvttpd_epi32(i), off);
             _mm256_cvtepi32_pd(_mm_and_si128(_mm_i32gather_epi32::<2>(table, idx), low16))
         };
+        // (floor(a / b), a mod b) for integers a < 2^32, b < 2^16 held in
+        // f64, from `inv` = 1 / b rounded.
+        let divmod = |a: __m256d, b: __m256d, inv: __m256d| {
+            let q = _mm256_floor_pd(_mm256_mul_pd(a, inv));
+            let r = _mm256_sub_pd(a, _mm256_mul_pd(q, b));
+            let zero = _mm256_setzero_pd();
+            let one = _mm256_set1_pd(1.0);
+            let low = _mm256_cmp_pd::<_CMP_LT_OQ>(r, zero);
+            let q = _mm256_sub_pd(q, _mm256_and_pd(low, one));
+            let r = _mm256_add_pd(r, _mm256_and_pd(low, b));
+            let high = _mm256_cmp_pd::<_CMP_GE_OQ>(r, b);
+            (
+                _mm256_add_pd(q, _mm256_and_pd(high, one)),
+                _mm256_sub_pd(r, _mm256_and_pd(high, b)),
+            )
+        };
         let mut a_lo = _mm256_set1_pd(a as f64);
         let mut a_hi = a_lo;
         let mut rev_lo = _mm256_setzero_pd();
@@ -443,10 +459,11 @@ impl PermutationTables {
             if _mm256_movemask_pd(_mm256_or_pd(m_lo, m_hi)) == 0 {
                 break;
             }
-            let q_lo = _mm256_floor_pd(_mm256_div_pd(a_lo, b2_lo));
-            let q_hi = _mm256_floor_pd(_mm256_div_pd(a_hi, b2_hi));
-            let r_lo = _mm256_sub_pd(a_lo, _mm256_mul_pd(q_lo, b2_lo));
-            let r_hi = _mm256_sub_pd(a_hi, _mm256_mul_pd(q_hi, b2_hi));
+            // a / base² by the reciprocal: the estimate is off by at most
+            // one (a < 2^32, so every product here is exact), which the
+            // remainder's sign and size correct.
+            let (q_lo, r_lo) = divmod(a_lo, b2_lo, ib2_lo);
+            let (q_hi, r_hi) = divmod(a_hi, b2_hi, ib2_hi);
             let d_lo = gather(r_lo, off_lo);
             let d_hi = gather(r_hi, off_hi);
             let nr_lo = _mm256_add_pd(_mm256_mul_pd(rev_lo, b2_lo), d_lo);
