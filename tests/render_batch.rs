@@ -3,8 +3,11 @@
 //! the scalar loop bit for bit, with the same rays traced: each scene is
 //! rendered both ways (`RenderOptions::scalar`) and compared pixel by pixel.
 //! The scenes cover every integrator, specular and subsurface paths, media,
-//! motion blur, ray differentials (textures), every sampler, sample counts
-//! that do not fill the last batch of a pixel, and a crop window.
+//! motion blur, ray differentials (textures), every sampler (the stratified
+//! one renders with the one-sample loop either way: it computes a whole
+//! pixel's samples when it starts one, which a copy per lane would repeat),
+//! sample counts that do not fill the last batch of a pixel, and a crop
+//! window.
 
 mod common;
 

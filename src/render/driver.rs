@@ -9,7 +9,7 @@ use crate::render::integrators::{Batch, Integrator, RayCounts, Scratch};
 use crate::render::samplers::{CameraSample, Sampler};
 use crate::render::scene::RenderScene;
 use crate::scene::SceneDescription;
-use glam::Vec3;
+use glam::{IVec2, Vec3};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -98,6 +98,11 @@ impl Renderer {
             .num_threads(opts.threads.unwrap_or(0))
             .build()
             .map_err(|e| format!("cannot start worker threads: {e}"))?;
+        let batch = if opts.scalar || !sampler.batches_well() {
+            1
+        } else {
+            BATCH
+        };
         let stats = RenderStats {
             build_time: t0.elapsed(),
             threads: pool.current_num_threads(),
@@ -110,7 +115,7 @@ impl Renderer {
             sampler,
             pool,
             stats,
-            batch: if opts.scalar { 1 } else { BATCH },
+            batch,
         })
     }
 
@@ -177,19 +182,20 @@ impl Renderer {
             ts.spawn(move || {
                 pool.broadcast(|_| {
                     let tx = tx.clone();
+                    // The batch's lanes, made once per thread.
+                    let mut lanes = (batch > 1).then(|| Lanes::new(batch, sampler));
                     loop {
                         let k = next.fetch_add(1, Ordering::Relaxed);
                         let Some(&tb) = tiles.get(k) else { break };
-                        let (tile, c) = if batch > 1 {
+                        let (tile, c) = if let Some(lanes) = lanes.as_mut() {
                             render_tile_batched(
                                 scene,
                                 integrator,
                                 maker,
-                                sampler,
                                 tb,
                                 region,
                                 samples.clone(),
-                                batch,
+                                lanes,
                             )
                         } else {
                             render_tile(
@@ -410,6 +416,26 @@ fn render_tile(
 /// bytes a lane, the sampler included) stays in the first-level cache.
 pub const BATCH: usize = 16;
 
+/// A thread's lanes for [`render_tile_batched`]: the batch, a sampler to
+/// start at each pixel, and each lane's camera sample and weight.
+struct Lanes {
+    b: Batch,
+    at_pixel: Sampler,
+    cs: Vec<CameraSample>,
+    weights: Vec<f32>,
+}
+
+impl Lanes {
+    fn new(lanes: usize, proto: &Sampler) -> Lanes {
+        Lanes {
+            b: Batch::new(lanes, proto),
+            at_pixel: proto.clone(),
+            cs: vec![CameraSample::default(); lanes],
+            weights: vec![0.0; lanes],
+        }
+    }
+}
+
 /// [`render_tile`] with `lanes` samples at a time: their camera rays, then
 /// the integrator's batch ([`Integrator::li_batch`]), then the film, in
 /// the scalar loop's order (so the tile's sums are the same bit for bit).
@@ -419,20 +445,26 @@ fn render_tile_batched(
     scene: &RenderScene,
     integrator: &Integrator,
     film: &TileMaker,
-    proto: &Sampler,
     bounds: Bounds2i,
     region: Option<Bounds2i>,
     samples: std::ops::Range<u32>,
-    lanes: usize,
+    lanes: &mut Lanes,
 ) -> (FilmTile, TileCounts) {
     let mut tile = film.tile(bounds);
     let pixels = match region {
         Some(r) => bounds.intersect(&r),
         None => bounds,
     };
-    let mut b = Batch::new(lanes, proto);
-    let mut cs = vec![CameraSample::default(); lanes];
-    let mut weights = vec![0.0f32; lanes];
+    let Lanes {
+        b,
+        at_pixel,
+        cs,
+        weights,
+    } = lanes;
+    let proto = &*at_pixel;
+    let lanes = b.samplers.len();
+    // `at_pixel` is started at each pixel once, for what the lanes share.
+    let mut current: Option<IVec2> = None;
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
     let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
@@ -448,8 +480,12 @@ fn render_tile_batched(
         b.len = 0;
         for (pixel, i) in todo.by_ref().take(lanes) {
             let j = b.len;
+            if current != Some(pixel) {
+                at_pixel.start_pixel_sample(pixel, i);
+                current = Some(pixel);
+            }
             let sampler = &mut b.samplers[j];
-            sampler.start_pixel_sample(pixel, i);
+            sampler.start_pixel_sample_from(&at_pixel, pixel, i);
             cs[j] = sampler.camera_sample(pixel, lens);
             b.times[j] = if moving {
                 scene.camera.time(&cs[j])
@@ -470,7 +506,7 @@ fn render_tile_batched(
             b.len += 1;
         }
         // Radiance.
-        integrator.li_batch(&mut b, scene, &mut scratch);
+        integrator.li_batch(b, scene, &mut scratch);
         // The film, in sample order.
         for j in 0..b.len {
             let l = sanitise(b.l[j], &mut c);

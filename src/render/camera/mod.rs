@@ -242,7 +242,7 @@ impl Projection {
 
     /// The camera ray for a film position (raster coordinates) and lens
     /// sample, and its weight.
-    #[inline]
+    #[inline(always)]
     pub fn generate_ray(&self, cs: &CameraSample) -> (Ray, f32) {
         match self {
             Projection::Perspective(c) => (c.generate_ray(cs), 1.0),

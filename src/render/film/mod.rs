@@ -319,7 +319,7 @@ impl FilmTile {
     /// Splats radiance `l` seen through raster position `p_film` onto the
     /// pixels within the filter radius. Non-finite radiance counts as black
     /// (the sample still adds its filter weight), as pbrt-v3's integrator does.
-    #[inline]
+    #[inline(always)]
     pub fn add_sample(&mut self, p_film: Vec2, l: Vec3, sample_weight: f32) {
         let mut l = if l.is_finite() { l } else { Vec3::ZERO };
         let y = luminance(l);

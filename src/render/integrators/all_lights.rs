@@ -52,18 +52,16 @@ pub(super) fn sample_all_lights_packed(
     let ns3 = splat3(sp.ns);
     let ng3 = splat3(bsdf.ng);
     let mut l = Vec3::ZERO;
-    let mut u_light = std::mem::take(&mut scratch.u_light);
-    let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
     for (k, pack) in packs.iter().enumerate() {
         // The samples, light by light in pbrt-v3's order.
         let mut ul = [Vec2::ZERO; 4];
         let mut us = [Vec2::ZERO; 4];
         for lane in 0..pack.count {
-            let got_light = sampler.fill_2d_array(1, &mut u_light);
-            let got_scatter = sampler.fill_2d_array(1, &mut u_scatter);
-            if got_light && got_scatter {
-                ul[lane] = u_light[0];
-                us[lane] = u_scatter[0];
+            let got_light = sampler.get_2d_array1();
+            let got_scatter = sampler.get_2d_array1();
+            if let (Some(a), Some(b)) = (got_light, got_scatter) {
+                ul[lane] = a;
+                us[lane] = b;
             } else {
                 ul[lane] = sampler.get_2d();
                 us[lane] = sampler.get_2d();
@@ -189,8 +187,6 @@ pub(super) fn sample_all_lights_packed(
             l += ld;
         }
     }
-    scratch.u_light = u_light;
-    scratch.u_scatter = u_scatter;
     l
 }
 

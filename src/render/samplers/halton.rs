@@ -2,7 +2,7 @@
 //! dimension and array handling (core/sampler.cpp).
 
 use super::lowdiscrepancy::{
-    inverse_radical_inverse, multiplicative_inverse, radical_inverse, radical_inverse_base2,
+    inverse_radical_inverse, multiplicative_inverse, radical_inverse_base2, radical_inverse_base3,
     DigitBase, PermutationTables, BLOCK_DIM_END, BLOCK_LANES, PRIME_TABLE_SIZE,
 };
 use super::ArrayStore;
@@ -15,7 +15,6 @@ use std::sync::Arc;
 const MAX_RESOLUTION: i32 = 128;
 /// First dimension used by sample arrays (GlobalSampler's arrayStartDim).
 const ARRAY_START_DIM: u32 = 5;
-const BASE3: DigitBase = DigitBase::new(3);
 
 #[derive(Clone, Debug)]
 pub struct HaltonSampler {
@@ -146,7 +145,7 @@ impl HaltonSampler {
         }
         match dim {
             0 => radical_inverse_base2(index >> self.base_exponents[0]),
-            1 => radical_inverse(&BASE3, self.scale1.as_ref().map_or(index, |s| s.div(index))),
+            1 => radical_inverse_base3(self.scale1.as_ref().map_or(index, |s| s.div(index))),
             d if (d as usize) < PRIME_TABLE_SIZE => self.scrambled(index, d),
             d => hash_to_unit(mix64(
                 mix64(index ^ self.seed_hash)
@@ -192,6 +191,13 @@ impl HaltonSampler {
                 self.sample_dimension(index, dim + 1),
             )
         }
+    }
+
+    /// Takes `other`'s cached pixel offset (a copy of the same sampler).
+    #[inline]
+    pub fn take_pixel_offset(&mut self, other: &HaltonSampler) {
+        self.pixel_for_offset = other.pixel_for_offset;
+        self.offset_for_pixel = other.offset_for_pixel;
     }
 
     pub fn start_pixel_sample(&mut self, pixel: IVec2, sample_index: u32) {
@@ -297,6 +303,19 @@ impl HaltonSampler {
             out.push(self.sample_2d_dimensions(self.index_for_sample(first + k), dim));
         }
         true
+    }
+
+    /// `fill_2d_array(1, ..)`'s value without the vector.
+    #[inline]
+    pub fn get_2d_array1(&mut self) -> Option<Vec2> {
+        let i = self.arrays.next_2d;
+        if i >= self.arrays.sizes_2d.len() || self.arrays.sizes_2d[i] != 1 {
+            return None;
+        }
+        self.arrays.next_2d += 1;
+        let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
+        let first = self.sample_index as u64;
+        Some(self.sample_2d_dimensions(self.index_for_sample(first), dim))
     }
 
     /// The global Halton index of the current sample (for tests and debugging).

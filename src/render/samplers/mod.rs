@@ -102,6 +102,24 @@ impl Sampler {
         dispatch!(self, s => s.start_pixel_sample(pixel, sample_index))
     }
 
+    /// `start_pixel_sample`, taking what the sampler computes once per
+    /// pixel from `at_pixel`, a sampler of the same kind already started at
+    /// `pixel` (so that the lanes of a batch do not each compute it again).
+    #[inline]
+    pub fn start_pixel_sample_from(&mut self, at_pixel: &Sampler, pixel: IVec2, sample_index: u32) {
+        if let (Sampler::Halton(h), Sampler::Halton(p)) = (&mut *self, at_pixel) {
+            h.take_pixel_offset(p);
+        }
+        self.start_pixel_sample(pixel, sample_index)
+    }
+
+    /// Whether lanes of a batch can each have a copy of this sampler at a
+    /// modest cost per pixel: not the stratified sampler, which computes
+    /// every sample of a pixel when it starts one.
+    pub fn batches_well(&self) -> bool {
+        !matches!(self, Sampler::Stratified(_))
+    }
+
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
         dispatch!(self, s => s.get_1d())
@@ -135,7 +153,7 @@ impl Sampler {
     /// dimensions are consumed (later dimensions are the same) but their
     /// values are not computed and read 0.5: for a pinhole camera without
     /// motion, which never reads them.
-    #[inline]
+    #[inline(always)]
     pub fn camera_sample(&mut self, pixel: IVec2, lens: bool) -> CameraSample {
         let base = pixel.as_vec2();
         // Keep p_film inside the pixel even when `pixel + offset` rounds up.
@@ -168,6 +186,17 @@ impl Sampler {
     #[inline]
     pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
         dispatch!(self, s => s.get_2d_array(n))
+    }
+
+    /// The next requested 2D array's one value, if the next array has one
+    /// entry (as `get_2d_array(1)`, without a copy: Halton computes it
+    /// straight away).
+    #[inline]
+    pub fn get_2d_array1(&mut self) -> Option<Vec2> {
+        if let Sampler::Halton(h) = self {
+            return h.get_2d_array1();
+        }
+        self.get_2d_array(1).map(|a| a[0])
     }
 
     /// `get_2d_array` copied into `out` (cleared first): true if there was
