@@ -485,7 +485,7 @@ fn render_tile_batched(
                 current = Some(pixel);
             }
             let sampler = &mut b.samplers[j];
-            sampler.start_pixel_sample_from(&at_pixel, pixel, i);
+            sampler.start_pixel_sample_from(at_pixel, pixel, i);
             cs[j] = sampler.camera_sample(pixel, lens);
             b.times[j] = if moving {
                 scene.camera.time(&cs[j])
