@@ -74,6 +74,24 @@ pub struct Batch {
 }
 
 impl Batch {
+    /// Bytes the batch holds: its lanes' state and their samplers (with
+    /// the samplers' array stores).
+    pub fn state_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let lanes = self.samplers.len();
+        lanes
+            * (size_of::<Sampler>()
+                + size_of::<Ray>()
+                + size_of::<Option<RayDiff>>()
+                + size_of::<f32>()
+                + size_of::<bool>()
+                + size_of::<Vec3>()
+                + size_of::<Option<Hit>>()
+                + size_of::<PathState>()
+                + size_of::<u32>())
+            + self.samplers.iter().map(|s| s.heap_bytes()).sum::<usize>()
+    }
+
     /// A batch of `lanes` lanes, each with a copy of `sampler`.
     pub fn new(lanes: usize, sampler: &Sampler) -> Batch {
         let ray = Ray::new(Vec3::ZERO, Vec3::Z);

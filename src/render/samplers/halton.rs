@@ -37,7 +37,7 @@ pub struct HaltonSampler {
     interval_index: u64,
     dimension: u32,
     array_end_dim: u32,
-    arrays: ArrayStore,
+    pub(super) arrays: ArrayStore,
     /// Dimensions `block_dim ..` of index `block_index`, computed
     /// `BLOCK_LANES` at a time (`block_len` of them valid; 0 when empty).
     block: [f32; BLOCK_LANES],

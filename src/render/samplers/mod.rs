@@ -80,6 +80,14 @@ impl Sampler {
         dispatch!(self, s => s.samples_per_pixel())
     }
 
+    /// Bytes this copy of the sampler holds on the heap (its array store;
+    /// Halton's permutation tables are shared and not counted).
+    pub fn heap_bytes(&self) -> usize {
+        let a = dispatch!(self, s => &s.arrays);
+        a.data_1d.iter().map(|v| v.len() * 4).sum::<usize>()
+            + a.data_2d.iter().map(|v| v.len() * 8).sum::<usize>()
+    }
+
     /// Asks for an array of `n` 1D values per sample. Call before rendering,
     /// in the same order as the later `get_1d_array` calls.
     pub fn request_1d_array(&mut self, n: u32) {

@@ -10,7 +10,7 @@ pub struct RandomSampler {
     spp: u32,
     seed: u64,
     rng: Pcg32,
-    arrays: ArrayStore,
+    pub(super) arrays: ArrayStore,
 }
 
 /// PCG32 stream for a (pixel, sample, seed, purpose) tuple.

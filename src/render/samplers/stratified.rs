@@ -20,7 +20,7 @@ pub struct StratifiedSampler {
     seed: u64,
     samples_1d: Vec<Vec<f32>>,
     samples_2d: Vec<Vec<Vec2>>,
-    arrays: ArrayStore,
+    pub(super) arrays: ArrayStore,
     pixel: Option<IVec2>,
     sample_index: u32,
     dim_1d: usize,
