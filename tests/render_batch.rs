@@ -11,119 +11,66 @@
 
 mod common;
 
-use pbrs::render::driver::{render, RenderOptions};
-use pbrs::scene::SceneDescription;
+use pbrs::scene::{SamplerKind, SceneDescription};
 
 fn both_ways(mut desc: SceneDescription, res: u32, spp: u32, what: &str) {
     desc.film.xresolution = res;
     desc.film.yresolution = res;
     desc.sampler.pixel_samples = spp;
-    let run = |scalar: bool| {
-        render(
-            &desc,
-            &RenderOptions {
-                threads: Some(2),
-                scalar,
-                ..Default::default()
-            },
-            &|_, _| {},
-        )
-        .expect("render failed")
-    };
-    let (batched, b_stats) = run(false);
-    let (scalar, s_stats) = run(true);
-    assert_eq!(batched.width, scalar.width);
-    let differ = batched
-        .data
-        .iter()
-        .zip(&scalar.data)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
+    let (fast, _) = common::assert_fast_is_scalar(&desc, what);
+    let batched = |n: &String| n.starts_with("batched:");
     assert_eq!(
-        differ, 0,
-        "{what}: {differ} values differ from the scalar loop"
+        fast.notes.iter().any(batched),
+        !matches!(desc.sampler.kind, SamplerKind::Stratified { .. }),
+        "{what}: {:?}",
+        fast.notes
     );
-    assert_eq!(b_stats.rays.closest, s_stats.rays.closest, "{what}");
-    assert_eq!(b_stats.rays.shadow, s_stats.rays.shadow, "{what}");
-    assert_eq!(b_stats.samples, s_stats.samples, "{what}");
-    let sum: f64 = batched.data.iter().map(|&v| v as f64).sum();
-    assert!(sum > 0.0, "{what}: a black image proves nothing");
+}
+
+/// Scenes of the repository at `res`×`res` and `spp` samples per pixel
+/// (counts that leave a pixel's last batch part-full on purpose).
+fn scenes(list: &[(&str, u32, u32)]) {
+    for &(path, res, spp) in list {
+        both_ways(common::load(path), res, spp, path);
+    }
 }
 
 #[test]
 fn path_cornell_and_glass() {
-    both_ways(
-        common::load("scenes/cornell-path.pbrt"),
-        32,
-        19,
-        "cornell-path",
-    );
-    both_ways(
-        common::load("scenes/cornell-glass.pbrt"),
-        32,
-        16,
-        "cornell-glass",
-    );
+    scenes(&[
+        ("scenes/cornell-path.pbrt", 32, 19),
+        ("scenes/cornell-glass.pbrt", 32, 16),
+    ]);
 }
 
 #[test]
 fn directlighting_and_whitted() {
-    both_ways(
-        common::load("scenes/cornell-direct.pbrt"),
-        32,
-        7,
-        "cornell-direct",
-    );
-    both_ways(
-        common::load("scenes/materials-direct.pbrt"),
-        32,
-        4,
-        "materials-direct",
-    );
-    both_ways(
-        common::load("scenes/materials-whitted.pbrt"),
-        32,
-        4,
-        "materials-whitted",
-    );
+    scenes(&[
+        ("scenes/cornell-direct.pbrt", 32, 7),
+        ("scenes/materials-direct.pbrt", 32, 4),
+        ("scenes/materials-whitted.pbrt", 32, 4),
+    ]);
 }
 
 #[test]
 fn volpath_subsurface_and_media() {
-    both_ways(common::load("scenes/fog/fog.pbrt"), 24, 5, "fog");
-    both_ways(
-        common::load("scenes/subsurface/subsurface.pbrt"),
-        24,
-        4,
-        "subsurface",
-    );
+    scenes(&[
+        ("scenes/fog/fog.pbrt", 24, 5),
+        ("scenes/subsurface/subsurface.pbrt", 24, 4),
+    ]);
 }
 
 #[test]
 fn motion_blur_and_textures() {
-    both_ways(
-        common::load("scenes/motion/motion-blur.pbrt"),
-        24,
-        6,
-        "motion-blur",
-    );
-    both_ways(
-        common::load("scenes/motion/motion-camera.pbrt"),
-        24,
-        6,
-        "motion-camera",
-    );
-    both_ways(
-        common::load("scenes/textures-env/textures-env.pbrt"),
-        24,
-        4,
-        "textures-env",
-    );
+    scenes(&[
+        ("scenes/motion/motion-blur.pbrt", 24, 6),
+        ("scenes/motion/motion-camera.pbrt", 24, 6),
+        ("scenes/textures-env/textures-env.pbrt", 24, 4),
+    ]);
 }
 
 #[test]
 fn every_sampler_and_a_crop_window() {
-    use pbrs::scene::SamplerKind;
     for (kind, name) in [
         (SamplerKind::Random, "random"),
         (

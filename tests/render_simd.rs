@@ -5,39 +5,10 @@
 mod common;
 
 use pbrs::loader::load_scene_str;
-use pbrs::render::driver::{render, RenderOptions};
 use pbrs::scene::SceneDescription;
 
 fn both_ways(desc: &SceneDescription, what: &str) {
-    let run = |scalar: bool| {
-        render(
-            desc,
-            &RenderOptions {
-                threads: Some(2),
-                scalar,
-                ..Default::default()
-            },
-            &|_, _| {},
-        )
-        .expect("render failed")
-    };
-    let (fast, fast_stats) = run(false);
-    let (slow, slow_stats) = run(true);
-    assert_eq!(fast.width, slow.width);
-    let differ = fast
-        .data
-        .iter()
-        .zip(&slow.data)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
-    assert_eq!(
-        differ, 0,
-        "{what}: {differ} pixels differ from the scalar path"
-    );
-    assert_eq!(fast_stats.rays.closest, slow_stats.rays.closest, "{what}");
-    assert_eq!(fast_stats.rays.shadow, slow_stats.rays.shadow, "{what}");
-    let sum: f64 = fast.data.iter().map(|&v| v as f64).sum();
-    assert!(sum > 0.0, "{what}: a black image proves nothing");
+    let (fast_stats, slow_stats) = common::assert_fast_is_scalar(desc, what);
     // The fast path was taken (and only when allowed).
     let packed =
         |s: &pbrs::render::driver::RenderStats| s.notes.iter().any(|n| n.contains("four-lane"));

@@ -5,6 +5,7 @@
 use crate::render::film::part::{self, PartHeader, PartKind};
 use crate::render::film::{luminance, Film, FilmTile, Image, TileMaker};
 use crate::render::geometry::Bounds2i;
+use crate::render::geometry::{Ray, RayDiff};
 use crate::render::integrators::{Batch, Integrator, RayCounts, Scratch};
 use crate::render::samplers::{CameraSample, Sampler};
 use crate::render::scene::RenderScene;
@@ -381,28 +382,11 @@ fn render_tile(
     let mut sampler = proto.clone();
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
-    // Whether the camera sample's time and lens values are read (all
-    // samplers draw both, as pbrt-v3; Halton skips computing them when
-    // nothing reads them).
-    let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
-    let lens = scene.camera.uses_lens() || moving;
-    // pbrt-v3 scales camera ray differentials by 1/√spp. Rays carry them
-    // only in scenes whose materials can use them.
-    let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();
-    let differentials = scene.differentials;
+    let camera = CameraRays::new(scene, proto);
     for pixel in pixels.iter() {
         for i in samples.clone() {
             sampler.start_pixel_sample(pixel, i);
-            let cs = sampler.camera_sample(pixel, lens);
-            // Only moving geometry reads a ray's time.
-            let time = if moving { scene.camera.time(&cs) } else { 0.0 };
-            let (ray, diff, weight) = if differentials {
-                let (ray, d, w) = scene.camera.generate_ray_differential(&cs, diff_scale);
-                (ray, Some(d), w)
-            } else {
-                let (ray, w) = scene.camera.generate_ray(&cs);
-                (ray, None, w)
-            };
+            let (cs, time, ray, diff, weight) = camera.ray(scene, &mut sampler, pixel);
             // pbrt-v3 computes no radiance for a sample the lens blocks
             // (weight 0), but the film still counts its filter weight.
             let mut l = if weight > 0.0 {
@@ -419,10 +403,61 @@ fn render_tile(
     (tile, c)
 }
 
+/// How the camera samples of a render become rays.
+struct CameraRays {
+    /// Only moving geometry (or a moving camera) reads a ray's time.
+    moving: bool,
+    /// Whether the camera sample's time and lens values are read (all
+    /// samplers draw both, as pbrt-v3; Halton skips computing them when
+    /// nothing reads them).
+    lens: bool,
+    /// Rays carry differentials only in scenes whose materials can use
+    /// them; pbrt-v3 scales them by 1/√spp.
+    differentials: bool,
+    diff_scale: f32,
+}
+
+impl CameraRays {
+    fn new(scene: &RenderScene, sampler: &Sampler) -> CameraRays {
+        let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
+        CameraRays {
+            moving,
+            lens: scene.camera.uses_lens() || moving,
+            differentials: scene.differentials,
+            diff_scale: 1.0 / (sampler.samples_per_pixel() as f32).sqrt(),
+        }
+    }
+
+    /// The camera sample of `sampler`'s current sample (started at
+    /// `pixel`) with its ray's time, the ray, its differentials and weight.
+    #[inline(always)]
+    fn ray(
+        &self,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        pixel: IVec2,
+    ) -> (CameraSample, f32, Ray, Option<RayDiff>, f32) {
+        let cs = sampler.camera_sample(pixel, self.lens);
+        let time = if self.moving {
+            scene.camera.time(&cs)
+        } else {
+            0.0
+        };
+        if self.differentials {
+            let (ray, d, w) = scene.camera.generate_ray_differential(&cs, self.diff_scale);
+            (cs, time, ray, Some(d), w)
+        } else {
+            let (ray, w) = scene.camera.generate_ray(&cs);
+            (cs, time, ray, None, w)
+        }
+    }
+}
+
 /// Samples in flight per thread in the batched renderer: enough
 /// independent paths for the core to overlap one's memory and division
-/// latencies with another's work, few enough that their state (about 300
-/// bytes a lane, the sampler included) stays in the first-level cache.
+/// latencies with another's work, few enough that their state (10–13 KiB
+/// for the Cornell scenes, the samplers included) stays in the first-level
+/// cache.
 pub const BATCH: usize = 16;
 
 /// A thread's lanes for [`render_tile_batched`]: the batch, a sampler to
@@ -476,10 +511,7 @@ fn render_tile_batched(
     let mut current: Option<IVec2> = None;
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
-    let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
-    let lens = scene.camera.uses_lens() || moving;
-    let diff_scale = 1.0 / (proto.samples_per_pixel() as f32).sqrt();
-    let differentials = scene.differentials;
+    let camera = CameraRays::new(scene, proto);
     let mut todo = pixels
         .iter()
         .flat_map(|p| samples.clone().map(move |i| (p, i)))
@@ -495,19 +527,9 @@ fn render_tile_batched(
             }
             let sampler = &mut b.samplers[j];
             sampler.start_pixel_sample_from(at_pixel, pixel, i);
-            cs[j] = sampler.camera_sample(pixel, lens);
-            b.times[j] = if moving {
-                scene.camera.time(&cs[j])
-            } else {
-                0.0
-            };
-            let (ray, diff, weight) = if differentials {
-                let (ray, d, w) = scene.camera.generate_ray_differential(&cs[j], diff_scale);
-                (ray, Some(d), w)
-            } else {
-                let (ray, w) = scene.camera.generate_ray(&cs[j]);
-                (ray, None, w)
-            };
+            let (cs_j, time, ray, diff, weight) = camera.ray(scene, sampler, pixel);
+            cs[j] = cs_j;
+            b.times[j] = time;
             b.rays[j] = ray;
             b.diffs[j] = diff;
             weights[j] = weight;

@@ -320,3 +320,41 @@ pub fn error_text(text: &str) -> String {
             .join("\n"),
     }
 }
+
+/// Renders `desc` with the fast paths (four-lane light estimate, batches)
+/// and with `RenderOptions::scalar`, both on two threads, and asserts that
+/// the images are the same bit for bit, with the same ray and sample
+/// counts and some light in them. Returns both statistics (fast, scalar).
+pub fn assert_fast_is_scalar(desc: &SceneDescription, what: &str) -> (RenderStats, RenderStats) {
+    let run = |scalar: bool| {
+        render(
+            desc,
+            &RenderOptions {
+                threads: Some(2),
+                scalar,
+                ..Default::default()
+            },
+            &|_, _| {},
+        )
+        .expect("render failed")
+    };
+    let (fast, fast_stats) = run(false);
+    let (slow, slow_stats) = run(true);
+    assert_eq!(fast.width, slow.width, "{what}");
+    let differ = fast
+        .data
+        .iter()
+        .zip(&slow.data)
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert_eq!(
+        differ, 0,
+        "{what}: {differ} values differ from the scalar code"
+    );
+    assert_eq!(fast_stats.rays.closest, slow_stats.rays.closest, "{what}");
+    assert_eq!(fast_stats.rays.shadow, slow_stats.rays.shadow, "{what}");
+    assert_eq!(fast_stats.samples, slow_stats.samples, "{what}");
+    let sum: f64 = fast.data.iter().map(|&v| v as f64).sum();
+    assert!(sum > 0.0, "{what}: a black image proves nothing");
+    (fast_stats, slow_stats)
+}

@@ -371,41 +371,27 @@ impl Integrator {
                     b.active.truncate(kept);
                 }
             }
-            Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                for j in 0..n {
-                    if b.live[j] {
-                        b.hits[j] = scene.geometry.intersect_at(&b.rays[j], b.times[j]);
+            Integrator::Direct { .. } | Integrator::Whitted { .. } | Integrator::VolPath { .. } => {
+                // volpath's first ray may pass through media: it starts
+                // from the camera ray itself.
+                let first_hits = !matches!(self, Integrator::VolPath { .. });
+                if first_hits {
+                    for j in 0..n {
+                        if b.live[j] {
+                            b.hits[j] = scene.geometry.intersect_at(&b.rays[j], b.times[j]);
+                        }
                     }
                 }
                 for j in 0..n {
-                    b.l[j] = if b.live[j] {
-                        self.specular_tree_li(
-                            b.rays[j],
-                            Some(b.hits[j]),
-                            b.times[j],
-                            b.diffs[j],
-                            scene,
-                            &mut b.samplers[j],
-                            scratch,
-                        )
-                    } else {
+                    let (ray, time, diff) = (b.rays[j], b.times[j], b.diffs[j]);
+                    let sampler = &mut b.samplers[j];
+                    b.l[j] = if !b.live[j] {
                         Vec3::ZERO
-                    };
-                }
-            }
-            Integrator::VolPath { .. } => {
-                for j in 0..n {
-                    b.l[j] = if b.live[j] {
-                        self.li(
-                            b.rays[j],
-                            b.times[j],
-                            b.diffs[j],
-                            scene,
-                            &mut b.samplers[j],
-                            scratch,
-                        )
+                    } else if first_hits {
+                        let hit = Some(b.hits[j]);
+                        self.specular_tree_li(ray, hit, time, diff, scene, sampler, scratch)
                     } else {
-                        Vec3::ZERO
+                        self.li(ray, time, diff, scene, sampler, scratch)
                     };
                 }
             }

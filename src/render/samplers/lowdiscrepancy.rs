@@ -512,6 +512,20 @@ impl PermutationTables {
                 _mm256_sub_pd(r, _mm256_and_pd(high, b)),
             )
         };
+        // Appends digits `d` (a number below `mul`, whose reciprocal is
+        // `inv_mul`) to the reversed digits and the scale, in the lanes of
+        // `mask`.
+        let push = |rev: __m256d,
+                    inv: __m256d,
+                    d: __m256d,
+                    mul: __m256d,
+                    inv_mul: __m256d,
+                    mask: __m256d| {
+            (
+                _mm256_blendv_pd(rev, _mm256_add_pd(_mm256_mul_pd(rev, mul), d), mask),
+                _mm256_blendv_pd(inv, _mm256_mul_pd(inv, inv_mul), mask),
+            )
+        };
         let mut a_lo = _mm256_set1_pd(a as f64);
         let mut a_hi = a_lo;
         let mut rev_lo = _mm256_setzero_pd();
@@ -531,12 +545,8 @@ impl PermutationTables {
             let (q_hi, r_hi) = divmod(a_hi, b2_hi, ib2_hi);
             let d_lo = gather(r_lo, off_lo);
             let d_hi = gather(r_hi, off_hi);
-            let nr_lo = _mm256_add_pd(_mm256_mul_pd(rev_lo, b2_lo), d_lo);
-            let nr_hi = _mm256_add_pd(_mm256_mul_pd(rev_hi, b2_hi), d_hi);
-            rev_lo = _mm256_blendv_pd(rev_lo, nr_lo, m_lo);
-            rev_hi = _mm256_blendv_pd(rev_hi, nr_hi, m_hi);
-            inv_lo = _mm256_blendv_pd(inv_lo, _mm256_mul_pd(inv_lo, ib2_lo), m_lo);
-            inv_hi = _mm256_blendv_pd(inv_hi, _mm256_mul_pd(inv_hi, ib2_hi), m_hi);
+            (rev_lo, inv_lo) = push(rev_lo, inv_lo, d_lo, b2_lo, ib2_lo, m_lo);
+            (rev_hi, inv_hi) = push(rev_hi, inv_hi, d_hi, b2_hi, ib2_hi, m_hi);
             a_lo = _mm256_blendv_pd(a_lo, q_lo, m_lo);
             a_hi = _mm256_blendv_pd(a_hi, q_hi, m_hi);
         }
@@ -555,12 +565,8 @@ impl PermutationTables {
         let mul_hi = _mm256_blendv_pd(b_hi, b2_hi, two_hi);
         let im_lo = _mm256_blendv_pd(ib_lo, ib2_lo, two_lo);
         let im_hi = _mm256_blendv_pd(ib_hi, ib2_hi, two_hi);
-        let nr_lo = _mm256_add_pd(_mm256_mul_pd(rev_lo, mul_lo), d_lo);
-        let nr_hi = _mm256_add_pd(_mm256_mul_pd(rev_hi, mul_hi), d_hi);
-        rev_lo = _mm256_blendv_pd(rev_lo, nr_lo, nz_lo);
-        rev_hi = _mm256_blendv_pd(rev_hi, nr_hi, nz_hi);
-        inv_lo = _mm256_blendv_pd(inv_lo, _mm256_mul_pd(inv_lo, im_lo), nz_lo);
-        inv_hi = _mm256_blendv_pd(inv_hi, _mm256_mul_pd(inv_hi, im_hi), nz_hi);
+        (rev_lo, inv_lo) = push(rev_lo, inv_lo, d_lo, mul_lo, im_lo, nz_lo);
+        (rev_hi, inv_hi) = push(rev_hi, inv_hi, d_hi, mul_hi, im_hi, nz_hi);
         let v_lo = _mm256_mul_pd(inv_lo, _mm256_add_pd(rev_lo, ld(&l.tail, 0)));
         let v_hi = _mm256_mul_pd(inv_hi, _mm256_add_pd(rev_hi, ld(&l.tail, 4)));
         let cap = _mm_set1_ps(ONE_MINUS_EPSILON);
