@@ -461,12 +461,11 @@ impl CameraRays {
 pub const BATCH: usize = 16;
 
 /// A thread's lanes for [`render_tile_batched`]: the batch, a sampler to
-/// start at each pixel, and each lane's camera sample and weight.
+/// start at each pixel, and each lane's camera sample.
 struct Lanes {
     b: Batch,
     at_pixel: Sampler,
     cs: Vec<CameraSample>,
-    weights: Vec<f32>,
 }
 
 impl Lanes {
@@ -475,7 +474,6 @@ impl Lanes {
             b: Batch::new(lanes, proto),
             at_pixel: proto.clone(),
             cs: vec![CameraSample::default(); lanes],
-            weights: vec![0.0; lanes],
         }
     }
 }
@@ -499,19 +497,13 @@ fn render_tile_batched(
         Some(r) => bounds.intersect(&r),
         None => bounds,
     };
-    let Lanes {
-        b,
-        at_pixel,
-        cs,
-        weights,
-    } = lanes;
-    let proto = &*at_pixel;
+    let Lanes { b, at_pixel, cs } = lanes;
     let lanes = b.samplers.len();
     // `at_pixel` is started at each pixel once, for what the lanes share.
     let mut current: Option<IVec2> = None;
     let mut scratch = Scratch::default();
     let mut c = TileCounts::default();
-    let camera = CameraRays::new(scene, proto);
+    let camera = CameraRays::new(scene, at_pixel);
     let mut todo = pixels
         .iter()
         .flat_map(|p| samples.clone().map(move |i| (p, i)))
@@ -532,16 +524,15 @@ fn render_tile_batched(
             b.times[j] = time;
             b.rays[j] = ray;
             b.diffs[j] = diff;
-            weights[j] = weight;
-            b.live[j] = weight > 0.0;
+            b.weights[j] = weight;
             b.len += 1;
         }
         // Radiance.
         integrator.li_batch(b, scene, &mut scratch);
         // The film, in sample order.
-        for j in 0..b.len {
-            let l = sanitise(b.l[j], &mut c);
-            tile.add_sample(cs[j].p_film, l, weights[j]);
+        for ((cs, &l), &weight) in cs.iter().zip(&b.l).zip(&b.weights).take(b.len) {
+            let l = sanitise(l, &mut c);
+            tile.add_sample(cs.p_film, l, weight);
             c.samples += 1;
         }
     }

@@ -56,7 +56,7 @@ struct Work {
 
 /// The samples a thread renders together (see [`Integrator::li_batch`]):
 /// per lane its sampler, camera ray and result, in structure-of-arrays
-/// form. Made once per tile; nothing in it allocates per batch.
+/// form. Made once per thread; nothing in it allocates per batch.
 pub struct Batch {
     /// Lanes in use.
     pub len: usize,
@@ -64,8 +64,9 @@ pub struct Batch {
     pub rays: Vec<Ray>,
     pub diffs: Vec<Option<RayDiff>>,
     pub times: Vec<f32>,
-    /// Lanes whose camera ray carries radiance (weight > 0).
-    pub live: Vec<bool>,
+    /// Each camera ray's weight; lanes of weight 0 (a sample the lens
+    /// blocks) get no radiance, as pbrt-v3.
+    pub weights: Vec<f32>,
     /// The radiance of each lane.
     pub l: Vec<Vec3>,
     hits: Vec<Option<Hit>>,
@@ -83,8 +84,7 @@ impl Batch {
             * (size_of::<Sampler>()
                 + size_of::<Ray>()
                 + size_of::<Option<RayDiff>>()
-                + size_of::<f32>()
-                + size_of::<bool>()
+                + 2 * size_of::<f32>()
                 + size_of::<Vec3>()
                 + size_of::<Option<Hit>>()
                 + size_of::<PathState>()
@@ -101,7 +101,7 @@ impl Batch {
             rays: vec![ray; lanes],
             diffs: vec![None; lanes],
             times: vec![0.0; lanes],
-            live: vec![false; lanes],
+            weights: vec![0.0; lanes],
             l: vec![Vec3::ZERO; lanes],
             hits: vec![None; lanes],
             states: vec![PathState::new(ray, None); lanes],
@@ -320,7 +320,7 @@ impl Integrator {
     /// paths one vertex at a time (all closest hits, then all shading and
     /// light sampling), directlighting and whitted trace all camera rays
     /// first, volpath renders lane by lane. Each lane has its own sampler,
-    /// positioned at its sample; lanes with `live` false get no radiance.
+    /// positioned at its sample; lanes of weight 0 get no radiance.
     pub fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
         let n = b.len;
         match self {
@@ -332,7 +332,7 @@ impl Integrator {
                 b.active.clear();
                 for j in 0..n {
                     b.l[j] = Vec3::ZERO;
-                    if b.live[j] {
+                    if b.weights[j] > 0.0 {
                         b.states[j] = PathState::new(b.rays[j], b.diffs[j]);
                         b.active.push(j as u32);
                     }
@@ -377,7 +377,7 @@ impl Integrator {
                 let first_hits = !matches!(self, Integrator::VolPath { .. });
                 if first_hits {
                     for j in 0..n {
-                        if b.live[j] {
+                        if b.weights[j] > 0.0 {
                             b.hits[j] = scene.geometry.intersect_at(&b.rays[j], b.times[j]);
                         }
                     }
@@ -385,13 +385,16 @@ impl Integrator {
                 for j in 0..n {
                     let (ray, time, diff) = (b.rays[j], b.times[j], b.diffs[j]);
                     let sampler = &mut b.samplers[j];
-                    b.l[j] = if !b.live[j] {
-                        Vec3::ZERO
-                    } else if first_hits {
-                        let hit = Some(b.hits[j]);
-                        self.specular_tree_li(ray, hit, time, diff, scene, sampler, scratch)
+                    // The scalar loop's test: a NaN weight gets no radiance.
+                    b.l[j] = if b.weights[j] > 0.0 {
+                        if first_hits {
+                            let hit = Some(b.hits[j]);
+                            self.specular_tree_li(ray, hit, time, diff, scene, sampler, scratch)
+                        } else {
+                            self.li(ray, time, diff, scene, sampler, scratch)
+                        }
                     } else {
-                        self.li(ray, time, diff, scene, sampler, scratch)
+                        Vec3::ZERO
                     };
                 }
             }
@@ -405,6 +408,8 @@ impl Integrator {
     /// transmission, as pbrt-v3 recurses; both specular samples of a vertex
     /// are drawn when it is expanded (the same distribution as pbrt-v3, which
     /// draws the transmission sample after the reflection subtree).
+    /// `first_hit`, if given, is the camera ray's intersection, already
+    /// traced.
     #[allow(clippy::too_many_arguments)]
     fn specular_tree_li(
         &self,

@@ -292,13 +292,9 @@ impl HaltonSampler {
     #[inline]
     pub fn fill_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
         out.clear();
-        let i = self.arrays.next_2d;
-        if i >= self.arrays.sizes_2d.len() || self.arrays.sizes_2d[i] != n {
+        let Some((dim, first)) = self.next_2d_array(n) else {
             return false;
-        }
-        self.arrays.next_2d += 1;
-        let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
-        let first = self.sample_index as u64 * n as u64;
+        };
         for k in 0..n as u64 {
             out.push(self.sample_2d_dimensions(self.index_for_sample(first + k), dim));
         }
@@ -308,14 +304,21 @@ impl HaltonSampler {
     /// `fill_2d_array(1, ..)`'s value without the vector.
     #[inline]
     pub fn get_2d_array1(&mut self) -> Option<Vec2> {
+        let (dim, first) = self.next_2d_array(1)?;
+        Some(self.sample_2d_dimensions(self.index_for_sample(first), dim))
+    }
+
+    /// Consumes the next requested 2D array if it has `n` entries: its
+    /// first dimension and the pixel sample number of its first entry.
+    #[inline]
+    fn next_2d_array(&mut self, n: u32) -> Option<(u32, u64)> {
         let i = self.arrays.next_2d;
-        if i >= self.arrays.sizes_2d.len() || self.arrays.sizes_2d[i] != 1 {
+        if i >= self.arrays.sizes_2d.len() || self.arrays.sizes_2d[i] != n {
             return None;
         }
         self.arrays.next_2d += 1;
         let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
-        let first = self.sample_index as u64;
-        Some(self.sample_2d_dimensions(self.index_for_sample(first), dim))
+        Some((dim, self.sample_index as u64 * n as u64))
     }
 
     /// The global Halton index of the current sample (for tests and debugging).
