@@ -310,6 +310,65 @@ fn array_api() {
     }
 }
 
+/// `get_2d_arrays1` (Halton's one-block fetch of several one-entry 2D
+/// arrays) gives what as many `get_2d_array1` calls give, wherever the
+/// arrays' dimensions fall (inside one block, across the end of the block
+/// dimensions, past the last prime), and consumes nothing when an array is
+/// missing or has more entries.
+#[test]
+fn fused_one_entry_arrays_match_one_by_one() {
+    // (1D arrays requested first, 2D arrays of one entry, then a larger one)
+    for (n1d, n2d) in [(0, 8), (0, 20), (3, 20), (11, 40), (0, 900)] {
+        let make = || {
+            let mut s = Sampler::new(&desc(SamplerKind::Halton, 64), bounds(512, 512), 0);
+            for _ in 0..n1d {
+                s.request_1d_array(1);
+            }
+            for _ in 0..n2d {
+                s.request_2d_array(1);
+            }
+            s.request_2d_array(3);
+            s
+        };
+        let (mut a, mut b) = (make(), make());
+        for (pixel, i) in [(IVec2::new(7, 300), 0), (IVec2::new(511, 511), 63)] {
+            a.start_pixel_sample(pixel, i);
+            b.start_pixel_sample(pixel, i);
+            for _ in 0..n1d {
+                assert_eq!(
+                    a.get_1d_array(1).map(|v| v[0]),
+                    b.get_1d_array(1).map(|v| v[0])
+                );
+            }
+            let mut left = n2d;
+            for k in [1usize, 2, 4, 3, 4, 2, 1].into_iter().cycle() {
+                if left == 0 {
+                    break;
+                }
+                let k = k.min(left);
+                let mut fused = [Vec2::ZERO; 4];
+                assert!(a.get_2d_arrays1(&mut fused[..k]), "{n1d} {n2d} {k}");
+                for v in &fused[..k] {
+                    assert_eq!(Some(*v), b.get_2d_array1(), "{n1d} {n2d} {k}");
+                }
+                left -= k;
+            }
+            // The next array has three entries: nothing fused, nothing consumed.
+            let mut one = [Vec2::ZERO; 1];
+            assert!(!a.get_2d_arrays1(&mut one));
+            assert_eq!(a.get_2d_array(3), b.get_2d_array(3));
+            assert!(!a.get_2d_arrays1(&mut one));
+            assert_eq!(a.get_2d(), b.get_2d());
+        }
+    }
+    // The other samplers always take arrays one by one.
+    let mut r = Sampler::new(&desc(SamplerKind::Random, 4), bounds(8, 8), 0);
+    r.request_2d_array(1);
+    r.start_pixel_sample(IVec2::ZERO, 0);
+    assert!(!r.get_2d_arrays1(&mut [Vec2::ZERO; 1]));
+    assert!(r.get_2d_array1().is_some());
+}
+
 #[test]
 fn halton_skips_array_dimensions() {
     let mut s = Sampler::new(&desc(SamplerKind::Halton, 4), bounds(16, 16), 0);

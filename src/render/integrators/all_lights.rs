@@ -56,15 +56,23 @@ pub(super) fn sample_all_lights_packed(
         // The samples, light by light in pbrt-v3's order.
         let mut ul = [Vec2::ZERO; 4];
         let mut us = [Vec2::ZERO; 4];
-        for lane in 0..pack.count {
-            let got_light = sampler.get_2d_array1();
-            let got_scatter = sampler.get_2d_array1();
-            if let (Some(a), Some(b)) = (got_light, got_scatter) {
-                ul[lane] = a;
-                us[lane] = b;
-            } else {
-                ul[lane] = sampler.get_2d();
-                us[lane] = sampler.get_2d();
+        let mut both = [Vec2::ZERO; 8];
+        if sampler.get_2d_arrays1(&mut both[..2 * pack.count]) {
+            for lane in 0..pack.count {
+                ul[lane] = both[2 * lane];
+                us[lane] = both[2 * lane + 1];
+            }
+        } else {
+            for lane in 0..pack.count {
+                let got_light = sampler.get_2d_array1();
+                let got_scatter = sampler.get_2d_array1();
+                if let (Some(a), Some(b)) = (got_light, got_scatter) {
+                    ul[lane] = a;
+                    us[lane] = b;
+                } else {
+                    ul[lane] = sampler.get_2d();
+                    us[lane] = sampler.get_2d();
+                }
             }
         }
         if wo_z == 0.0 {

@@ -308,6 +308,45 @@ impl HaltonSampler {
         Some(self.sample_2d_dimensions(self.index_for_sample(first), dim))
     }
 
+    /// The next `out.len()` requested 2D arrays' values, if each of them
+    /// has one entry: the same values, in the same order, as that many
+    /// `get_2d_array1` calls, computed together (their dimensions are
+    /// consecutive, so one block of eight dimensions serves four arrays).
+    /// False, with nothing consumed, if any of them is missing or larger.
+    #[inline]
+    pub fn get_2d_arrays1(&mut self, out: &mut [Vec2]) -> bool {
+        let i = self.arrays.next_2d;
+        let n = out.len();
+        if !self
+            .arrays
+            .sizes_2d
+            .get(i..i + n)
+            .is_some_and(|s| s.iter().all(|&k| k == 1))
+        {
+            return false;
+        }
+        self.arrays.next_2d += n;
+        let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
+        // Entry 0 of each array is the current sample's own index.
+        let index = self.interval_index;
+        if 2 * n <= BLOCK_LANES
+            && dim >= 2
+            && dim as usize + 2 * n <= BLOCK_DIM_END
+            && index <= u32::MAX as u64
+        {
+            let mut block = [0.0; BLOCK_LANES];
+            self.tables.scrambled_block(dim as usize, index, &mut block);
+            for (k, v) in out.iter_mut().enumerate() {
+                *v = Vec2::new(block[2 * k], block[2 * k + 1]);
+            }
+        } else {
+            for (k, v) in out.iter_mut().enumerate() {
+                *v = self.sample_2d_dimensions(index, dim + 2 * k as u32);
+            }
+        }
+        true
+    }
+
     /// Consumes the next requested 2D array if it has `n` entries: its
     /// first dimension and the pixel sample number of its first entry.
     #[inline]

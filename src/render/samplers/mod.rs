@@ -207,6 +207,18 @@ impl Sampler {
         self.get_2d_array(1).map(|a| a[0])
     }
 
+    /// The next `out.len()` requested 2D arrays' values if each has one
+    /// entry (what as many `get_2d_array1` calls give, Halton's computed
+    /// together); false, with nothing consumed, otherwise (and always for
+    /// the other samplers, whose callers then take them one by one).
+    #[inline]
+    pub fn get_2d_arrays1(&mut self, out: &mut [Vec2]) -> bool {
+        match self {
+            Sampler::Halton(h) => h.get_2d_arrays1(out),
+            _ => false,
+        }
+    }
+
     /// `get_2d_array` copied into `out` (cleared first): true if there was
     /// an array, else `out` stays empty. Halton computes the values straight
     /// into `out`.
