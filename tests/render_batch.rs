@@ -52,6 +52,89 @@ fn directlighting_and_whitted() {
     ]);
 }
 
+/// directlighting's batched camera vertices (Lambertian ones four at a
+/// time, one light per pass): seven triangle lights (two packs, the
+/// second part-full; one two-sided, one black), camera hits on glass, a
+/// mirror, plastic, textured and bump-mapped matte (differentials) and a
+/// `Material "none"` sheet, with `maxdepth` 1 (no specular children, so no
+/// samples skipped) and 5.
+#[test]
+fn directlighting_lanes_every_kind_of_camera_vertex() {
+    let scene = |max_depth: u32| {
+        format!(
+            r#"
+LookAt 0 1 4  0 0.8 0  0 1 0
+Camera "perspective" "float fov" [45]
+Film "image" "integer xresolution" [24] "integer yresolution" [24]
+Sampler "halton" "integer pixelsamples" [16]
+Integrator "directlighting" "string strategy" "all" "integer maxdepth" [{max_depth}]
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [8 6 4]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [-0.5 1.9 -0.5  0.5 1.9 -0.5  0.5 1.9 0.5  -0.5 1.9 0.5]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [2 3 5] "bool twosided" "true"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [-1.5 0.2 -1  -1.5 0.2 0  -1.5 1.2 0  -1.5 1.2 -1]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [0 0 0]
+  Shape "trianglemesh" "integer indices" [0 1 2]
+    "point P" [1.5 0.2 -1  1.5 0.2 0  1.5 1.2 0]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [4 4 4]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [1.4 0.2 0.5  1.4 0.2 1  1.4 1.2 1  1.4 1.2 0.5]
+AttributeEnd
+Material "matte" "rgb Kd" [0.6 0.6 0.6]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point P" [-2 0 -2  2 0 -2  2 0 2  -2 0 2]
+Texture "checks" "spectrum" "checkerboard" "float uscale" [8] "float vscale" [8]
+  "rgb tex1" [0.8 0.2 0.2] "rgb tex2" [0.2 0.8 0.2]
+AttributeBegin
+  Material "matte" "texture Kd" "checks"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [-2 0 -2  2 0 -2  2 2 -2  -2 2 -2] "float uv" [0 0 1 0 1 1 0 1]
+AttributeEnd
+Texture "bumps" "float" "wrinkled" "float scale" [4]
+AttributeBegin
+  Material "matte" "rgb Kd" [0.3 0.5 0.7] "texture bumpmap" "bumps"
+  Translate -0.9 0.35 0
+  Shape "sphere" "float radius" [0.35]
+AttributeEnd
+AttributeBegin
+  Material "glass"
+  Translate 0 0.35 0.3
+  Shape "sphere" "float radius" [0.35]
+AttributeEnd
+AttributeBegin
+  Material "mirror"
+  Translate 0.9 0.35 0
+  Shape "sphere" "float radius" [0.35]
+AttributeEnd
+AttributeBegin
+  Material "plastic" "float roughness" [0.1]
+  Translate 0.4 1.2 -0.6
+  Shape "sphere" "float radius" [0.25]
+AttributeEnd
+AttributeBegin
+  Material "none"
+  Shape "trianglemesh" "integer indices" [0 1 2]
+    "point P" [-1 0.1 1.5  0 0.1 1.5  -1 1.1 1.5]
+AttributeEnd
+WorldEnd
+"#
+        )
+    };
+    for max_depth in [1, 5] {
+        let desc = common::load_text(&scene(max_depth)).scene;
+        both_ways(desc, 24, 13, &format!("lanes, maxdepth {max_depth}"));
+    }
+}
+
 #[test]
 fn volpath_subsurface_and_media() {
     scenes(&[

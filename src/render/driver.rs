@@ -184,7 +184,7 @@ impl Renderer {
                 pool.broadcast(|_| {
                     let tx = tx.clone();
                     // The batch's lanes, made once per thread.
-                    let mut lanes = (batch > 1).then(|| Lanes::new(batch, sampler));
+                    let mut lanes = (batch > 1).then(|| Lanes::new(batch, sampler, integrator));
                     loop {
                         let k = next.fetch_add(1, Ordering::Relaxed);
                         let Some(&tb) = tiles.get(k) else { break };
@@ -274,7 +274,10 @@ impl Renderer {
             format!(
                 "batched: {} samples in flight per thread ({:.1} KiB of lane state per thread)",
                 self.batch,
-                Batch::new(self.batch, &self.sampler).state_bytes() as f64 / 1024.0
+                self.integrator
+                    .batch(self.batch, &self.sampler)
+                    .state_bytes() as f64
+                    / 1024.0
             )
         } else {
             "one sample at a time per thread (scalar loop)".to_string()
@@ -469,9 +472,9 @@ struct Lanes {
 }
 
 impl Lanes {
-    fn new(lanes: usize, proto: &Sampler) -> Lanes {
+    fn new(lanes: usize, proto: &Sampler, integrator: &Integrator) -> Lanes {
         Lanes {
-            b: Batch::new(lanes, proto),
+            b: integrator.batch(lanes, proto),
             at_pixel: proto.clone(),
             cs: vec![CameraSample::default(); lanes],
         }

@@ -72,6 +72,39 @@ pub struct Batch {
     hits: Vec<Option<Hit>>,
     states: Vec<PathState>,
     active: Vec<u32>,
+    direct: DirectLanes,
+}
+
+/// directlighting's Lambertian camera vertices of a batch (see
+/// [`Integrator::li_batch`]): the batch lane of each, the vertex, its
+/// emission, its light and BSDF samples for every light, and the sums of
+/// the light estimates. Grown to the batch's need on the first batch.
+#[derive(Default)]
+struct DirectLanes {
+    lanes: Vec<u32>,
+    verts: Vec<all_lights::LambertVertex>,
+    emitted: Vec<Vec3>,
+    u: Vec<Vec2>,
+    sums: Vec<Vec3>,
+}
+
+impl DirectLanes {
+    /// Bytes held (after a batch has grown them).
+    fn bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.lanes.capacity() * size_of::<u32>()
+            + self.verts.capacity() * size_of::<all_lights::LambertVertex>()
+            + (self.emitted.capacity() + self.sums.capacity()) * size_of::<Vec3>()
+            + self.u.capacity() * size_of::<Vec2>()
+    }
+
+    fn clear(&mut self) {
+        self.lanes.clear();
+        self.verts.clear();
+        self.emitted.clear();
+        self.u.clear();
+        self.sums.clear();
+    }
 }
 
 impl Batch {
@@ -90,6 +123,7 @@ impl Batch {
                 + size_of::<PathState>()
                 + size_of::<u32>())
             + self.samplers.iter().map(|s| s.heap_bytes()).sum::<usize>()
+            + self.direct.bytes()
     }
 
     /// A batch of `lanes` lanes, each with a copy of `sampler`.
@@ -106,6 +140,7 @@ impl Batch {
             hits: vec![None; lanes],
             states: vec![PathState::new(ray, None); lanes],
             active: Vec::with_capacity(lanes),
+            direct: DirectLanes::default(),
         }
     }
 }
@@ -142,6 +177,9 @@ pub enum Integrator {
         /// The lights four to a pack, for strategy "all" when every light is
         /// a triangle of constant normal with one sample (else empty).
         packs: Vec<TriangleLightPack>,
+        /// Light `i` of `packs` in all four lanes, for the camera vertices
+        /// of a batch (one light at four vertices).
+        uniform: Vec<TriangleLightPack>,
     },
     Whitted {
         max_depth: u32,
@@ -199,6 +237,7 @@ impl Integrator {
                     }
                     _ => Vec::new(),
                 },
+                uniform: Vec::new(),
             },
             IntegratorDesc::Whitted { max_depth } => Integrator::Whitted { max_depth },
             IntegratorDesc::VolPath {
@@ -216,6 +255,23 @@ impl Integrator {
         }
     }
 
+    /// A batch of `lanes` lanes for [`Integrator::li_batch`], each with a
+    /// copy of `sampler`, with room for what this integrator keeps per lane.
+    pub fn batch(&self, lanes: usize, sampler: &Sampler) -> Batch {
+        let mut b = Batch::new(lanes, sampler);
+        if let Integrator::Direct { uniform, .. } = self {
+            if !uniform.is_empty() {
+                let d = &mut b.direct;
+                d.lanes.reserve(lanes);
+                d.verts.reserve(lanes);
+                d.emitted.reserve(lanes);
+                d.sums.reserve(lanes);
+                d.u.reserve(lanes * 2 * uniform.len());
+            }
+        }
+        b
+    }
+
     /// Requests the sampler arrays the integrator uses (pbrt-v3's Preprocess).
     pub fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
         if let Integrator::Direct {
@@ -223,6 +279,7 @@ impl Integrator {
             strategy: DirectStrategy::All,
             n_light_samples,
             packs,
+            uniform,
             ..
         } = self
         {
@@ -234,6 +291,10 @@ impl Integrator {
             if n_light_samples.iter().any(|&n| n != 1) {
                 packs.clear();
             }
+            *uniform = packs
+                .iter()
+                .flat_map(|p| (0..p.count).map(|lane| p.uniform(lane)))
+                .collect();
             for _ in 0..*max_depth {
                 for &n in n_light_samples.iter() {
                     sampler.request_2d_array(n);
@@ -310,7 +371,17 @@ impl Integrator {
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                self.specular_tree_li(ray, None, time, diff, scene, sampler, scratch)
+                let mut bsdf = Bsdf::empty();
+                self.specular_tree_li(
+                    ray,
+                    First::Trace,
+                    time,
+                    diff,
+                    scene,
+                    sampler,
+                    scratch,
+                    &mut bsdf,
+                )
             }
         }
     }
@@ -382,14 +453,23 @@ impl Integrator {
                         }
                     }
                 }
+                if let Integrator::Direct { uniform, .. } = self {
+                    if !uniform.is_empty() {
+                        self.direct_batch(b, scene, scratch, uniform);
+                        return;
+                    }
+                }
+                let mut bsdf = Bsdf::empty();
                 for j in 0..n {
                     let (ray, time, diff) = (b.rays[j], b.times[j], b.diffs[j]);
                     let sampler = &mut b.samplers[j];
                     // The scalar loop's test: a NaN weight gets no radiance.
                     b.l[j] = if b.weights[j] > 0.0 {
                         if first_hits {
-                            let hit = Some(b.hits[j]);
-                            self.specular_tree_li(ray, hit, time, diff, scene, sampler, scratch)
+                            let first = First::Hit(b.hits[j]);
+                            self.specular_tree_li(
+                                ray, first, time, diff, scene, sampler, scratch, &mut bsdf,
+                            )
                         } else {
                             self.li(ray, time, diff, scene, sampler, scratch)
                         }
@@ -401,6 +481,95 @@ impl Integrator {
         }
     }
 
+    /// directlighting (strategy "all", triangle lights) for a batch whose
+    /// camera rays are traced: camera vertices whose BSDF is one
+    /// Lambertian are shaded and their samples drawn lane by lane, then
+    /// their light estimates are computed four vertices at a time
+    /// ([`all_lights::sample_all_lights_lanes`]); the other lanes go
+    /// through [`Integrator::specular_tree_li`] from their shaded vertex.
+    /// Lane by lane the same values, samples and rays as `li`.
+    fn direct_batch<'a>(
+        &self,
+        b: &mut Batch,
+        scene: &'a RenderScene,
+        scratch: &mut Scratch,
+        uniform: &[TriangleLightPack],
+    ) {
+        let Integrator::Direct {
+            max_depth, packs, ..
+        } = self
+        else {
+            unreachable!("direct_batch is directlighting's");
+        };
+        let d = &mut b.direct;
+        d.clear();
+        let mut bsdf = Bsdf::empty();
+        for j in 0..b.len {
+            let (ray, time, diff) = (b.rays[j], b.times[j], b.diffs[j]);
+            let sampler = &mut b.samplers[j];
+            b.l[j] = Vec3::ZERO;
+            // The scalar loop's test: a NaN weight gets no radiance.
+            if b.weights[j].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let mut go_on = |first: First, bsdf: &mut Bsdf<'a>| {
+                self.specular_tree_li(ray, first, time, diff, scene, sampler, scratch, bsdf)
+            };
+            let Some(hit) = b.hits[j] else {
+                b.l[j] = go_on(First::Hit(None), &mut bsdf);
+                continue;
+            };
+            let mut s = scene.geometry.surface_at(&hit, time);
+            let material = &scene.materials[s.material as usize];
+            if material.is_none() {
+                b.l[j] = go_on(First::Hit(Some(hit)), &mut bsdf);
+                continue;
+            }
+            // specular_tree_li's shading of its first vertex.
+            let geom = diff
+                .as_ref()
+                .filter(|_| scene.material_needs_geom[s.material as usize])
+                .map(|dd| with_diff(scene, &hit, &s, dd));
+            shade_geom(
+                scene,
+                &hit,
+                &mut s,
+                material,
+                false,
+                geom.as_ref(),
+                &mut bsdf,
+            );
+            let Some(r) = bsdf.single_lambertian() else {
+                b.l[j] = go_on(First::Shaded { hit, s, geom }, &mut bsdf);
+                continue;
+            };
+            // What specular_tree_li does at a Lambertian first vertex: the
+            // vertex counted, the light samples drawn, and no specular
+            // children (their samples skipped).
+            scratch.counts.closest += 1;
+            let wo = -ray.d;
+            for pack in packs {
+                all_lights::draw_samples(sampler, pack.count, &mut d.u);
+            }
+            if 1 < *max_depth {
+                sampler.skip_2d();
+                sampler.skip_2d();
+            }
+            d.lanes.push(j as u32);
+            d.emitted.push(emitted(scene, &s, wo));
+            d.verts
+                .push(all_lights::LambertVertex::new(&s, &bsdf, r, wo));
+            d.sums.push(Vec3::ZERO);
+        }
+        all_lights::sample_all_lights_lanes(scene, &d.verts, &d.u, uniform, &mut d.sums, scratch);
+        for ((&j, &e), &sum) in d.lanes.iter().zip(&d.emitted).zip(&d.sums) {
+            // specular_tree_li's sums: local = emitted + estimate, then
+            // l += beta · local with l = 0 and beta = 1.
+            let local = e + sum;
+            b.l[j as usize] = Vec3::ZERO + Vec3::ONE * local;
+        }
+    }
+
     /// directlighting and whitted: pbrt-v3's recursive Li, run with an
     /// explicit stack (kept in the per-tile scratch) instead of recursion, so
     /// that a hall of mirrors with a huge `maxdepth` cannot overflow a
@@ -408,18 +577,20 @@ impl Integrator {
     /// transmission, as pbrt-v3 recurses; both specular samples of a vertex
     /// are drawn when it is expanded (the same distribution as pbrt-v3, which
     /// draws the transmission sample after the reflection subtree).
-    /// `first_hit`, if given, is the camera ray's intersection, already
-    /// traced.
+    /// `first` says how far the camera ray's vertex has got already;
+    /// `bsdf` is the BSDF to shade into (holding the first vertex's when
+    /// `first` is [`First::Shaded`]).
     #[allow(clippy::too_many_arguments)]
-    fn specular_tree_li(
+    fn specular_tree_li<'a>(
         &self,
         ray: Ray,
-        first_hit: Option<Option<Hit>>,
+        first: First,
         time: f32,
         diff: Option<RayDiff>,
-        scene: &RenderScene,
+        scene: &'a RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
+        bsdf: &mut Bsdf<'a>,
     ) -> Vec3 {
         let mut stack = std::mem::take(&mut scratch.work);
         stack.clear();
@@ -433,58 +604,50 @@ impl Integrator {
             pass: 0,
         });
         let mut l = Vec3::ZERO;
-        let mut bsdf = Bsdf::empty();
-        let mut first_hit = first_hit;
+        let mut first = first;
         while let Some(w) = root.take().or_else(|| stack.pop()) {
             scratch.counts.closest += 1;
-            let hit = match first_hit.take() {
-                Some(h) => h,
-                None => scene.geometry.intersect_at(&w.ray, time),
-            };
-            let Some(hit) = hit else {
-                l += w.beta * escaped(scene, w.ray.d);
-                continue;
-            };
-            let mut s = scene.geometry.surface_at(&hit, time);
-            let material = &scene.materials[s.material as usize];
-            if material.is_none() {
-                if w.pass < MAX_PASS_THROUGH {
-                    let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
-                    // A spawned ray has no differentials (pbrt-v3's SpawnRay).
-                    stack.push(Work {
-                        ray,
-                        diff: None,
-                        pass: w.pass + 1,
-                        ..w
-                    });
+            let (hit, s, mut geom) = match std::mem::replace(&mut first, First::Trace) {
+                First::Shaded { hit, s, geom } => (hit, s, geom),
+                f => {
+                    let hit = match f {
+                        First::Hit(h) => h,
+                        _ => scene.geometry.intersect_at(&w.ray, time),
+                    };
+                    let Some(hit) = hit else {
+                        l += w.beta * escaped(scene, w.ray.d);
+                        continue;
+                    };
+                    let mut s = scene.geometry.surface_at(&hit, time);
+                    let material = &scene.materials[s.material as usize];
+                    if material.is_none() {
+                        if w.pass < MAX_PASS_THROUGH {
+                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                            // A spawned ray has no differentials (pbrt-v3's SpawnRay).
+                            stack.push(Work {
+                                ray,
+                                diff: None,
+                                pass: w.pass + 1,
+                                ..w
+                            });
+                        }
+                        continue;
+                    }
+                    // A material that reads the geometry gets it with the
+                    // ray's differentials; otherwise it is computed only if
+                    // specular children will carry differentials.
+                    let geom = w
+                        .diff
+                        .as_ref()
+                        .filter(|_| scene.material_needs_geom[s.material as usize])
+                        .map(|d| with_diff(scene, &hit, &s, d));
+                    shade_geom(scene, &hit, &mut s, material, false, geom.as_ref(), bsdf);
+                    (hit, s, geom)
                 }
-                continue;
-            }
-            let wo = -w.ray.d;
-            let with_diff = |s: &SurfaceHit, d: &RayDiff| {
-                let mut g = scene.geometry.diff_geom(&hit, s);
-                g.compute_differentials(s.point.p, s.point.n, d);
-                g
             };
-            // A material that reads the geometry gets it with the ray's
-            // differentials; otherwise it is computed only if specular
-            // children will carry differentials.
-            let mut geom = w
-                .diff
-                .as_ref()
-                .filter(|_| scene.material_needs_geom[s.material as usize])
-                .map(|d| with_diff(&s, d));
-            shade_geom(
-                scene,
-                &hit,
-                &mut s,
-                material,
-                false,
-                geom.as_ref(),
-                &mut bsdf,
-            );
+            let wo = -w.ray.d;
             if geom.is_none() && bsdf.has_specular() {
-                geom = w.diff.as_ref().map(|d| with_diff(&s, d));
+                geom = w.diff.as_ref().map(|d| with_diff(scene, &hit, &s, d));
             }
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
@@ -494,25 +657,26 @@ impl Integrator {
                     ref lights,
                     ref n_light_samples,
                     ref packs,
+                    ..
                 } => {
                     if !scene.lights.is_empty() {
                         local += match (strategy, bsdf.single_lambertian()) {
                             (DirectStrategy::All, Some(r)) if !packs.is_empty() => {
                                 all_lights::sample_all_lights_packed(
-                                    scene, &s, &bsdf, r, wo, sampler, scratch, packs,
+                                    scene, &s, bsdf, r, wo, sampler, scratch, packs,
                                 )
                             }
                             (DirectStrategy::All, _) => sample_all_lights(
                                 scene,
                                 &s,
-                                &bsdf,
+                                bsdf,
                                 wo,
                                 sampler,
                                 scratch,
                                 n_light_samples,
                             ),
                             (DirectStrategy::One, _) => {
-                                sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, lights)
+                                sample_one_light(scene, &s, bsdf, wo, sampler, scratch, lights)
                             }
                         };
                     }
@@ -588,6 +752,32 @@ impl Integrator {
         scratch.work = stack;
         l
     }
+}
+
+/// Where [`Integrator::specular_tree_li`] starts its camera vertex.
+#[allow(clippy::large_enum_variant)] // one per camera ray, on the stack, never stored
+enum First {
+    /// The camera ray is still to be traced.
+    Trace,
+    /// The camera ray's intersection, already traced.
+    Hit(Option<Hit>),
+    /// The camera ray's hit already shaded: its surface (with the BSDF's
+    /// shading normal) and its differential geometry, if computed; the
+    /// BSDF is the one handed to `specular_tree_li`.
+    Shaded {
+        hit: Hit,
+        s: SurfaceHit,
+        geom: Option<DiffGeom>,
+    },
+}
+
+/// The differential geometry of `hit` at `s`, with the screen-space
+/// derivatives of ray differentials `d`.
+#[inline]
+fn with_diff(scene: &RenderScene, hit: &Hit, s: &SurfaceHit, d: &RayDiff) -> DiffGeom {
+    let mut g = scene.geometry.diff_geom(hit, s);
+    g.compute_differentials(s.point.p, s.point.n, d);
+    g
 }
 
 /// The BSDF of `material` at a hit, built into `bsdf`, with the hit's

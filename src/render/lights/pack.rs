@@ -106,10 +106,28 @@ pub struct PackLightSample {
 }
 
 impl TriangleLightPack {
-    /// `TriangleCache::sample_li` for the four lanes, operation for
-    /// operation (the same values bit for bit).
+    /// The pack of light `lane` in all four lanes (to sample one light
+    /// from four points at once).
+    pub fn uniform(&self, lane: usize) -> TriangleLightPack {
+        let one = |v: &Vec3x4| splat3(lane3(v, lane));
+        TriangleLightPack {
+            count: 4,
+            p: [one(&self.p[0]), one(&self.p[1]), one(&self.p[2])],
+            n: one(&self.n),
+            plane: one(&self.plane),
+            bary: [one(&self.bary[0]), one(&self.bary[1])],
+            area: Vec4::splat(self.area[lane]),
+            l: one(&self.l),
+            two_sided: BVec4A::splat(self.two_sided.test(lane)),
+            emits: BVec4A::splat(self.emits.test(lane)),
+        }
+    }
+
+    /// `TriangleCache::sample_li` for the four lanes (lane `i` from point
+    /// `p` lane `i`), operation for operation (the same values bit for
+    /// bit).
     #[inline(always)]
-    pub fn sample_li(&self, p: Vec3, u: [Vec4; 2]) -> PackLightSample {
+    pub fn sample_li(&self, p: &Vec3x4, u: [Vec4; 2]) -> PackLightSample {
         // uniform_sample_triangle and sample_triangle_point.
         let su0 = u[0].sqrt();
         let b0 = Vec4::ONE - su0;
@@ -121,7 +139,7 @@ impl TriangleLightPack {
         let q_error: Vec3x4 = std::array::from_fn(|a| {
             g6 * ((b0 * self.p[0][a]).abs() + (b1 * self.p[1][a]).abs() + (b2 * self.p[2][a]).abs())
         });
-        let d: Vec3x4 = std::array::from_fn(|a| q[a] - Vec4::splat(p[a]));
+        let d: Vec3x4 = std::array::from_fn(|a| q[a] - p[a]);
         let dist2 = dot3(&d, &d);
         let dist = dist2.sqrt();
         let inv = Vec4::ONE / dist;
