@@ -332,20 +332,8 @@ pub(super) fn sample_all_lights_packed(
     for (k, pack) in packs.iter().enumerate() {
         let mut u = arrayvec::ArrayVec::<Vec2, 8>::new();
         draw_samples(sampler, pack.count, &mut u);
-        let lanes = |first: usize| {
-            let at = |i: usize| u.get(2 * i + first).copied().unwrap_or_default();
-            [
-                Vec4::new(at(0).x, at(1).x, at(2).x, at(3).x),
-                Vec4::new(at(0).y, at(1).y, at(2).y, at(3).y),
-            ]
-        };
-        let active = BVec4A::new(
-            pack.count > 0,
-            pack.count > 1,
-            pack.count > 2,
-            pack.count > 3,
-        );
-        let e = estimate4(pack, &v4, lanes(0), lanes(1), active);
+        let lanes = |k: usize| x4(|i| u.get(2 * i + k).copied().unwrap_or_default());
+        let e = estimate4(pack, &v4, lanes(0), lanes(1), first_lanes(pack.count));
         for lane in 0..pack.count {
             l += lane_ld(scene, &e, lane, (4 * k + lane) as u32, pack, &v, scratch);
         }
@@ -369,22 +357,32 @@ pub(super) fn sample_all_lights_lanes(
     for (g, group) in verts.chunks(4).enumerate() {
         let v4 = Vertex4::gather(group);
         let n = group.len();
-        let active = BVec4A::new(true, n > 1, n > 2, n > 3);
+        let active = first_lanes(n);
         let first = 4 * g;
         for (i, light) in lights.iter().enumerate() {
-            let lanes = |k: usize| {
-                let at = |lane: usize| u[(first + lane.min(n - 1)) * stride + 2 * i + k];
-                [
-                    Vec4::new(at(0).x, at(1).x, at(2).x, at(3).x),
-                    Vec4::new(at(0).y, at(1).y, at(2).y, at(3).y),
-                ]
-            };
+            let lanes = |k: usize| x4(|lane| u[(first + lane.min(n - 1)) * stride + 2 * i + k]);
             let e = estimate4(light, &v4, lanes(0), lanes(1), active);
             for (lane, v) in group.iter().enumerate() {
                 out[first + lane] += lane_ld(scene, &e, lane, i as u32, light, v, scratch);
             }
         }
     }
+}
+
+/// Four 2D samples in lanes: lane `i` is `at(i)`.
+#[inline(always)]
+fn x4(at: impl Fn(usize) -> Vec2) -> [Vec4; 2] {
+    let v = [at(0), at(1), at(2), at(3)];
+    [
+        Vec4::new(v[0].x, v[1].x, v[2].x, v[3].x),
+        Vec4::new(v[0].y, v[1].y, v[2].y, v[3].y),
+    ]
+}
+
+/// The first `n` of four lanes.
+#[inline(always)]
+fn first_lanes(n: usize) -> BVec4A {
+    BVec4A::new(n > 0, n > 1, n > 2, n > 3)
 }
 
 /// `concentric_sample_disk` in four lanes, both of its cases computed and
