@@ -431,6 +431,38 @@ impl CameraRays {
         }
     }
 
+    /// [`CameraRays::ray`] with the ray and its differentials written to
+    /// `ray` and `diff` (where the batch keeps them: a ray returned and
+    /// then copied stalls on the stores that made it).
+    #[inline(always)]
+    fn ray_into(
+        &self,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        pixel: IVec2,
+        ray: &mut Ray,
+        diff: &mut Option<RayDiff>,
+    ) -> (CameraSample, f32, f32) {
+        let cs = sampler.camera_sample(pixel, self.lens);
+        let time = if self.moving {
+            scene.camera.time(&cs)
+        } else {
+            0.0
+        };
+        let w = if self.differentials {
+            let (r, d, w) = scene.camera.generate_ray_differential(&cs, self.diff_scale);
+            *ray = r;
+            *diff = Some(d);
+            w
+        } else {
+            let (r, w) = scene.camera.generate_ray(&cs);
+            *ray = r;
+            *diff = None;
+            w
+        };
+        (cs, time, w)
+    }
+
     /// The camera sample of `sampler`'s current sample (started at
     /// `pixel`) with its ray's time, the ray, its differentials and weight.
     #[inline(always)]
@@ -440,19 +472,9 @@ impl CameraRays {
         sampler: &mut Sampler,
         pixel: IVec2,
     ) -> (CameraSample, f32, Ray, Option<RayDiff>, f32) {
-        let cs = sampler.camera_sample(pixel, self.lens);
-        let time = if self.moving {
-            scene.camera.time(&cs)
-        } else {
-            0.0
-        };
-        if self.differentials {
-            let (ray, d, w) = scene.camera.generate_ray_differential(&cs, self.diff_scale);
-            (cs, time, ray, Some(d), w)
-        } else {
-            let (ray, w) = scene.camera.generate_ray(&cs);
-            (cs, time, ray, None, w)
-        }
+        let (mut ray, mut diff) = (Ray::new(Vec3::ZERO, Vec3::Z), None);
+        let (cs, time, w) = self.ray_into(scene, sampler, pixel, &mut ray, &mut diff);
+        (cs, time, ray, diff, w)
     }
 }
 
@@ -522,11 +544,10 @@ fn render_tile_batched(
             }
             let sampler = &mut b.samplers[j];
             sampler.start_pixel_sample_from(at_pixel, pixel, i);
-            let (cs_j, time, ray, diff, weight) = camera.ray(scene, sampler, pixel);
+            let (ray, diff) = (&mut b.rays[j], &mut b.diffs[j]);
+            let (cs_j, time, weight) = camera.ray_into(scene, sampler, pixel, ray, diff);
             cs[j] = cs_j;
             b.times[j] = time;
-            b.rays[j] = ray;
-            b.diffs[j] = diff;
             b.weights[j] = weight;
             b.len += 1;
         }

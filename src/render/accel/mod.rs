@@ -706,6 +706,20 @@ impl Geometry {
     /// instances: a still scene never looks at it).
     #[inline(never)]
     pub fn intersect_at(&self, ray: &Ray, time: f32) -> Option<Hit> {
+        self.closest_at(ray, time)
+    }
+
+    /// [`Geometry::intersect_at`] written to `out`: the batched loops keep
+    /// their hits in an array, and a hit returned by value is stored by the
+    /// callee and at once copied by the caller with wider loads than its
+    /// stores (a store-forwarding stall on every ray).
+    #[inline(never)]
+    pub fn intersect_into(&self, ray: &Ray, time: f32, out: &mut Option<Hit>) {
+        *out = self.closest_at(ray, time);
+    }
+
+    #[inline(always)]
+    fn closest_at(&self, ray: &Ray, time: f32) -> Option<Hit> {
         self.shapes().intersect(
             ray,
             |i, t_max| {

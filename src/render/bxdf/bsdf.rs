@@ -98,12 +98,15 @@ impl<'a> Bsdf<'a> {
 
     #[inline]
     pub fn add_scaled(&mut self, b: impl Into<Bxdf<'a>>, scale: Vec3) {
+        if self.lobes.is_full() {
+            return;
+        }
+        // The lobe goes straight into its slot: built on the stack and
+        // copied, the copy's wide loads stalled on the narrower stores
+        // that had just built it (store forwarding fails), at every vertex.
         let bxdf = b.into();
-        let _ = self.lobes.try_push(Lobe {
-            flags: bxdf.flags(),
-            bxdf,
-            scale,
-        });
+        let flags = bxdf.flags();
+        self.lobes.push(Lobe { bxdf, scale, flags });
     }
 
     /// Multiplies the weights of lobes `from..` by `s` (for `mix`).

@@ -136,7 +136,7 @@ impl Camera {
 
     /// The camera ray for a film position (raster coordinates), lens sample
     /// and time sample (at [`Camera::time`]), and its weight.
-    #[inline]
+    #[inline(always)]
     pub fn generate_ray(&self, cs: &CameraSample) -> (Ray, f32) {
         let (ray, w) = self.projection.generate_ray(cs);
         match &self.motion {

@@ -78,8 +78,10 @@ impl PerspectiveCamera {
         world_ray(&self.camera_to_world, lens, d)
     }
 
-    /// The camera ray for a film position (raster coordinates) and lens sample.
-    #[inline]
+    /// The camera ray for a film position (raster coordinates) and lens
+    /// sample. Inlined into the render loop, which stores the ray: returned
+    /// through memory, its copy stalled on the stores that had just made it.
+    #[inline(always)]
     pub fn generate_ray(&self, cs: &CameraSample) -> Ray {
         let dir = self.film_dir(cs);
         if self.lens_radius > 0.0 {

@@ -404,7 +404,7 @@ impl Integrator {
                 for j in 0..n {
                     b.l[j] = Vec3::ZERO;
                     if b.weights[j] > 0.0 {
-                        b.states[j] = PathState::new(b.rays[j], b.diffs[j]);
+                        b.states[j].reset(b.rays[j], &b.diffs[j]);
                         b.active.push(j as u32);
                     }
                 }
@@ -413,7 +413,10 @@ impl Integrator {
                     for &j in &b.active {
                         let j = j as usize;
                         scratch.counts.closest += 1;
-                        b.hits[j] = scene.geometry.intersect_at(&b.states[j].ray, b.times[j]);
+                        let ray = &b.states[j].ray;
+                        scene
+                            .geometry
+                            .intersect_into(ray, b.times[j], &mut b.hits[j]);
                     }
                     let mut kept = 0;
                     for k in 0..b.active.len() {
@@ -427,7 +430,7 @@ impl Integrator {
                         };
                         if path_step(
                             &mut b.states[j],
-                            b.hits[j],
+                            &b.hits[j],
                             &p,
                             &mut b.samplers[j],
                             scratch,
@@ -449,7 +452,8 @@ impl Integrator {
                 if first_hits {
                     for j in 0..n {
                         if b.weights[j] > 0.0 {
-                            b.hits[j] = scene.geometry.intersect_at(&b.rays[j], b.times[j]);
+                            let hit = &mut b.hits[j];
+                            scene.geometry.intersect_into(&b.rays[j], b.times[j], hit);
                         }
                     }
                 }
@@ -505,7 +509,9 @@ impl Integrator {
         d.clear();
         let mut bsdf = Bsdf::empty();
         for j in 0..b.len {
-            let (ray, time, diff) = (b.rays[j], b.times[j], b.diffs[j]);
+            // The differentials are copied only where they are read (a
+            // copy of every lane's stalled on the camera stage's stores).
+            let (ray, time, diff) = (b.rays[j], b.times[j], &b.diffs[j]);
             let sampler = &mut b.samplers[j];
             b.l[j] = Vec3::ZERO;
             // The scalar loop's test: a NaN weight gets no radiance.
@@ -513,7 +519,7 @@ impl Integrator {
                 continue;
             }
             let mut go_on = |first: First, bsdf: &mut Bsdf<'a>| {
-                self.specular_tree_li(ray, first, time, diff, scene, sampler, scratch, bsdf)
+                self.specular_tree_li(ray, first, time, *diff, scene, sampler, scratch, bsdf)
             };
             let Some(hit) = b.hits[j] else {
                 b.l[j] = go_on(First::Hit(None), &mut bsdf);
@@ -901,7 +907,7 @@ fn path_li(
     loop {
         scratch.counts.closest += 1;
         let hit = scene.geometry.intersect_at(&st.ray, time);
-        if !path_step(&mut st, hit, &p, sampler, scratch, &mut bsdf) {
+        if !path_step(&mut st, &hit, &p, sampler, scratch, &mut bsdf) {
             break;
         }
     }
@@ -932,6 +938,22 @@ pub(crate) struct PathState {
 }
 
 impl PathState {
+    /// `*self = PathState::new(ray, *diff)`, field by field (a new state
+    /// built on the stack and copied stalled on the copy's loads).
+    #[inline]
+    pub(crate) fn reset(&mut self, ray: Ray, diff: &Option<RayDiff>) {
+        self.ray = ray;
+        self.diff = *diff;
+        self.l = Vec3::ZERO;
+        self.beta = Vec3::ONE;
+        self.specular_bounce = false;
+        self.eta_scale = 1.0;
+        self.bounces = 0;
+        self.pass = 0;
+        self.prev = None;
+        self.bsdf_pdf = 0.0;
+    }
+
     #[inline]
     pub(crate) fn new(ray: Ray, diff: Option<RayDiff>) -> PathState {
         PathState {
@@ -964,7 +986,7 @@ pub(crate) struct PathParams<'a> {
 #[inline(always)]
 fn path_step<'a>(
     st: &mut PathState,
-    hit: Option<Hit>,
+    hit: &Option<Hit>,
     p: &PathParams<'a>,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
@@ -973,7 +995,8 @@ fn path_step<'a>(
     let (scene, time, lights) = (p.scene, p.time, p.lights);
     let ray = st.ray;
     let from = st.prev.filter(|_| !st.specular_bounce);
-    let Some(hit) = hit else {
+    // By reference: a copy of the hit just read stalls on its stores.
+    let Some(hit) = hit.as_ref() else {
         add_escaped_mis(
             &mut st.l,
             scene,
@@ -985,7 +1008,7 @@ fn path_step<'a>(
         );
         return false;
     };
-    let mut s = scene.geometry.surface_at(&hit, time);
+    let mut s = scene.geometry.surface_at(hit, time);
     let wo = -ray.d;
     st.l += emitted_mis(
         scene,
@@ -1010,7 +1033,7 @@ fn path_step<'a>(
         st.diff = None;
         return true;
     }
-    shade(scene, &hit, &mut s, material, true, st.diff.as_ref(), bsdf);
+    shade(scene, hit, &mut s, material, true, st.diff.as_ref(), bsdf);
     st.diff = None;
     if bsdf.has_non_specular() {
         st.l += st.beta * sample_light_mis(scene, &s, bsdf, wo, sampler, scratch, lights);
@@ -1033,7 +1056,7 @@ fn path_step<'a>(
         // point, with light sampled there, not counted as a bounce.
         let frame = bsdf.frame;
         let Some((pi, w, exit)) =
-            subsurface_exit(scene, &hit, &s, material, &frame, time, sampler, scratch)
+            subsurface_exit(scene, hit, &s, material, &frame, time, sampler, scratch)
         else {
             return false;
         };
