@@ -308,11 +308,14 @@ pub struct PermutationTables {
     lanes: BlockLanes,
 }
 
-/// Dimensions `2..BLOCK_DIM_END` (bases 5 ..= 127, all with pair tables)
+/// Dimensions `2..BLOCK_DIM_END` (bases 5 ..= 127, the pair-table ones)
 /// can be computed `BLOCK_LANES` at a time by `scrambled_block`.
 pub const BLOCK_DIM_END: usize = 31;
 /// Dimensions per `scrambled_block` call: 8 lanes, two AVX2 vectors of f64.
 pub const BLOCK_LANES: usize = 8;
+/// Blocks below this dimension (bases up to 61) read the pair tables;
+/// later ones the permutations.
+const PAIR_BLOCK_DIM_END: usize = 18;
 
 /// Per-dimension constants of the pair-table dimensions as structure of
 /// arrays (indexed by dimension, padded by `BLOCK_LANES` past
@@ -327,6 +330,8 @@ struct BlockLanes {
     tail: Vec<f64>,
     /// Start of the dimension's pair table in `pairs`.
     pairs: Vec<i32>,
+    /// Start of the dimension's permutation in `perms`.
+    perm: Vec<i32>,
 }
 
 impl BlockLanes {
@@ -347,6 +352,7 @@ impl BlockLanes {
             l.inv_base2.push(s.b.inv_base2);
             l.tail.push(s.tail);
             l.pairs.push(s.pairs as i32);
+            l.perm.push(s.perm as i32);
         }
         l
     }
@@ -462,10 +468,17 @@ impl PermutationTables {
         #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
         // SAFETY: AVX2 is enabled at compile time; the constant loads stay
         // inside `lanes` (padded by BLOCK_LANES past BLOCK_DIM_END) and
-        // every gather index is a pair-table entry of a dimension below
-        // BLOCK_DIM_END (the table is padded for the 32-bit read).
+        // every gather index is an entry of the pair table or a digit of
+        // the permutation of a dimension below BLOCK_DIM_END (the pair
+        // tables are padded for the 32-bit read; the permutations of these
+        // bases, up to 127, start `perms`, whose later ones keep the reads
+        // inside it).
         unsafe {
-            self.scrambled_block_avx2(first, a as u32, out)
+            if first + BLOCK_LANES <= PAIR_BLOCK_DIM_END {
+                self.scrambled_block_avx2::<true>(first, a as u32, out)
+            } else {
+                self.scrambled_block_avx2::<false>(first, a as u32, out)
+            }
         }
         #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
         for (k, v) in out.iter_mut().enumerate() {
@@ -477,9 +490,18 @@ impl PermutationTables {
     /// per lane (two digits while `a >= base²`, then one or two), the
     /// reversed digits held exactly in f64 (below 2^40), quotients by
     /// correctly rounded division (exact when floored, for `a < 2^53`).
+    /// A pair of digits is one load from the pair tables (`PAIRS`) or two
+    /// from the permutations: the pair tables of bases past 61 (250 KiB)
+    /// miss the first- and second-level caches, the permutations (3 KiB)
+    /// do not, and the pair tables below (41 KiB) mostly hit.
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     #[inline]
-    unsafe fn scrambled_block_avx2(&self, first: usize, a: u32, out: &mut [f32; BLOCK_LANES]) {
+    unsafe fn scrambled_block_avx2<const PAIRS: bool>(
+        &self,
+        first: usize,
+        a: u32,
+        out: &mut [f32; BLOCK_LANES],
+    ) {
         use std::arch::x86_64::*;
         let l = &self.lanes;
         let ld = |v: &Vec<f64>, k: usize| _mm256_loadu_pd(v.as_ptr().add(first + k));
@@ -487,11 +509,14 @@ impl PermutationTables {
         let (b2_lo, b2_hi) = (ld(&l.base2, 0), ld(&l.base2, 4));
         let (ib_lo, ib_hi) = (ld(&l.inv_base, 0), ld(&l.inv_base, 4));
         let (ib2_lo, ib2_hi) = (ld(&l.inv_base2, 0), ld(&l.inv_base2, 4));
-        let off_lo = _mm_loadu_si128(l.pairs.as_ptr().add(first) as *const __m128i);
-        let off_hi = _mm_loadu_si128(l.pairs.as_ptr().add(first + 4) as *const __m128i);
-        let table = self.pairs.as_ptr() as *const i32;
+        let (offsets, table) = match PAIRS {
+            true => (&l.pairs, self.pairs.as_ptr() as *const i32),
+            false => (&l.perm, self.perms.as_ptr() as *const i32),
+        };
+        let off_lo = _mm_loadu_si128(offsets.as_ptr().add(first) as *const __m128i);
+        let off_hi = _mm_loadu_si128(offsets.as_ptr().add(first + 4) as *const __m128i);
         let low16 = _mm_set1_epi32(0xffff);
-        // Entry `i` of a dimension's pair table, for 4 lanes.
+        // Entry `i` of a dimension's pair table or permutation, for 4 lanes.
         let gather = |i: __m256d, off: __m128i| {
             let idx = _mm_add_epi32(_mm256_cvttpd_epi32(i), off);
             _mm256_cvtepi32_pd(_mm_and_si128(_mm_i32gather_epi32::<2>(table, idx), low16))
@@ -511,6 +536,14 @@ impl PermutationTables {
                 _mm256_add_pd(q, _mm256_and_pd(high, one)),
                 _mm256_sub_pd(r, _mm256_and_pd(high, b)),
             )
+        };
+        // The pair of digits `r` = hi · base + lo (< base²) reversed and
+        // permuted, perm[lo] · base + perm[hi] (the pair table's entry
+        // `r`), from the permutations.
+        let pair = |r: __m256d, b: __m256d, inv: __m256d, off: __m128i| {
+            let (hi, lo) = divmod(r, b, inv);
+            let p_lo = gather(lo, off);
+            (_mm256_add_pd(_mm256_mul_pd(p_lo, b), gather(hi, off)), p_lo)
         };
         // Appends digits `d` (a number below `mul`, whose reciprocal is
         // `inv_mul`) to the reversed digits and the scale, in the lanes of
@@ -543,24 +576,38 @@ impl PermutationTables {
             // remainder's sign and size correct.
             let (q_lo, r_lo) = divmod(a_lo, b2_lo, ib2_lo);
             let (q_hi, r_hi) = divmod(a_hi, b2_hi, ib2_hi);
-            let d_lo = gather(r_lo, off_lo);
-            let d_hi = gather(r_hi, off_hi);
+            let (d_lo, d_hi) = match PAIRS {
+                true => (gather(r_lo, off_lo), gather(r_hi, off_hi)),
+                false => (
+                    pair(r_lo, b_lo, ib_lo, off_lo).0,
+                    pair(r_hi, b_hi, ib_hi, off_hi).0,
+                ),
+            };
             (rev_lo, inv_lo) = push(rev_lo, inv_lo, d_lo, b2_lo, ib2_lo, m_lo);
             (rev_hi, inv_hi) = push(rev_hi, inv_hi, d_hi, b2_hi, ib2_hi, m_hi);
             a_lo = _mm256_blendv_pd(a_lo, q_lo, m_lo);
             a_hi = _mm256_blendv_pd(a_hi, q_hi, m_hi);
         }
-        // The last one or two digits: entry `a` (two digits) when
-        // `a >= base`, else entry `base² + a` (one digit) when `a != 0`.
+        // The last one or two digits: the pair `a` when `a >= base`, else
+        // the digit perm[a] when `a != 0` (pair-table entry `base² + a`;
+        // lo = a, hi = 0 from the permutations).
         let zero = _mm256_setzero_pd();
         let two_lo = _mm256_cmp_pd::<_CMP_GE_OQ>(a_lo, b_lo);
         let two_hi = _mm256_cmp_pd::<_CMP_GE_OQ>(a_hi, b_hi);
         let nz_lo = _mm256_cmp_pd::<_CMP_GT_OQ>(a_lo, zero);
         let nz_hi = _mm256_cmp_pd::<_CMP_GT_OQ>(a_hi, zero);
-        let i_lo = _mm256_blendv_pd(_mm256_add_pd(a_lo, b2_lo), a_lo, two_lo);
-        let i_hi = _mm256_blendv_pd(_mm256_add_pd(a_hi, b2_hi), a_hi, two_hi);
-        let d_lo = gather(i_lo, off_lo);
-        let d_hi = gather(i_hi, off_hi);
+        let (d_lo, d_hi) = if PAIRS {
+            let i_lo = _mm256_blendv_pd(_mm256_add_pd(a_lo, b2_lo), a_lo, two_lo);
+            let i_hi = _mm256_blendv_pd(_mm256_add_pd(a_hi, b2_hi), a_hi, two_hi);
+            (gather(i_lo, off_lo), gather(i_hi, off_hi))
+        } else {
+            let (p2_lo, p1_lo) = pair(a_lo, b_lo, ib_lo, off_lo);
+            let (p2_hi, p1_hi) = pair(a_hi, b_hi, ib_hi, off_hi);
+            (
+                _mm256_blendv_pd(p1_lo, p2_lo, two_lo),
+                _mm256_blendv_pd(p1_hi, p2_hi, two_hi),
+            )
+        };
         let mul_lo = _mm256_blendv_pd(b_lo, b2_lo, two_lo);
         let mul_hi = _mm256_blendv_pd(b_hi, b2_hi, two_hi);
         let im_lo = _mm256_blendv_pd(ib_lo, ib2_lo, two_lo);
