@@ -98,15 +98,26 @@ impl<'a> Bsdf<'a> {
 
     #[inline]
     pub fn add_scaled(&mut self, b: impl Into<Bxdf<'a>>, scale: Vec3) {
-        if self.lobes.is_full() {
+        let len = self.lobes.len();
+        if len == MAX_BXDFS {
             return;
         }
-        // The lobe goes straight into its slot: built on the stack and
-        // copied, the copy's wide loads stalled on the narrower stores
-        // that had just built it (store forwarding fails), at every vertex.
         let bxdf = b.into();
         let flags = bxdf.flags();
-        self.lobes.push(Lobe { bxdf, scale, flags });
+        // The lobe's fields are written straight into its slot: a lobe
+        // built on the stack and pushed was copied with wide loads that
+        // stalled on the narrower stores that had just built it (store
+        // forwarding fails), at every shaded vertex.
+        // SAFETY: `len` is below the capacity, so slot `len` is inside the
+        // array; its three fields are written before the length covers
+        // it, and `Lobe` has no other fields.
+        unsafe {
+            let slot = self.lobes.as_mut_ptr().add(len);
+            std::ptr::addr_of_mut!((*slot).bxdf).write(bxdf);
+            std::ptr::addr_of_mut!((*slot).scale).write(scale);
+            std::ptr::addr_of_mut!((*slot).flags).write(flags);
+            self.lobes.set_len(len + 1);
+        }
     }
 
     /// Multiplies the weights of lobes `from..` by `s` (for `mix`).
