@@ -98,17 +98,17 @@ impl<'a> Bsdf<'a> {
 
     #[inline]
     pub fn add_scaled(&mut self, b: impl Into<Bxdf<'a>>, scale: Vec3) {
-        let len = self.lobes.len();
-        if len == MAX_BXDFS {
+        if self.lobes.is_full() {
             return;
         }
+        let len = self.lobes.len();
         let bxdf = b.into();
         let flags = bxdf.flags();
         // The lobe's fields are written straight into its slot: a lobe
         // built on the stack and pushed was copied with wide loads that
         // stalled on the narrower stores that had just built it (store
         // forwarding fails), at every shaded vertex.
-        // SAFETY: `len` is below the capacity, so slot `len` is inside the
+        // SAFETY: the array is not full, so slot `len` is inside the
         // array; its three fields are written before the length covers
         // it, and `Lobe` has no other fields.
         unsafe {

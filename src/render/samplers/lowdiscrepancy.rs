@@ -509,9 +509,10 @@ impl PermutationTables {
         let (b2_lo, b2_hi) = (ld(&l.base2, 0), ld(&l.base2, 4));
         let (ib_lo, ib_hi) = (ld(&l.inv_base, 0), ld(&l.inv_base, 4));
         let (ib2_lo, ib2_hi) = (ld(&l.inv_base2, 0), ld(&l.inv_base2, 4));
-        let (offsets, table) = match PAIRS {
-            true => (&l.pairs, self.pairs.as_ptr() as *const i32),
-            false => (&l.perm, self.perms.as_ptr() as *const i32),
+        let (offsets, table) = if PAIRS {
+            (&l.pairs, self.pairs.as_ptr() as *const i32)
+        } else {
+            (&l.perm, self.perms.as_ptr() as *const i32)
         };
         let off_lo = _mm_loadu_si128(offsets.as_ptr().add(first) as *const __m128i);
         let off_hi = _mm_loadu_si128(offsets.as_ptr().add(first + 4) as *const __m128i);
@@ -576,12 +577,13 @@ impl PermutationTables {
             // remainder's sign and size correct.
             let (q_lo, r_lo) = divmod(a_lo, b2_lo, ib2_lo);
             let (q_hi, r_hi) = divmod(a_hi, b2_hi, ib2_hi);
-            let (d_lo, d_hi) = match PAIRS {
-                true => (gather(r_lo, off_lo), gather(r_hi, off_hi)),
-                false => (
+            let (d_lo, d_hi) = if PAIRS {
+                (gather(r_lo, off_lo), gather(r_hi, off_hi))
+            } else {
+                (
                     pair(r_lo, b_lo, ib_lo, off_lo).0,
                     pair(r_hi, b_hi, ib_hi, off_hi).0,
-                ),
+                )
             };
             (rev_lo, inv_lo) = push(rev_lo, inv_lo, d_lo, b2_lo, ib2_lo, m_lo);
             (rev_hi, inv_hi) = push(rev_hi, inv_hi, d_hi, b2_hi, ib2_hi, m_hi);
