@@ -2,7 +2,9 @@
 //!
 //! obvhs builds the tree (PLOC and SAH reinsertion, the same steps as its
 //! CWBVH builder); this module collapses obvhs's binary tree into nodes of up
-//! to four children and leaves of up to four primitives. A node holds its
+//! to four children and leaves of up to four primitives, choosing which
+//! subtrees become slots and leaves by the surface area heuristic
+//! ([`CollapsePlan`]). A node holds its
 //! children's boxes as six four-lane vectors, so one ray meets all four boxes
 //! in a handful of SIMD instructions; a leaf holds its triangles' vertices in
 //! lanes, so one ray meets up to four triangles in one pass of the watertight
@@ -252,35 +254,17 @@ impl Bvh4 {
             (leaves.len() - 1) as u32 | LEAF
         };
 
+        let plan = CollapsePlan::new(bvh2, &counts);
         // Work list: (BVH2 node, BVH4 node to fill, depth).
         nodes.push(empty_node());
         let mut work = vec![(0usize, 0usize, 1usize)];
         while let Some((n2, out, depth)) = work.pop() {
             max_depth = max_depth.max(depth);
-            // The children: open the largest internal child until there are four.
-            let mut kids: Vec<usize> = if counts[n2] as usize <= LEAF_SIZE {
+            let kids = if plan.is_leaf(0) && n2 == 0 {
                 vec![n2] // a root small enough to be one leaf
             } else {
-                let f = nodes2[n2].first_index as usize;
-                vec![f, f + 1]
+                plan.children(n2, nodes2)
             };
-            while kids.len() < 4 {
-                let open = kids
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &k)| counts[k] as usize > LEAF_SIZE)
-                    .max_by(|a, b| {
-                        nodes2[*a.1]
-                            .aabb
-                            .half_area()
-                            .total_cmp(&nodes2[*b.1].aabb.half_area())
-                    })
-                    .map(|(i, _)| i);
-                let Some(i) = open else { break };
-                let f = nodes2[kids[i]].first_index as usize;
-                kids[i] = f;
-                kids.push(f + 1);
-            }
             let mut node = empty_node();
             node.valid = BVec4A::new(true, kids.len() > 1, kids.len() > 2, kids.len() > 3);
             for (slot, &k) in kids.iter().enumerate() {
@@ -289,7 +273,7 @@ impl Bvh4 {
                     node.b[axis][slot] = a.min[axis];
                     node.b[3 + axis][slot] = a.max[axis];
                 }
-                node.child[slot] = if counts[k] as usize <= LEAF_SIZE {
+                node.child[slot] = if plan.is_leaf(k) {
                     make_leaf(k, &mut order)
                 } else {
                     nodes.push(empty_node());
@@ -550,6 +534,128 @@ fn empty_node() -> Node {
     }
 }
 
+/// Relative costs of the surface area heuristic: testing a node's four
+/// boxes, and a leaf's triangle pack (about twice the instructions).
+const COST_NODE: f32 = 1.0;
+const COST_LEAF: f32 = 3.0;
+
+/// How the binary tree collapses into four-wide nodes, chosen by the
+/// surface area heuristic over all ways to do it (Ylitie, Karras and
+/// Laine 2017, "Efficient incoherent ray traversal on GPUs through
+/// compressed wide BVHs", section 3.1): a subtree with at most
+/// `LEAF_SIZE` primitives is a leaf only when that is cheaper than a node,
+/// and a node's four slots go to the subtrees whose boxes save the most.
+/// On the Cornell box the greedy collapse put the two side walls in one
+/// leaf whose box is the whole room, tested by every ray.
+struct CollapsePlan {
+    /// Per BVH2 node and slot budget `k` (1..=4, at index `k - 1`): the
+    /// least cost of its subtree in at most `k` slots of a parent node.
+    cost: Vec<[f32; 4]>,
+    /// How that cost is reached: 0 takes the subtree whole (`k` = 1) or
+    /// in one slot fewer; `j` > 0 gives `j` slots to the first child and
+    /// `k - j` to the second.
+    split: Vec<[u8; 4]>,
+    /// Whether the subtree, taken whole into one slot, is a leaf.
+    leaf: Vec<bool>,
+}
+
+impl CollapsePlan {
+    fn new(bvh2: &Bvh2, counts: &[u32]) -> CollapsePlan {
+        let nodes = &bvh2.nodes;
+        let n = nodes.len();
+        let mut plan = CollapsePlan {
+            cost: vec![[0.0; 4]; n],
+            split: vec![[0; 4]; n],
+            leaf: vec![false; n],
+        };
+        // Children first (post-order without recursion).
+        let mut stack = vec![(0usize, false)];
+        while let Some((i, done)) = stack.pop() {
+            let node = &nodes[i];
+            let area = node.aabb.half_area().max(0.0);
+            if node.prim_count != 0 {
+                plan.leaf[i] = true;
+                plan.cost[i] = [area * COST_LEAF; 4];
+                continue;
+            }
+            let f = node.first_index as usize;
+            if !done {
+                stack.push((i, true));
+                stack.push((f, false));
+                stack.push((f + 1, false));
+                continue;
+            }
+            let (a, b) = (plan.cost[f], plan.cost[f + 1]);
+            // Both children in `k` slots (at least one each).
+            let both = |k: usize| -> (f32, u8) {
+                (1..k)
+                    .map(|j| (a[j - 1] + b[k - j - 1], j as u8))
+                    .min_by(|x, y| x.0.total_cmp(&y.0))
+                    .unwrap_or((f32::INFINITY, 0))
+            };
+            let as_node = area * COST_NODE + both(4).0;
+            let as_leaf = if counts[i] as usize <= LEAF_SIZE {
+                area * COST_LEAF
+            } else {
+                f32::INFINITY
+            };
+            plan.leaf[i] = as_leaf <= as_node;
+            let mut cost = [as_leaf.min(as_node); 4];
+            let mut split = [0u8; 4];
+            for k in 2..=4 {
+                let (c, j) = both(k);
+                cost[k - 1] = cost[k - 2];
+                if c < cost[k - 1] {
+                    cost[k - 1] = c;
+                    split[k - 1] = j;
+                }
+            }
+            plan.cost[i] = cost;
+            plan.split[i] = split;
+        }
+        plan
+    }
+
+    fn is_leaf(&self, i: usize) -> bool {
+        self.leaf[i]
+    }
+
+    /// The slots of the four-wide node made of internal BVH2 node `i`.
+    fn children(&self, i: usize, nodes: &[obvhs::bvh2::node::Bvh2Node]) -> Vec<usize> {
+        let f = nodes[i].first_index as usize;
+        let (a, b) = (self.cost[f], self.cost[f + 1]);
+        let j = (1..4)
+            .min_by(|&x, &y| (a[x - 1] + b[3 - x]).total_cmp(&(a[y - 1] + b[3 - y])))
+            .unwrap_or(1);
+        let mut kids = Vec::with_capacity(4);
+        self.expand(f, j, nodes, &mut kids);
+        self.expand(f + 1, 4 - j, nodes, &mut kids);
+        kids
+    }
+
+    /// The subtrees filling the (at most) `k` slots of subtree `i`.
+    fn expand(
+        &self,
+        i: usize,
+        k: usize,
+        nodes: &[obvhs::bvh2::node::Bvh2Node],
+        out: &mut Vec<usize>,
+    ) {
+        let mut k = k;
+        while k > 1 && self.split[i][k - 1] == 0 {
+            k -= 1;
+        }
+        if k <= 1 {
+            out.push(i);
+            return;
+        }
+        let j = self.split[i][k - 1] as usize;
+        let f = nodes[i].first_index as usize;
+        self.expand(f, j, nodes, out);
+        self.expand(f + 1, k - j, nodes, out);
+    }
+}
+
 /// Primitive count of every BVH2 node's subtree (without recursion: trees
 /// can be deep).
 /// Per BVH2 node, the sum of `weights` of the primitives below it.
@@ -754,6 +860,79 @@ mod tests {
             bvh.closest_with(&ray, ray.t_max, |_, _| None, &mut stack);
             let mut stack = vec![0u32; bvh.stack_need];
             bvh.any_with(&ray, ray.t_max, |_| false, &mut stack);
+        }
+    }
+
+    /// A binary tree that pairs a room's opposite side walls (as obvhs
+    /// built it for the Cornell box): a leaf holding both would have the
+    /// whole room as its box, entered by every ray, and the greedy collapse
+    /// made that leaf (the pair has four triangles). The surface area
+    /// heuristic gives each wall a box of its own.
+    #[test]
+    fn leaves_do_not_span_the_room() {
+        use obvhs::bvh2::node::Bvh2Node;
+        let quad = |a: [f32; 3], b: [f32; 3], c: [f32; 3], d: [f32; 3]| {
+            let [a, b, c, d] = [a, b, c, d].map(Vec3::from);
+            [[a, b, c], [a, c, d]]
+        };
+        // Left and right walls, then the back wall and the floor.
+        let tris: Vec<[Vec3; 3]> = [
+            quad([-1., 0., -1.], [-1., 0., 1.], [-1., 2., 1.], [-1., 2., -1.]),
+            quad([1., 0., -1.], [1., 0., 1.], [1., 2., 1.], [1., 2., -1.]),
+            quad([-1., 0., -1.], [1., 0., -1.], [1., 2., -1.], [-1., 2., -1.]),
+            quad([-1., 0., -1.], [1., 0., -1.], [1., 0., 1.], [-1., 0., 1.]),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let tri_box = |i: usize| {
+            let mut a = Aabb::empty();
+            for p in tris[i] {
+                a.extend(p.into());
+            }
+            a
+        };
+        // Node 0 the root; 1 and 2 the wall pairs; 3-6 one wall each;
+        // 7-14 the triangles.
+        let inner = |kids: [usize; 2], first: u32, nodes: &[Bvh2Node]| Bvh2Node {
+            aabb: nodes[kids[0]].aabb.union(&nodes[kids[1]].aabb),
+            prim_count: 0,
+            first_index: first,
+            ..Bvh2Node::default()
+        };
+        let mut nodes = vec![Bvh2Node::default(); 15];
+        for t in 0..8 {
+            nodes[7 + t] = Bvh2Node {
+                aabb: tri_box(t),
+                prim_count: 1,
+                first_index: t as u32,
+                ..Bvh2Node::default()
+            };
+        }
+        for w in 0..4 {
+            nodes[3 + w] = inner([7 + 2 * w, 8 + 2 * w], 7 + 2 * w as u32, &nodes);
+        }
+        nodes[1] = inner([3, 4], 3, &nodes);
+        nodes[2] = inner([5, 6], 5, &nodes);
+        nodes[0] = inner([1, 2], 1, &nodes);
+        let bvh2 = Bvh2 {
+            nodes,
+            primitive_indices: (0..8).collect(),
+            ..Bvh2::default()
+        };
+        let (bvh, order) = Bvh4::from_bvh2(&bvh2, |i| Some(tris[i]));
+        assert_eq!(order.len(), 8);
+        for leaf in &bvh.leaves {
+            let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+            for &p in &order[leaf.first as usize..(leaf.first + leaf.count) as usize] {
+                for v in tris[p as usize] {
+                    (lo, hi) = (lo.min(v), hi.max(v));
+                }
+            }
+            assert!(
+                (hi - lo).min_element() == 0.0,
+                "a leaf holds more than one wall: {lo} .. {hi}"
+            );
         }
     }
 
