@@ -1314,7 +1314,10 @@ fn light_strategy(
     scratch: &mut Scratch,
 ) -> Vec3 {
     let light = &scene.lights[light_index as usize];
-    let Some(ls) = light.sample_li(&s.point, u_light, &scene.geometry) else {
+    // Read in place: moved out of the option, the sample was copied by
+    // wide loads that stalled on the narrower stores that had just made it.
+    let sample = light.sample_li(&s.point, u_light, &scene.geometry);
+    let Some(ls) = sample.as_ref() else {
         return Vec3::ZERO;
     };
     if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
