@@ -324,6 +324,38 @@ fn add_sample_footprint_and_table_lookup() {
     film.merge_tile(tile);
 }
 
+/// A box filter's table is one value, so splats skip the table offsets:
+/// every pixel of the footprint (here 3×2, in a tile whose pixels start
+/// away from the origin) gets weight 1 and the radiance, no other pixel
+/// anything.
+#[test]
+fn box_footprint_in_an_offset_tile() {
+    let fd = FilterDesc::Box {
+        radius: Vec2::new(1.5, 1.0),
+    };
+    let mut film = Film::new(&film_desc(16, 16, FULL), &fd);
+    assert!(film.filter_table().iter().all(|&w| w == 1.0));
+    let mut tile = film.tile(Bounds2i::new(IVec2::new(3, 4), IVec2::new(9, 10)));
+    let l = Vec3::new(1.0, 2.0, 4.0);
+    // pDiscrete = (4.8, 6.3): x in 4..7, y in 6..8.
+    tile.add_sample(Vec2::new(5.3, 6.8), l, 0.5);
+    let b = tile.pixel_bounds();
+    assert!(b.min.x > 0 && b.min.y > 0, "{b:?}");
+    for y in b.min.y..b.max.y {
+        for x in b.min.x..b.max.x {
+            let s = tile.pixel_sums(IVec2::new(x, y));
+            if (4..7).contains(&x) && (6..8).contains(&y) {
+                assert_eq!(s.weight, 1.0, "({x},{y})");
+                assert_eq!(s.contrib, [0.5, 1.0, 2.0], "({x},{y})");
+            } else {
+                assert_eq!(s.weight, 0.0, "({x},{y})");
+                assert_eq!(s.contrib, [0.0; 3], "({x},{y})");
+            }
+        }
+    }
+    film.merge_tile(tile);
+}
+
 #[test]
 fn max_sample_luminance_and_scale() {
     let mut d = film_desc(2, 2, FULL);

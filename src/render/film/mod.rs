@@ -290,6 +290,7 @@ impl TileMaker {
             radius: r,
             inv_radius: Vec2::ONE / r,
             filter_table: self.filter_table,
+            uniform_weight: uniform_weight(&self.filter_table),
             max_sample_luminance: self.max_sample_luminance,
             pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
         }
@@ -303,8 +304,21 @@ pub struct FilmTile {
     radius: Vec2,
     inv_radius: Vec2,
     filter_table: [f32; TABLE_SIZE],
+    /// The filter table's one value when all its entries are equal (the
+    /// box filter, pbrt-v3's default): every splat weight is then that
+    /// value, with no table offsets to compute.
+    uniform_weight: Option<f32>,
     max_sample_luminance: f32,
     pixels: Vec<PixelSums>,
+}
+
+/// The value of a filter table whose entries are all equal (bit for bit).
+fn uniform_weight(table: &[f32; TABLE_SIZE]) -> Option<f32> {
+    let w = table[0];
+    table
+        .iter()
+        .all(|v| v.to_bits() == w.to_bits())
+        .then_some(w)
 }
 
 /// Footprints up to this many pixels per axis use a stack cache of table
@@ -334,12 +348,27 @@ impl FilmTile {
         }
         let n_x = (p1.x - p0.x) as usize;
         let n_y = (p1.y - p0.y) as usize;
+        let lw = (l * sample_weight).as_dvec3();
+        let width = self.pixel_bounds.width() as usize;
+        if let Some(fw) = self.uniform_weight {
+            // The weights the table would give, without its offsets.
+            let fw = fw as f64;
+            for j in 0..n_y {
+                let row = (p0.y - self.pixel_bounds.min.y) as usize + j;
+                let base = row * width + (p0.x - self.pixel_bounds.min.x) as usize;
+                for px in &mut self.pixels[base..base + n_x] {
+                    px.contrib[0] += lw.x * fw;
+                    px.contrib[1] += lw.y * fw;
+                    px.contrib[2] += lw.z * fw;
+                    px.weight += fw;
+                }
+            }
+            return;
+        }
         let scale = FILTER_TABLE_WIDTH as f32;
         let offset = |d: f32, inv_r: f32| -> usize {
             (((d * inv_r * scale).abs()) as usize).min(FILTER_TABLE_WIDTH - 1)
         };
-        let lw = (l * sample_weight).as_dvec3();
-        let width = self.pixel_bounds.width() as usize;
         if n_x <= MAX_CACHED_FOOTPRINT && n_y <= MAX_CACHED_FOOTPRINT {
             let mut ifx = [0usize; MAX_CACHED_FOOTPRINT];
             let mut ify = [0usize; MAX_CACHED_FOOTPRINT];
