@@ -306,6 +306,40 @@ pub struct PermutationTables {
     pairs: Vec<u16>,
     dims: Vec<ScrambledDim>,
     lanes: BlockLanes,
+    late: OnceLock<LateTables>,
+    /// The generator as the first `EAGER_PRIMES` permutations left it.
+    late_rng: Pcg32,
+}
+
+/// Permutations generated up front: the bases of the dimensions the Halton
+/// blocks compute and more (a path of default depth reads about 70). The
+/// other 872 (3.6 million entries, 7 MiB, 16 ms of shuffling) come when a
+/// dimension past 127 is first read.
+const EAGER_PRIMES: usize = 128;
+
+/// The permutations of the bases past `EAGER_PRIMES` (offsets in `perms`).
+#[derive(Debug)]
+struct LateTables {
+    perms: Vec<u16>,
+    dims: Vec<ScrambledDim>,
+}
+
+/// Appends pbrt-v3's permutation of the digits of base `p` (its
+/// `Shuffle(p, count, 1, rng)` of the identity) to `perms`.
+fn push_permutation(p: u32, rng: &mut Pcg32, perms: &mut Vec<u16>) -> ScrambledDim {
+    let off = perms.len();
+    perms.extend(0..p as u16);
+    let slice = &mut perms[off..];
+    for i in 0..p as usize {
+        let other = i + rng.uniform_u32_below(p - i as u32) as usize;
+        slice.swap(i, other);
+    }
+    ScrambledDim {
+        b: DigitBase::new(p),
+        tail: scramble_tail(slice),
+        perm: off as u32,
+        pairs: NO_PAIRS,
+    }
 }
 
 /// Dimensions `2..BLOCK_DIM_END` (bases 5 ..= 503) can be computed
@@ -364,42 +398,26 @@ impl BlockLanes {
 
 impl PermutationTables {
     /// Tables generated from `rng` exactly as pbrt-v3 does (it passes a
-    /// default-constructed `RNG`).
+    /// default-constructed `RNG`): the first `EAGER_PRIMES` bases now, the
+    /// rest (99% of the entries, read only by dimensions past 127) on first
+    /// use, from the generator's state where the first ones left it.
     pub fn generate(rng: &mut Pcg32) -> Self {
-        let total: usize = PRIMES.iter().map(|&p| p as usize).sum();
-        let mut perms = vec![0u16; total];
+        let mut perms = Vec::new();
         let mut pairs = Vec::new();
-        let mut dims = Vec::with_capacity(PRIME_TABLE_SIZE);
-        let mut off = 0usize;
-        for &p in PRIMES.iter() {
-            let slice = &mut perms[off..off + p as usize];
-            for (j, v) in slice.iter_mut().enumerate() {
-                *v = j as u16;
-            }
-            // pbrt-v3's Shuffle(p, count, 1, rng).
-            for i in 0..p as usize {
-                let other = i + rng.uniform_u32_below(p - i as u32) as usize;
-                slice.swap(i, other);
-            }
-            let pair_off = if p <= PAIR_TABLE_MAX_BASE {
-                let start = pairs.len() as u32;
+        let mut dims = Vec::with_capacity(EAGER_PRIMES);
+        for &p in &PRIMES[..EAGER_PRIMES] {
+            let off = perms.len();
+            dims.push(push_permutation(p, rng, &mut perms));
+            let slice = &perms[off..];
+            if p <= PAIR_TABLE_MAX_BASE {
+                dims.last_mut().expect("just pushed").pairs = pairs.len() as u32;
                 for hi in 0..p as usize {
                     for lo in 0..p as usize {
                         pairs.push(slice[lo] * p as u16 + slice[hi]);
                     }
                 }
                 pairs.extend_from_slice(slice);
-                start
-            } else {
-                NO_PAIRS
-            };
-            dims.push(ScrambledDim {
-                b: DigitBase::new(p),
-                tail: scramble_tail(slice),
-                perm: off as u32,
-                pairs: pair_off,
-            });
-            off += p as usize;
+            }
         }
         // The AVX2 gather reads 32 bits at a 16-bit entry: one entry of
         // padding keeps the last read inside the table.
@@ -410,6 +428,34 @@ impl PermutationTables {
             pairs,
             dims,
             lanes,
+            late: OnceLock::new(),
+            late_rng: *rng,
+        }
+    }
+
+    /// The permutations of the bases past `EAGER_PRIMES`.
+    #[cold]
+    fn late(&self) -> &LateTables {
+        self.late.get_or_init(|| {
+            let mut rng = self.late_rng;
+            let mut perms = Vec::new();
+            let dims = PRIMES[EAGER_PRIMES..]
+                .iter()
+                .map(|&p| push_permutation(p, &mut rng, &mut perms))
+                .collect();
+            LateTables { perms, dims }
+        })
+    }
+
+    /// Base, permutation and tail of prime dimension `dim`, and the table
+    /// its permutation is in.
+    #[inline(always)]
+    fn dim(&self, dim: usize) -> (&ScrambledDim, &[u16]) {
+        if dim < EAGER_PRIMES {
+            (&self.dims[dim], &self.perms)
+        } else {
+            let late = self.late();
+            (&late.dims[dim - EAGER_PRIMES], &late.perms)
         }
     }
 
@@ -439,9 +485,9 @@ impl PermutationTables {
     /// (< PRIME_TABLE_SIZE): what `scrambled` is checked against.
     #[cfg(test)]
     pub fn dimension(&self, dim: usize) -> (&DigitBase, &[u16], f64) {
-        let d = &self.dims[dim];
+        let (d, perms) = self.dim(dim);
         let off = d.perm as usize;
-        (&d.b, &self.perms[off..off + d.b.base as usize], d.tail)
+        (&d.b, &perms[off..off + d.b.base as usize], d.tail)
     }
 
     /// The scrambled radical inverse of `a` in prime dimension `dim`
@@ -449,13 +495,13 @@ impl PermutationTables {
     /// dimension's tables, bit for bit.
     #[inline(always)]
     pub fn scrambled(&self, dim: usize, a: u64) -> f32 {
-        let d = &self.dims[dim];
+        let (d, perms) = self.dim(dim);
         if d.pairs != NO_PAIRS {
             let n = (d.b.base2 + d.b.base as u64) as usize;
             let table = &self.pairs[d.pairs as usize..d.pairs as usize + n];
             scrambled_radical_inverse_pairs(&d.b, table, d.tail, a)
         } else {
-            let perm = &self.perms[d.perm as usize..d.perm as usize + d.b.base as usize];
+            let perm = &perms[d.perm as usize..d.perm as usize + d.b.base as usize];
             scrambled_radical_inverse(&d.b, perm, d.tail, a)
         }
     }
@@ -827,5 +873,25 @@ mod tests {
         assert!(Arc::ptr_eq(&t, &PermutationTables::shared(0)));
         let t7 = PermutationTables::shared(7);
         assert_ne!(t7.dimension(5).1, t.dimension(5).1);
+    }
+
+    /// The permutations made on first use continue pbrt-v3's one stream of
+    /// shuffles: every dimension's is the one of shuffling all 1000 bases
+    /// in order from the default generator, and its tail follows from it.
+    #[test]
+    fn late_permutations_continue_the_stream() {
+        let t = PermutationTables::generate(&mut Pcg32::new());
+        let mut rng = Pcg32::new();
+        for (dim, &p) in PRIMES.iter().enumerate() {
+            let mut want: Vec<u16> = (0..p as u16).collect();
+            for i in 0..p as usize {
+                let other = i + rng.uniform_u32_below(p - i as u32) as usize;
+                want.swap(i, other);
+            }
+            let (b, got, tail) = t.dimension(dim);
+            assert_eq!(b.base, p);
+            assert_eq!(got, &want[..], "dimension {dim}");
+            assert_eq!(tail.to_bits(), scramble_tail(&want).to_bits());
+        }
     }
 }
