@@ -359,40 +359,48 @@ const PAIR_BLOCK_DIM_END: usize = 18;
 /// arrays (indexed by dimension, padded by `BLOCK_LANES` past
 /// `BLOCK_DIM_END` with harmless values), so that a block of consecutive
 /// dimensions loads each constant as one vector.
-#[derive(Debug, Default)]
+#[derive(Debug)]
+#[repr(C, align(64))]
 struct BlockLanes {
-    base: Vec<f64>,
-    base2: Vec<f64>,
-    inv_base: Vec<f64>,
-    inv_base2: Vec<f64>,
-    tail: Vec<f64>,
+    base: [f64; LANES_LEN],
+    base2: [f64; LANES_LEN],
+    inv_base: [f64; LANES_LEN],
+    inv_base2: [f64; LANES_LEN],
+    tail: [f64; LANES_LEN],
     /// Start of the dimension's pair table in `pairs`.
-    pairs: Vec<i32>,
+    pairs: [i32; LANES_LEN],
     /// Start of the dimension's permutation in `perms`.
-    perm: Vec<i32>,
+    perm: [i32; LANES_LEN],
 }
 
+/// Entries of each `BlockLanes` array.
+const LANES_LEN: usize = BLOCK_DIM_END + BLOCK_LANES;
+
 impl BlockLanes {
+    /// The constants in arrays of their own inside the tables (not
+    /// separate allocations: where the allocator put those, the loads of a
+    /// block's constants could stall, 12% of the block's time).
     fn new(dims: &[ScrambledDim]) -> Self {
-        let mut l = Self::default();
-        for d in 0..BLOCK_DIM_END + BLOCK_LANES {
-            // Dimensions 0 and 1 and the padding reuse dimension 2's
-            // constants; their lanes are computed and ignored.
+        // Dimensions 0 and 1 and the padding reuse dimension 2's
+        // constants; their lanes are computed and ignored.
+        let dim = |d: usize| {
             let s = &dims[if (2..BLOCK_DIM_END).contains(&d) {
                 d
             } else {
                 2
             }];
             debug_assert!(d >= PAIR_BLOCK_DIM_END || s.pairs != NO_PAIRS);
-            l.base.push(s.b.base as f64);
-            l.base2.push(s.b.base2 as f64);
-            l.inv_base.push(s.b.inv_base);
-            l.inv_base2.push(s.b.inv_base2);
-            l.tail.push(s.tail);
-            l.pairs.push(s.pairs as i32);
-            l.perm.push(s.perm as i32);
+            s
+        };
+        BlockLanes {
+            base: std::array::from_fn(|d| dim(d).b.base as f64),
+            base2: std::array::from_fn(|d| dim(d).b.base2 as f64),
+            inv_base: std::array::from_fn(|d| dim(d).b.inv_base),
+            inv_base2: std::array::from_fn(|d| dim(d).b.inv_base2),
+            tail: std::array::from_fn(|d| dim(d).tail),
+            pairs: std::array::from_fn(|d| dim(d).pairs as i32),
+            perm: std::array::from_fn(|d| dim(d).perm as i32),
         }
-        l
     }
 }
 
@@ -554,7 +562,7 @@ impl PermutationTables {
     ) {
         use std::arch::x86_64::*;
         let l = &self.lanes;
-        let ld = |v: &Vec<f64>, k: usize| _mm256_loadu_pd(v.as_ptr().add(first + k));
+        let ld = |v: &[f64; LANES_LEN], k: usize| _mm256_loadu_pd(v.as_ptr().add(first + k));
         let (b_lo, b_hi) = (ld(&l.base, 0), ld(&l.base, 4));
         let (b2_lo, b2_hi) = (ld(&l.base2, 0), ld(&l.base2, 4));
         let (ib_lo, ib_hi) = (ld(&l.inv_base, 0), ld(&l.inv_base, 4));
