@@ -16,7 +16,7 @@ pub use filter::Filter;
 
 use crate::render::geometry::Bounds2i;
 use crate::scene::{FilmDesc, FilterDesc};
-use glam::{IVec2, Vec2, Vec3};
+use glam::{DVec3, IVec2, Vec2, Vec3};
 
 /// Width of the precomputed filter table (pbrt-v3's `filterTableWidth`).
 pub const FILTER_TABLE_WIDTH: usize = 16;
@@ -64,12 +64,28 @@ pub struct PixelSums {
     pub weight: f64,
 }
 
+impl PixelSums {
+    /// Adds radiance `lw` (L times the sample weight) with filter weight
+    /// `fw`.
+    #[inline(always)]
+    fn add(&mut self, lw: DVec3, fw: f64) {
+        self.contrib[0] += lw.x * fw;
+        self.contrib[1] += lw.y * fw;
+        self.contrib[2] += lw.z * fw;
+        self.weight += fw;
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct Film {
     full_resolution: IVec2,
     pixel_bounds: Bounds2i,
     filter: Filter,
     filter_table: [f32; TABLE_SIZE],
+    /// The filter table's one value when all its entries are equal (the
+    /// box filter, pbrt-v3's default): every splat weight is then that
+    /// value, with no table offsets to compute.
+    uniform_weight: Option<f32>,
     scale: f32,
     max_sample_luminance: f32,
     pixels: Vec<PixelSums>,
@@ -112,6 +128,7 @@ impl Film {
             pixel_bounds,
             filter,
             filter_table,
+            uniform_weight: uniform_weight(&filter_table),
             scale: film.scale,
             max_sample_luminance,
             pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
@@ -173,6 +190,7 @@ impl Film {
             radius: self.filter.radius(),
             pixel_bounds: self.pixel_bounds,
             filter_table: self.filter_table,
+            uniform_weight: self.uniform_weight,
             max_sample_luminance: self.max_sample_luminance,
         }
     }
@@ -268,6 +286,7 @@ pub struct TileMaker {
     radius: Vec2,
     pixel_bounds: Bounds2i,
     filter_table: [f32; TABLE_SIZE],
+    uniform_weight: Option<f32>,
     max_sample_luminance: f32,
 }
 
@@ -290,7 +309,7 @@ impl TileMaker {
             radius: r,
             inv_radius: Vec2::ONE / r,
             filter_table: self.filter_table,
-            uniform_weight: uniform_weight(&self.filter_table),
+            uniform_weight: self.uniform_weight,
             max_sample_luminance: self.max_sample_luminance,
             pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
         }
@@ -304,9 +323,7 @@ pub struct FilmTile {
     radius: Vec2,
     inv_radius: Vec2,
     filter_table: [f32; TABLE_SIZE],
-    /// The filter table's one value when all its entries are equal (the
-    /// box filter, pbrt-v3's default): every splat weight is then that
-    /// value, with no table offsets to compute.
+    /// [`Film`]'s `uniform_weight`.
     uniform_weight: Option<f32>,
     max_sample_luminance: f32,
     pixels: Vec<PixelSums>,
@@ -357,10 +374,7 @@ impl FilmTile {
                 let row = (p0.y - self.pixel_bounds.min.y) as usize + j;
                 let base = row * width + (p0.x - self.pixel_bounds.min.x) as usize;
                 for px in &mut self.pixels[base..base + n_x] {
-                    px.contrib[0] += lw.x * fw;
-                    px.contrib[1] += lw.y * fw;
-                    px.contrib[2] += lw.z * fw;
-                    px.weight += fw;
+                    px.add(lw, fw);
                 }
             }
             return;
@@ -384,11 +398,7 @@ impl FilmTile {
                 let base = row * width + (p0.x - self.pixel_bounds.min.x) as usize;
                 let pixels = &mut self.pixels[base..base + n_x];
                 for (px, &ox) in pixels.iter_mut().zip(&ifx[..n_x]) {
-                    let fw = self.filter_table[oy + ox] as f64;
-                    px.contrib[0] += lw.x * fw;
-                    px.contrib[1] += lw.y * fw;
-                    px.contrib[2] += lw.z * fw;
-                    px.weight += fw;
+                    px.add(lw, self.filter_table[oy + ox] as f64);
                 }
             }
         } else {
@@ -396,14 +406,9 @@ impl FilmTile {
                 let oy = offset(y as f32 - p_discrete.y, self.inv_radius.y) * FILTER_TABLE_WIDTH;
                 for x in p0.x..p1.x {
                     let ox = offset(x as f32 - p_discrete.x, self.inv_radius.x);
-                    let fw = self.filter_table[oy + ox] as f64;
                     let i = (y - self.pixel_bounds.min.y) as usize * width
                         + (x - self.pixel_bounds.min.x) as usize;
-                    let px = &mut self.pixels[i];
-                    px.contrib[0] += lw.x * fw;
-                    px.contrib[1] += lw.y * fw;
-                    px.contrib[2] += lw.z * fw;
-                    px.weight += fw;
+                    self.pixels[i].add(lw, self.filter_table[oy + ox] as f64);
                 }
             }
         }

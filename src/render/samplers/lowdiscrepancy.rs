@@ -316,6 +316,8 @@ pub struct PermutationTables {
 /// other 872 (3.6 million entries, 7 MiB, 16 ms of shuffling) come when a
 /// dimension past 127 is first read.
 const EAGER_PRIMES: usize = 128;
+// The block constants and gathers read the eager tables only.
+const _: () = assert!(EAGER_PRIMES >= BLOCK_DIM_END);
 
 /// The permutations of the bases past `EAGER_PRIMES` (offsets in `perms`).
 #[derive(Debug)]
@@ -414,18 +416,18 @@ impl PermutationTables {
         let mut pairs = Vec::new();
         let mut dims = Vec::with_capacity(EAGER_PRIMES);
         for &p in &PRIMES[..EAGER_PRIMES] {
-            let off = perms.len();
-            dims.push(push_permutation(p, rng, &mut perms));
-            let slice = &perms[off..];
+            let mut d = push_permutation(p, rng, &mut perms);
             if p <= PAIR_TABLE_MAX_BASE {
-                dims.last_mut().expect("just pushed").pairs = pairs.len() as u32;
+                let perm = &perms[d.perm as usize..];
+                d.pairs = pairs.len() as u32;
                 for hi in 0..p as usize {
                     for lo in 0..p as usize {
-                        pairs.push(slice[lo] * p as u16 + slice[hi]);
+                        pairs.push(perm[lo] * p as u16 + perm[hi]);
                     }
                 }
-                pairs.extend_from_slice(slice);
+                pairs.extend_from_slice(perm);
             }
+            dims.push(d);
         }
         // The AVX2 gather reads 32 bits at a 16-bit entry: one entry of
         // padding keeps the last read inside the table.
