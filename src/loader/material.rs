@@ -19,6 +19,7 @@ use crate::scene::{
 use glam::Vec3;
 use std::collections::HashMap;
 use std::rc::Rc;
+use std::sync::Arc;
 
 /// A material as declared (built lazily when a shape uses it).
 #[derive(Debug)]
@@ -434,8 +435,31 @@ pub fn read_params_as(
                 }
                 None
             }
-            // Media's kinds: no material or texture declares them.
-            ParamKind::Spectrum(_) | ParamKind::Point3(_) | ParamKind::Floats => None,
+            ParamKind::Spectrum(def) => Some(ParamValue::Spectrum(
+                l.lists()
+                    .find_map(|list| find_spectrum(list, s.name))
+                    .and_then(|q| spectrum_value(ctx, q))
+                    .unwrap_or(Vec3::from_array(def)),
+            )),
+            ParamKind::Point3(def) => Some(ParamValue::Point(
+                l.plain(s.name, ParamType::Point3)
+                    .map(|q| {
+                        let v = q.nums();
+                        glam::DVec3::new(v[0], v[1], v[2])
+                    })
+                    .unwrap_or(Vec3::from_array(def).as_dvec3()),
+            )),
+            ParamKind::Floats => l
+                .lists()
+                .find_map(|list| {
+                    list.items
+                        .iter()
+                        .find(|q| q.name == s.name && q.ty == ParamType::Float)
+                })
+                .map(|q| {
+                    q.used.set(true);
+                    ParamValue::Floats(Arc::from(q.nums()))
+                }),
         };
         if let Some(v) = value {
             out.set(s.name, v);

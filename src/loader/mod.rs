@@ -16,6 +16,7 @@ pub mod color;
 pub mod entities;
 pub mod fourier;
 pub mod image;
+pub mod kinds;
 pub mod material;
 pub mod medium;
 pub mod meshfile;

@@ -105,7 +105,7 @@ pub fn texture(
         );
         return None;
     };
-    if let Some(why) = k.unsupported {
+    if let Some(why) = k.unsupported() {
         ctx.warn(
             class.loc,
             format!(
@@ -117,11 +117,29 @@ pub fn texture(
     }
     let what = format!("Texture \"{}\"", name.value);
     let defined = if is_float {
-        build::<f32>(ctx, name, class, k, k.float, params, textures, ctm, state)
-            .map(|tex| Defined::Float(entry(tex, name, k)))
+        build::<f32>(
+            ctx,
+            name,
+            class,
+            k,
+            k.build.float,
+            params,
+            textures,
+            ctm,
+            state,
+        )
+        .map(|tex| Defined::Float(entry(tex, name, k)))
     } else {
         build::<Vec3>(
-            ctx, name, class, k, k.spectrum, params, textures, ctm, state,
+            ctx,
+            name,
+            class,
+            k,
+            k.build.spectrum,
+            params,
+            textures,
+            ctm,
+            state,
         )
         .map(|tex| Defined::Spectrum(entry(tex, name, k)))
     };
@@ -168,7 +186,7 @@ fn build<T: TexValue>(
         textures,
     };
     let (values, _) = read_params_as(ctx, k.params, &l, T::IS_FLOAT);
-    let two_d = match k.mapping {
+    let two_d = match k.build.mapping {
         MappingUse::TwoD => true,
         MappingUse::ByDimension => values.int("dimension") == 2,
         MappingUse::None | MappingUse::ThreeD => false,

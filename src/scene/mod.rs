@@ -8,6 +8,7 @@
 
 mod fourier;
 pub mod image;
+pub mod kind;
 pub mod memory;
 pub mod motion;
 mod params;
@@ -15,6 +16,7 @@ mod textures;
 
 pub use fourier::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
 pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
+pub use kind::{Collected, Kind, Report, Support};
 pub use motion::AnimatedTransform;
 pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};

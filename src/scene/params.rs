@@ -310,6 +310,12 @@ pub enum ParamValue {
     Vector(Vec3),
     Material(MaterialId),
     Fourier(Arc<FourierTable>),
+    /// A plain spectrum as linear RGB (`ParamKind::Spectrum`).
+    Spectrum(Vec3),
+    /// A `point3`, in f64 as the scene's transforms.
+    Point(glam::DVec3),
+    /// A list of numbers, as written (`ParamKind::Floats`).
+    Floats(Arc<[f64]>),
 }
 
 /// The values of one entity's parameters, by name (absent: no value and no
@@ -388,6 +394,31 @@ impl ParamValues {
             None => None,
             Some(v) => panic!("parameter \"{name}\" is {v:?}, not a material"),
         }
+    }
+    pub fn spectrum(&self, name: &str) -> Vec3 {
+        match self.get(name) {
+            Some(ParamValue::Spectrum(v)) => *v,
+            v => panic!("parameter \"{name}\" is {v:?}, not a spectrum"),
+        }
+    }
+    pub fn point(&self, name: &str) -> glam::DVec3 {
+        match self.get(name) {
+            Some(ParamValue::Point(p)) => *p,
+            v => panic!("parameter \"{name}\" is {v:?}, not a point"),
+        }
+    }
+    /// A number list; empty when not given.
+    pub fn floats(&self, name: &str) -> Arc<[f64]> {
+        match self.get(name) {
+            Some(ParamValue::Floats(v)) => v.clone(),
+            None => Arc::from([]),
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a list of numbers"),
+        }
+    }
+    /// True when the statement gave the parameter (not just its default):
+    /// for kinds whose pbrt-v3 code treats "given" differently.
+    pub fn has(&self, name: &str) -> bool {
+        self.get(name).is_some()
     }
     pub fn fourier(&self, name: &str) -> Option<Arc<FourierTable>> {
         match self.get(name) {

@@ -95,6 +95,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "disney",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "Burley's Disney BSDF (pbrt-v3's): diffuse, retro, sheen, specular, clearcoat, transmission, thin surfaces",

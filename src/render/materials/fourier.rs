@@ -27,6 +27,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "fourier",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "a BSDF tabulated in a Fourier basis (`.bsdf` file)",

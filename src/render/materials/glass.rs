@@ -44,6 +44,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "glass",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "a dielectric interface, smooth or rough",

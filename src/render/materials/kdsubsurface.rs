@@ -46,6 +46,7 @@ pub const PARAMS: &[ParamSpec] = &[
 /// The entry of [`super::MATERIALS`].
 pub const KIND: MaterialKind = MaterialKind {
     name: "kdsubsurface",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "subsurface scattering given by diffuse albedo and mean free path",

@@ -19,6 +19,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "matte",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "diffuse reflection (Lambertian, or Oren–Nayar when sigma > 0)",

@@ -134,6 +134,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "metal",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "a rough conductor (default: copper)",

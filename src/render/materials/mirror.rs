@@ -17,6 +17,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "mirror",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "perfect specular reflection",

@@ -30,6 +30,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "mix",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "a blend of two named materials",

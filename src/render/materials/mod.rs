@@ -43,27 +43,16 @@ use crate::render::accel::SurfaceHit;
 use crate::render::bxdf::{roughness_to_alpha, MicrofacetDistribution, TrowbridgeReitz};
 use crate::render::geometry::Frame;
 use crate::render::shapes::DiffGeom;
-use crate::scene::{FloatTex, MaterialDesc, MaterialId, ParamSpec, ParamValues, SpectrumTex};
+use crate::scene::{FloatTex, MaterialDesc, MaterialId, ParamValues, SpectrumTex};
 use std::sync::Arc;
 
-/// Whether pbrs renders a material kind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Support {
-    Supported,
-    /// Known to pbrt-v3, not rendered by pbrs: the loader substitutes a
-    /// matte with the material's `Kd` and warns, giving the reason.
-    Unsupported(&'static str),
-}
+pub use crate::scene::Support;
+
+/// What a material kind builds from its parameters.
+pub type MaterialBuild = fn(&ParamValues) -> Material;
 
 /// One material kind: its pbrt-v3 name, its parameters, and its builder.
-pub struct MaterialKind {
-    pub name: &'static str,
-    pub support: Support,
-    pub params: &'static [ParamSpec],
-    /// What it is, for `grammar/REFERENCE.md`.
-    pub doc: &'static str,
-    pub build: fn(&ParamValues) -> Material,
-}
+pub type MaterialKind = crate::scene::Kind<MaterialBuild>;
 
 /// Every material type pbrt-v3 knows, in the order of pbrt-v3's
 /// `MakeMaterial`.
@@ -87,6 +76,7 @@ pub static MATERIALS: &[MaterialKind] = &[
 
 const NONE_KIND: MaterialKind = MaterialKind {
     name: "none",
+    aliases: &[""],
     support: Support::Supported,
     params: &[],
     doc: "no surface: rays pass through (it only delimits media)",
@@ -96,6 +86,7 @@ const NONE_KIND: MaterialKind = MaterialKind {
 const fn unsupported(name: &'static str, why: &'static str) -> MaterialKind {
     MaterialKind {
         name,
+        aliases: &[],
         support: Support::Unsupported(why),
         params: &[],
         doc: why,
@@ -105,8 +96,7 @@ const fn unsupported(name: &'static str, why: &'static str) -> MaterialKind {
 
 /// The table entry of a material type (`""` is `"none"`, as in pbrt-v3).
 pub fn kind(name: &str) -> Option<&'static MaterialKind> {
-    let name = if name.is_empty() { "none" } else { name };
-    MATERIALS.iter().find(|k| k.name == name)
+    crate::scene::kind::find(MATERIALS, name)
 }
 
 /// What materials and textures see of a hit: the point with its normals,

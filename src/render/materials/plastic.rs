@@ -32,6 +32,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "plastic",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "diffuse base under a glossy dielectric coat",

@@ -34,6 +34,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "substrate",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "Ashikhmin–Shirley diffuse base under a glossy layer",

@@ -70,6 +70,7 @@ pub const PARAMS: &[ParamSpec] = &[
 /// The entry of [`super::MATERIALS`].
 pub const KIND: MaterialKind = MaterialKind {
     name: "subsurface",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "a dielectric boundary over a scattering medium (tabulated BSSRDF)",

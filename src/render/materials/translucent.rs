@@ -45,6 +45,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "translucent",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "a thin sheet that reflects and transmits, diffusely and glossily",

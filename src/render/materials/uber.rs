@@ -61,6 +61,7 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const KIND: MaterialKind = MaterialKind {
     name: "uber",
+    aliases: &[],
     support: Support::Supported,
     params: PARAMS,
     doc: "opacity, diffuse, glossy, specular reflection and transmission",

@@ -17,7 +17,7 @@
 //! density, transmittance estimated by ratio tracking with pbrt-v3's
 //! Russian roulette below 0.1, each drawing from the sampler as pbrt-v3.
 
-use super::{MediumType, COMMON};
+use super::{MediumType, Support, COMMON};
 use crate::render::geometry::{gamma, Ray};
 use crate::render::samplers::Sampler;
 use crate::scene::ParamSpec;
@@ -25,6 +25,8 @@ use glam::{Mat4, Vec3};
 
 pub const KIND: MediumType = MediumType {
     name: "heterogeneous",
+    aliases: &[],
+    support: Support::Supported,
     params: &[
         COMMON[0],
         COMMON[1],
@@ -39,6 +41,7 @@ pub const KIND: MediumType = MediumType {
         ParamSpec::point3("p1", [1.0; 3], "the grid box's opposite corner"),
     ],
     doc: "a density grid scaling the coefficients, trilinearly interpolated (pbrt-v3's GridDensityMedium)",
+    build: (),
 };
 
 #[derive(Clone, Debug)]

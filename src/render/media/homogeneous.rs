@@ -14,15 +14,18 @@
 //! channel chosen uniformly, an exponential step in its σt, and the
 //! weight divided by the density averaged over the channels.
 
-use super::{MediumType, COMMON};
+use super::{MediumType, Support, COMMON};
 use crate::render::geometry::Ray;
 use crate::render::samplers::Sampler;
 use glam::Vec3;
 
 pub const KIND: MediumType = MediumType {
     name: "homogeneous",
+    aliases: &[],
+    support: Support::Supported,
     params: &[COMMON[0], COMMON[1], COMMON[2], COMMON[3], COMMON[4]],
     doc: "constant coefficients everywhere (pbrt-v3's HomogeneousMedium)",
+    build: (),
 };
 
 #[derive(Clone, Debug)]

@@ -25,12 +25,9 @@ use crate::scene::{MediumDesc, MediumKind, ParamSpec};
 use glam::Vec3;
 
 /// One medium type: its pbrt-v3 name, its parameters, what it is.
-pub struct MediumType {
-    pub name: &'static str,
-    pub params: &'static [ParamSpec],
-    /// For `grammar/REFERENCE.md`.
-    pub doc: &'static str,
-}
+pub type MediumType = crate::scene::Kind<()>;
+
+pub use crate::scene::Support;
 
 /// The parameters every medium type reads (pbrt-v3's `MakeMedium`).
 pub const COMMON: [ParamSpec; 5] = [
@@ -62,7 +59,7 @@ pub static MEDIA: &[MediumType] = &[homogeneous::KIND, grid::KIND];
 
 /// The table entry of a medium type.
 pub fn kind(name: &str) -> Option<&'static MediumType> {
-    MEDIA.iter().find(|k| k.name == name)
+    crate::scene::kind::find(MEDIA, name)
 }
 
 /// A medium ready to render.

@@ -9,7 +9,9 @@
 //! | `v11` | value of the texture's type | 1 | at (1, 1) |
 //! | mapping | see `mapping.rs` | uv | |
 
-use super::{Class, Mapping2D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{
+    Class, Mapping2D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
+};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 
@@ -22,12 +24,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "bilerp",
-    unsupported: None,
-    mapping: MappingUse::TwoD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "bilinear interpolation of v00, v01, v10, v11 over (s, t)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::TwoD,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 pub struct Bilerp<T> {

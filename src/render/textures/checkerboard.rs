@@ -9,7 +9,10 @@
 //! | `aamode` | string | `closedform` | 2D only: `closedform` (box-filtered over the differentials' footprint, pbrt-v3's closed form) or `none` (point sampled) |
 //! | mapping | see `mapping.rs` | uv | 2D; 3D uses the statement's transform |
 
-use super::{Class, Mapping2D, Mapping3D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{
+    Class, Mapping2D, Mapping3D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture,
+    TextureClass,
+};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 use glam::Vec2;
@@ -28,12 +31,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "checkerboard",
-    unsupported: None,
-    mapping: MappingUse::ByDimension,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "tex1 and tex2 alternating on unit squares (2D) or cubes (3D)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::ByDimension,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

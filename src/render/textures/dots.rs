@@ -13,7 +13,9 @@
 //! keeps pbrt-v3's images: the same swap.
 
 use super::noise::noise;
-use super::{Class, Mapping2D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{
+    Class, Mapping2D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
+};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 use glam::Vec2;
@@ -25,12 +27,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "dots",
-    unsupported: None,
-    mapping: MappingUse::TwoD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "polka dots placed by noise (pbrt-v3 shows \"outside\" in the dots)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::TwoD,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 pub struct Dots<T> {

@@ -7,7 +7,9 @@
 //! | `roughness` | float | 0.5 | amplitude factor per octave (ω) |
 
 use super::noise::fbm;
-use super::{Class, Mapping3D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{
+    Class, Mapping3D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
+};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 
@@ -18,12 +20,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "fbm",
-    unsupported: None,
-    mapping: MappingUse::ThreeD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "fractional Brownian motion (sum of noise octaves)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::ThreeD,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 pub struct Fbm {

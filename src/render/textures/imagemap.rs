@@ -21,7 +21,9 @@
 //! parameters: a warning, ignored.
 
 use super::mipmap::{MipMap, Wrap};
-use super::{Class, Mapping2D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{
+    Class, Mapping2D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
+};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, RgbImage, Tex};
 use glam::Vec3;
@@ -52,12 +54,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "imagemap",
-    unsupported: None,
-    mapping: MappingUse::TwoD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "an image file, MIP-mapped (EWA or trilinear filtering)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::TwoD,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<Vec3>),
+    },
 };
 
 /// Where image textures get their images (the loader: files read once,

@@ -14,7 +14,7 @@
 //! pbrt-v3 makes no float `marble` texture (the name stays undefined).
 
 use super::noise::fbm;
-use super::{Class, Mapping3D, MappingUse, TexBuilder, Texture, TextureClass};
+use super::{Class, Mapping3D, MappingUse, Support, TexBuild, TexBuilder, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 use glam::Vec3;
@@ -28,12 +28,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "marble",
-    unsupported: None,
-    mapping: MappingUse::ThreeD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "marble veins: a colour spline of sin(y + variation·FBm)",
-    float: None,
-    spectrum: Some(build),
+    build: TexBuild {
+        mapping: MappingUse::ThreeD,
+        float: None,
+        spectrum: Some(build),
+    },
 };
 
 /// pbrt-v3's marble colours (textures/marble.h).

@@ -8,7 +8,7 @@
 //!
 //! Value (1 − amount)·tex1 + amount·tex2; of constants, a constant.
 
-use super::{Class, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{Class, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
 use crate::scene::{FloatTex, ParamSpec, Tex};
 
@@ -20,12 +20,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "mix",
-    unsupported: None,
-    mapping: MappingUse::None,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "(1 − amount)·tex1 + amount·tex2",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::None,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 pub struct Mix<T> {

@@ -47,7 +47,7 @@ pub use windy::Windy;
 pub use wrinkled::Wrinkled;
 
 use crate::render::materials::ShadingContext;
-use crate::scene::{ParamSpec, ParamValues, Tex};
+use crate::scene::{ParamValues, Tex};
 use glam::Vec3;
 use std::collections::HashMap;
 use std::fmt::Debug;
@@ -337,20 +337,19 @@ impl TexBuilder<'_> {
 /// warning at the statement; pbrt-v3 then leaves the name undefined).
 pub type Build<T> = fn(&mut TexBuilder) -> Result<Tex<T>, String>;
 
-/// One texture class: its pbrt-v3 name, its parameters, and its builders
+/// How a texture class is built: the mapping it reads and its builders
 /// (`None`: pbrt-v3 has no texture of that type for the class).
-pub struct TextureClass {
-    pub name: &'static str,
-    /// `Some(why)`: known to pbrt-v3, not rendered by pbrs (the builders
-    /// then make the stand-in the reason names).
-    pub unsupported: Option<&'static str>,
+pub struct TexBuild {
     pub mapping: MappingUse,
-    pub params: &'static [ParamSpec],
-    /// What it is, for `grammar/REFERENCE.md`.
-    pub doc: &'static str,
     pub float: Option<Build<f32>>,
     pub spectrum: Option<Build<Vec3>>,
 }
+
+/// One texture class: its pbrt-v3 name, its parameters, and its builders.
+/// An unsupported class's builders make the stand-in its reason names.
+pub type TextureClass = crate::scene::Kind<TexBuild>;
+
+pub use crate::scene::Support;
 
 /// Every texture class pbrt-v3 knows, in the order of its
 /// `MakeFloatTexture`.
@@ -372,5 +371,5 @@ pub static TEXTURES: &[TextureClass] = &[
 
 /// The table entry of a texture class.
 pub fn class(name: &str) -> Option<&'static TextureClass> {
-    TEXTURES.iter().find(|c| c.name == name)
+    crate::scene::kind::find(TEXTURES, name)
 }

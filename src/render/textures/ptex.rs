@@ -7,7 +7,7 @@
 //! | `filename` | string | | the `.ptx` file (not read) |
 //! | `gamma` | float | 2.2 | (not used) |
 
-use super::{MappingUse, TexBuilder, TexValue, TextureClass};
+use super::{MappingUse, Support, TexBuild, TexBuilder, TexValue, TextureClass};
 use crate::scene::{ParamSpec, Tex};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -20,12 +20,15 @@ pub const WHY: &str = "there is no Ptex reader for Rust; a constant 0.5 is used 
 
 pub const CLASS: TextureClass = TextureClass {
     name: "ptex",
-    unsupported: Some(WHY),
-    mapping: MappingUse::None,
+    aliases: &[],
+    support: Support::Unsupported(WHY),
     params: PARAMS,
     doc: "Ptex per-face textures (not read: constant 0.5)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::None,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 fn build<T: TexValue>(_: &mut TexBuilder) -> Result<Tex<T>, String> {

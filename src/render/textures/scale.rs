@@ -9,7 +9,7 @@
 //! `ScaleTexture<Spectrum, Spectrum>`): a `"float tex2"` is not used. The
 //! product of two constants is a constant.
 
-use super::{Class, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{Class, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 
@@ -20,12 +20,15 @@ pub const PARAMS: &[ParamSpec] = &[
 
 pub const CLASS: TextureClass = TextureClass {
     name: "scale",
-    unsupported: None,
-    mapping: MappingUse::None,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "tex1 · tex2",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::None,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 pub struct Scale<T> {

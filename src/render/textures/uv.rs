@@ -7,7 +7,7 @@
 //!
 //! pbrt-v3 makes no float `uv` texture (the name stays undefined).
 
-use super::{Class, Mapping2D, MappingUse, TexBuilder, Texture, TextureClass};
+use super::{Class, Mapping2D, MappingUse, Support, TexBuild, TexBuilder, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 use glam::Vec3;
@@ -16,12 +16,15 @@ pub const PARAMS: &[ParamSpec] = &[];
 
 pub const CLASS: TextureClass = TextureClass {
     name: "uv",
-    unsupported: None,
-    mapping: MappingUse::TwoD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "(s − ⌊s⌋, t − ⌊t⌋, 0) as RGB",
-    float: None,
-    spectrum: Some(build),
+    build: TexBuild {
+        mapping: MappingUse::TwoD,
+        float: None,
+        spectrum: Some(build),
+    },
 };
 
 pub struct UvTexture {

@@ -4,7 +4,9 @@
 //! statement's transform (the 3D mapping).
 
 use super::noise::fbm;
-use super::{Class, Mapping3D, MappingUse, TexBuilder, TexValue, Texture, TextureClass};
+use super::{
+    Class, Mapping3D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
+};
 use crate::render::materials::ShadingContext;
 use crate::scene::{ParamSpec, Tex};
 
@@ -12,12 +14,15 @@ pub const PARAMS: &[ParamSpec] = &[];
 
 pub const CLASS: TextureClass = TextureClass {
     name: "windy",
-    unsupported: None,
-    mapping: MappingUse::ThreeD,
+    aliases: &[],
+    support: Support::Supported,
     params: PARAMS,
     doc: "wind-modulated waves (two FBm sums)",
-    float: Some(build::<f32>),
-    spectrum: Some(build::<glam::Vec3>),
+    build: TexBuild {
+        mapping: MappingUse::ThreeD,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
 };
 
 pub struct Windy {
