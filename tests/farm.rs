@@ -10,7 +10,8 @@ use pbrs::render::driver::{render, render_part, RenderOptions};
 use pbrs::render::film::io::write_image;
 use pbrs::render::film::part::{merge, read_part, tile_rect, Part, PartKind};
 use pbrs::render::film::Image;
-use pbrs::scene::{FilterDesc, SceneDescription};
+use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
+use pbrs::scene::SceneDescription;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -22,7 +23,7 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 /// The Cornell box at `w`×`h`, `spp` samples, with `filter`.
-fn scene(w: u32, h: u32, spp: u32, filter: FilterDesc) -> SceneDescription {
+fn scene(w: u32, h: u32, spp: u32, filter: Filter) -> SceneDescription {
     let mut d = common::load("scenes/cornell-box.pbrt");
     d.film.xresolution = w;
     d.film.yresolution = h;
@@ -36,41 +37,38 @@ fn scene(w: u32, h: u32, spp: u32, filter: FilterDesc) -> SceneDescription {
     d
 }
 
-fn filters() -> Vec<(&'static str, FilterDesc)> {
+fn filters() -> Vec<(&'static str, Filter)> {
     vec![
         (
             "box",
-            FilterDesc::Box {
+            Filter::Box(BoxFilter {
                 radius: Vec2::splat(0.5),
-            },
+            }),
         ),
         (
             "gaussian",
-            FilterDesc::Gaussian {
-                radius: Vec2::splat(2.0),
-                alpha: 2.0,
-            },
+            Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0)),
         ),
         (
             "triangle",
-            FilterDesc::Triangle {
+            Filter::Triangle(Triangle {
                 radius: Vec2::new(2.0, 1.5),
-            },
+            }),
         ),
         (
             "mitchell",
-            FilterDesc::Mitchell {
+            Filter::Mitchell(Mitchell {
                 radius: Vec2::splat(2.0),
                 b: 1.0 / 3.0,
                 c: 1.0 / 3.0,
-            },
+            }),
         ),
         (
             "sinc",
-            FilterDesc::LanczosSinc {
+            Filter::LanczosSinc(LanczosSinc {
                 radius: Vec2::splat(4.0),
                 tau: 3.0,
-            },
+            }),
         ),
     ]
 }

@@ -1,10 +1,11 @@
 //! Filters, film bounds, tiles and sample accumulation.
 
 use glam::{IVec2, Vec2, Vec3};
-use pbrs::render::film::{luminance, Film, Filter, FILTER_TABLE_WIDTH};
+use pbrs::render::film::{luminance, Film, FILTER_TABLE_WIDTH};
+use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
 use pbrs::render::geometry::Bounds2i;
 use pbrs::render::sampling::Pcg32;
-use pbrs::scene::{FilmDesc, FilterDesc};
+use pbrs::scene::FilmDesc;
 use rayon::prelude::*;
 
 fn film_desc(w: u32, h: u32, crop: [f32; 4]) -> FilmDesc {
@@ -21,30 +22,27 @@ fn film_desc(w: u32, h: u32, crop: [f32; 4]) -> FilmDesc {
 
 const FULL: [f32; 4] = [0.0, 1.0, 0.0, 1.0];
 
-fn all_filters() -> Vec<FilterDesc> {
+fn all_filters() -> Vec<Filter> {
     vec![
-        FilterDesc::Box {
+        Filter::Box(BoxFilter {
             radius: Vec2::splat(0.5),
-        },
-        FilterDesc::Box {
+        }),
+        Filter::Box(BoxFilter {
             radius: Vec2::new(1.0, 0.75),
-        },
-        FilterDesc::Gaussian {
+        }),
+        Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0)),
+        Filter::Triangle(Triangle {
             radius: Vec2::splat(2.0),
-            alpha: 2.0,
-        },
-        FilterDesc::Triangle {
-            radius: Vec2::splat(2.0),
-        },
-        FilterDesc::Mitchell {
+        }),
+        Filter::Mitchell(Mitchell {
             radius: Vec2::splat(2.0),
             b: 1.0 / 3.0,
             c: 1.0 / 3.0,
-        },
-        FilterDesc::LanczosSinc {
+        }),
+        Filter::LanczosSinc(LanczosSinc {
             radius: Vec2::splat(4.0),
             tau: 3.0,
-        },
+        }),
     ]
 }
 
@@ -67,23 +65,20 @@ fn integral(f: &Filter) -> f64 {
 
 #[test]
 fn filter_values_and_integrals() {
-    let b = Filter::new(&FilterDesc::Box {
+    let b = Filter::Box(BoxFilter {
         radius: Vec2::new(1.0, 0.5),
     });
     assert_eq!(b.evaluate(Vec2::new(0.9, -0.4)), 1.0);
     assert!((integral(&b) - 2.0).abs() < 1e-6);
 
-    let t = Filter::new(&FilterDesc::Triangle {
+    let t = Filter::Triangle(Triangle {
         radius: Vec2::splat(2.0),
     });
     assert_eq!(t.evaluate(Vec2::ZERO), 4.0);
     assert_eq!(t.evaluate(Vec2::new(2.0, 0.0)), 0.0);
     assert!((integral(&t) - 16.0).abs() < 1e-3); // (r²)²
 
-    let g = Filter::new(&FilterDesc::Gaussian {
-        radius: Vec2::splat(2.0),
-        alpha: 2.0,
-    });
+    let g = Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0));
     let e = (-8.0f32).exp();
     assert!((g.evaluate(Vec2::ZERO) - (1.0 - e) * (1.0 - e)).abs() < 1e-6);
     assert_eq!(g.evaluate(Vec2::new(2.0, 0.0)), 0.0);
@@ -97,7 +92,7 @@ fn filter_values_and_integrals() {
     // Mitchell–Netravali kernels integrate to 1 over [-2, 2] for any B, C;
     // pbrt scales the argument by 2/radius, so with radius 2 the integral is 1.
     for (bb, cc) in [(1.0 / 3.0, 1.0 / 3.0), (0.0, 0.5), (1.0, 0.0)] {
-        let m = Filter::new(&FilterDesc::Mitchell {
+        let m = Filter::Mitchell(Mitchell {
             radius: Vec2::splat(2.0),
             b: bb,
             c: cc,
@@ -110,7 +105,7 @@ fn filter_values_and_integrals() {
         assert!(m.evaluate(Vec2::new(2.0, 2.0)).abs() < 1e-6);
     }
 
-    let l = Filter::new(&FilterDesc::LanczosSinc {
+    let l = Filter::LanczosSinc(LanczosSinc {
         radius: Vec2::splat(4.0),
         tau: 3.0,
     });
@@ -122,11 +117,11 @@ fn filter_values_and_integrals() {
 
 #[test]
 fn filter_table_matches_pbrt_layout() {
-    let d = FilterDesc::Triangle {
+    let d = Filter::Triangle(Triangle {
         radius: Vec2::new(2.0, 1.0),
-    };
+    });
     let film = Film::new(&film_desc(8, 8, FULL), &d);
-    let f = Filter::new(&d);
+    let f = d;
     let t = film.filter_table();
     for y in 0..FILTER_TABLE_WIDTH {
         for x in 0..FILTER_TABLE_WIDTH {
@@ -141,9 +136,9 @@ type CropCase = ((u32, u32), [f32; 4], (IVec2, IVec2));
 
 #[test]
 fn crop_window_bounds_match_pbrt() {
-    let b = FilterDesc::Box {
+    let b = Filter::Box(BoxFilter {
         radius: Vec2::splat(0.5),
-    };
+    });
     let cases: [CropCase; 5] = [
         ((128, 128), FULL, (IVec2::ZERO, IVec2::new(128, 128))),
         (
@@ -184,13 +179,10 @@ fn crop_window_bounds_match_pbrt() {
 
 #[test]
 fn sample_bounds_and_tiles() {
-    let box_ = FilterDesc::Box {
+    let box_ = Filter::Box(BoxFilter {
         radius: Vec2::splat(0.5),
-    };
-    let gauss = FilterDesc::Gaussian {
-        radius: Vec2::splat(2.0),
-        alpha: 2.0,
-    };
+    });
+    let gauss = Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0));
     let film = Film::new(&film_desc(128, 128, FULL), &box_);
     assert_eq!(
         film.sample_bounds(),
@@ -277,9 +269,9 @@ fn constant_radiance_is_reproduced_by_every_filter() {
 fn box_filter_pixel_is_the_mean_of_its_samples() {
     let mut film = Film::new(
         &film_desc(4, 4, FULL),
-        &FilterDesc::Box {
+        &Filter::Box(BoxFilter {
             radius: Vec2::splat(0.5),
-        },
+        }),
     );
     let mut tile = film.tile(film.sample_bounds());
     tile.add_sample(Vec2::new(1.2, 2.7), Vec3::new(1.0, 2.0, 3.0), 1.0);
@@ -301,9 +293,9 @@ fn box_filter_pixel_is_the_mean_of_its_samples() {
 
 #[test]
 fn add_sample_footprint_and_table_lookup() {
-    let fd = FilterDesc::Triangle {
+    let fd = Filter::Triangle(Triangle {
         radius: Vec2::splat(2.0),
-    };
+    });
     let mut film = Film::new(&film_desc(16, 16, FULL), &fd);
     let mut tile = film.tile(film.sample_bounds());
     tile.add_sample(Vec2::new(5.5, 5.5), Vec3::ONE, 1.0);
@@ -330,9 +322,9 @@ fn add_sample_footprint_and_table_lookup() {
 /// anything.
 #[test]
 fn box_footprint_in_an_offset_tile() {
-    let fd = FilterDesc::Box {
+    let fd = Filter::Box(BoxFilter {
         radius: Vec2::new(1.5, 1.0),
-    };
+    });
     let mut film = Film::new(&film_desc(16, 16, FULL), &fd);
     assert!(film.filter_table().iter().all(|&w| w == 1.0));
     let mut tile = film.tile(Bounds2i::new(IVec2::new(3, 4), IVec2::new(9, 10)));
@@ -363,9 +355,9 @@ fn max_sample_luminance_and_scale() {
     d.scale = 2.0;
     let mut film = Film::new(
         &d,
-        &FilterDesc::Box {
+        &Filter::Box(BoxFilter {
             radius: Vec2::splat(0.5),
-        },
+        }),
     );
     let mut tile = film.tile(film.sample_bounds());
     let l = Vec3::new(10.0, 5.0, 1.0);
@@ -383,10 +375,7 @@ fn max_sample_luminance_and_scale() {
 
 #[test]
 fn merging_is_deterministic_across_thread_counts() {
-    let fd = FilterDesc::Gaussian {
-        radius: Vec2::splat(2.0),
-        alpha: 2.0,
-    };
+    let fd = Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0));
     let render = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

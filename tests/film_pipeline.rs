@@ -3,8 +3,9 @@
 
 use glam::{Vec2, Vec3};
 use pbrs::render::film::{Film, Image};
+use pbrs::render::filters::{BoxFilter, Filter, Gaussian};
 use pbrs::render::samplers::Sampler;
-use pbrs::scene::{FilmDesc, FilterDesc, SamplerDesc, SamplerKind};
+use pbrs::scene::{FilmDesc, SamplerDesc, SamplerKind};
 use rayon::prelude::*;
 
 fn film_desc(w: u32, h: u32) -> FilmDesc {
@@ -38,7 +39,7 @@ fn pixel_mean(x: i32, y: i32) -> Vec3 {
     )
 }
 
-fn render(kind: SamplerKind, spp: u32, filter: FilterDesc, threads: usize) -> Image {
+fn render(kind: SamplerKind, spp: u32, filter: Filter, threads: usize) -> Image {
     let mut film = Film::new(&film_desc(40, 30), &filter);
     let desc = SamplerDesc {
         kind,
@@ -90,9 +91,9 @@ fn errors(img: &Image) -> (f32, f64) {
 
 #[test]
 fn box_filtered_image_converges_to_pixel_means() {
-    let box_filter = FilterDesc::Box {
+    let box_filter = Filter::Box(BoxFilter {
         radius: Vec2::splat(0.5),
-    };
+    });
     let (h_max, h_rms) = errors(&render(SamplerKind::Halton, 64, box_filter, 2));
     let (r_max, r_rms) = errors(&render(SamplerKind::Random, 64, box_filter, 2));
     println!("64 spp: Halton max {h_max:.5} rms {h_rms:.6}; Random max {r_max:.5} rms {r_rms:.6}");
@@ -116,10 +117,7 @@ fn images_are_bit_identical_for_any_thread_count() {
             ysamples: 4,
         },
     ] {
-        let filter = FilterDesc::Gaussian {
-            radius: Vec2::splat(2.0),
-            alpha: 2.0,
-        };
+        let filter = Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0));
         let a = render(kind, 8, filter, 1);
         let b = render(kind, 8, filter, 2);
         let c = render(kind, 8, filter, 3);

@@ -257,3 +257,58 @@ fn reference_media_section_is_generated_from_the_table() {
         }
     }
 }
+
+/// Every family's generated section of REFERENCE.md is what the generator
+/// writes from its table (`PBRS_WRITE_REFERENCE=1` rewrites them), and
+/// lists every kind and parameter of the table.
+#[test]
+fn reference_family_sections_are_generated_from_the_tables() {
+    use pbrs::loader::reference::{markers, splice_between};
+    type Section = (
+        &'static str,
+        &'static str,
+        fn() -> String,
+        Vec<(&'static str, Vec<&'static str>)>,
+    );
+    fn rows<B>(t: &'static [pbrs::scene::Kind<B>]) -> Vec<(&'static str, Vec<&'static str>)> {
+        t.iter()
+            .map(|k| (k.name, k.params.iter().map(|p| p.name).collect()))
+            .collect()
+    }
+    let sections: Vec<Section> = vec![(
+        "render::filters::FILTERS",
+        "filters",
+        pbrs::loader::reference::filters_section,
+        rows(pbrs::render::filters::FILTERS),
+    )];
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
+    let write = std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1");
+    for (table, noun, make, kinds) in sections {
+        let doc = std::fs::read_to_string(&path).unwrap();
+        let (begin, end) = markers(table, noun);
+        let section = make();
+        let Some(expected) = splice_between(&doc, &section, &begin, &end) else {
+            panic!("REFERENCE.md lacks the lines {begin:?} and, after it, {end:?}");
+        };
+        if write {
+            if expected != doc {
+                std::fs::write(&path, &expected).unwrap();
+            }
+            continue;
+        }
+        assert!(
+            expected == doc,
+            "grammar/REFERENCE.md's {noun} section differs from {table}; regenerate it with \
+             `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` and commit the diff"
+        );
+        for (name, params) in kinds {
+            assert!(section.contains(&format!("`{name}`")), "{noun}: {name}");
+            for p in params {
+                assert!(
+                    section.contains(&format!("| `{p}` |")),
+                    "{noun} {name}: {p}"
+                );
+            }
+        }
+    }
+}

@@ -5,6 +5,7 @@ mod common;
 use common::{error_text as errors, load_text as load, warning_text as warnings};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
+use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
 use pbrs::scene::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -50,9 +51,9 @@ fn defaults_without_options() {
     assert_eq!(s.film.cropwindow, [0.0, 1.0, 0.0, 1.0]);
     assert_eq!(
         s.filter,
-        FilterDesc::Box {
+        Filter::Box(BoxFilter {
             radius: Vec2::splat(0.5)
-        }
+        })
     );
     assert_eq!(
         s.sampler,
@@ -90,31 +91,28 @@ fn filters_and_samplers_defaults() {
     };
     assert_eq!(
         f("gaussian"),
-        FilterDesc::Gaussian {
-            radius: Vec2::splat(2.0),
-            alpha: 2.0
-        }
+        Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0))
     );
     assert_eq!(
         f("triangle"),
-        FilterDesc::Triangle {
+        Filter::Triangle(Triangle {
             radius: Vec2::splat(2.0)
-        }
+        })
     );
     assert_eq!(
         f("mitchell"),
-        FilterDesc::Mitchell {
+        Filter::Mitchell(Mitchell {
             radius: Vec2::splat(2.0),
             b: 1.0 / 3.0,
             c: 1.0 / 3.0
-        }
+        })
     );
     assert_eq!(
         f("sinc"),
-        FilterDesc::LanczosSinc {
+        Filter::LanczosSinc(LanczosSinc {
             radius: Vec2::splat(4.0),
             tau: 3.0
-        }
+        })
     );
     let s = |t: &str| {
         load(&format!("Sampler {t}\nWorldBegin\nWorldEnd"))

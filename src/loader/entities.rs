@@ -3,6 +3,7 @@
 //! shapes. Every lookup marks its parameter used.
 
 use super::color::{blackbody_to_rgb, repeated_wavelength, sampled_to_rgb, xyz_to_rgb};
+use super::kinds::{self, Family, Unknown};
 use super::meshfile::{read_gltf, read_obj};
 use super::ply::{read_ply, PlyMesh};
 use super::spd;
@@ -10,6 +11,7 @@ use super::Ctx;
 use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
+use crate::render::filters::{Filter, FILTERS};
 use crate::scene::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::collections::HashMap;
@@ -1245,56 +1247,17 @@ pub fn film(ctx: &mut Ctx, f: Ent) -> FilmDesc {
     }
 }
 
-pub fn filter(ctx: &mut Ctx, f: Ent) -> FilterDesc {
-    let Some((name, p)) = f else {
-        return FilterDesc::Box {
-            radius: Vec2::splat(0.5),
-        };
+/// `PixelFilter`: the kind's builder from [`FILTERS`] (pbrt-v3's default
+/// when there is no statement: a box of radius 0.5).
+pub fn filter(ctx: &mut Ctx, f: Ent) -> Filter {
+    let family = Family {
+        directive: "PixelFilter",
+        noun: "filter",
+        table: FILTERS,
+        unknown: Unknown::Error,
     };
-    let def = match name.value.as_str() {
-        "box" => 0.5,
-        "gaussian" | "triangle" | "mitchell" => 2.0,
-        "sinc" => 4.0,
-        other => {
-            p.mark_all_used();
-            ctx.error(name.loc, format!("unknown filter \"{other}\" (pbrt-v3 has box, gaussian, mitchell, sinc, triangle; an unknown filter is fatal there)"), "unknown filter", None);
-            return FilterDesc::Box {
-                radius: Vec2::splat(0.5),
-            };
-        }
-    };
-    let mut radius = Vec2::new(
-        float(p, "xwidth", def) as f32,
-        float(p, "ywidth", def) as f32,
-    );
-    if !(radius.x > 0.0 && radius.y > 0.0 && radius.is_finite()) {
-        ctx.error(
-            name.loc,
-            format!("filter width {} {} must be positive", radius.x, radius.y),
-            "bad filter width",
-            None,
-        );
-        radius = Vec2::splat(def as f32);
-    }
-    let d = match name.value.as_str() {
-        "box" => FilterDesc::Box { radius },
-        "gaussian" => FilterDesc::Gaussian {
-            radius,
-            alpha: float(p, "alpha", 2.0) as f32,
-        },
-        "triangle" => FilterDesc::Triangle { radius },
-        "mitchell" => FilterDesc::Mitchell {
-            radius,
-            b: float(p, "B", 1.0 / 3.0) as f32,
-            c: float(p, "C", 1.0 / 3.0) as f32,
-        },
-        _ => FilterDesc::LanczosSinc {
-            radius,
-            tau: float(p, "tau", 3.0) as f32,
-        },
-    };
-    ctx.report_unused(p, &format!("PixelFilter \"{}\"", name.value));
-    d
+    f.and_then(|(name, p)| kinds::build(ctx, &family, name, p))
+        .unwrap_or_default()
 }
 
 pub fn sampler(ctx: &mut Ctx, s: Ent) -> SamplerDesc {

@@ -119,3 +119,28 @@ impl Report for StatementReport<'_> {
         self.ctx.error(loc, msg, label, None);
     }
 }
+
+/// The builder shape of the families whose kinds need nothing but their
+/// parameters (filters, samplers, integrators).
+pub type PlainBuild<T> = fn(&ParamValues, &mut dyn Report) -> T;
+
+/// Reads a statement of such a family and builds it; `None` for an unknown
+/// kind (already reported).
+pub fn build<T>(
+    ctx: &mut Ctx,
+    family: &Family<PlainBuild<T>>,
+    name: &Name,
+    p: &ParamList,
+) -> Option<T> {
+    let r = read(ctx, family, name, p)?;
+    let built = (r.kind.build)(
+        &r.params,
+        &mut StatementReport {
+            ctx,
+            at: name.loc,
+            params: p,
+        },
+    );
+    report_unused(ctx, family, &r, name, p);
+    Some(built)
+}

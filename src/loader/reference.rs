@@ -227,6 +227,63 @@ pub fn media_section() -> String {
     out
 }
 
+/// The markers around a family's generated section: `<!-- BEGIN generated
+/// from TABLE … -->` and `<!-- END generated NOUN -->`.
+pub fn markers(table: &str, noun: &str) -> (String, String) {
+    (
+        format!("<!-- BEGIN generated from {table}: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->"),
+        format!("<!-- END generated {noun} -->"),
+    )
+}
+
+/// A family's section from its table: each kind (with its aliases) and
+/// its parameters, then the kinds known to pbrt-v3 that pbrs does not
+/// render, with the reason.
+pub fn kinds_section<B>(
+    (begin, end): (&str, &str),
+    table: &'static [crate::scene::Kind<B>],
+) -> String {
+    let mut out = format!("{begin}\n");
+    for k in table.iter().filter(|k| k.is_supported()) {
+        let mut names = vec![format!("`{}`", k.name)];
+        names.extend(k.aliases.iter().map(|a| format!("`{a}`")));
+        let _ = write!(out, "\n### {}\n\n{}\n", names.join(" = "), sentence(k.doc));
+        if k.params.is_empty() {
+            out.push_str("\nNo parameters.\n");
+            continue;
+        }
+        out.push_str("\n| parameter | type | default | meaning |\n|---|---|---|---|\n");
+        for p in k.params {
+            let (ty, default) = describe(p);
+            let _ = writeln!(out, "| `{}` | {ty} | {default} | {} |", p.name, cell(p.doc));
+        }
+    }
+    let unsupported: Vec<_> = table.iter().filter(|k| !k.is_supported()).collect();
+    if !unsupported.is_empty() {
+        out.push_str("\n### Known to pbrt-v3, not rendered by pbrs\n\n| type | what pbrs does |\n|---|---|\n");
+        for k in unsupported {
+            let mut names = vec![format!("`{}`", k.name)];
+            names.extend(k.aliases.iter().map(|a| format!("`{a}`")));
+            let _ = writeln!(
+                out,
+                "| {} | {} |",
+                names.join(", "),
+                cell(k.unsupported().unwrap_or(""))
+            );
+        }
+    }
+    out.push('\n');
+    out.push_str(end);
+    out.push('\n');
+    out
+}
+
+/// The filter section, from [`FILTERS`](crate::render::filters::FILTERS).
+pub fn filters_section() -> String {
+    let (b, e) = markers("render::filters::FILTERS", "filters");
+    kinds_section((&b, &e), crate::render::filters::FILTERS)
+}
+
 /// `doc` with the part from the line `begin_marker` to the line
 /// `end_marker` (both included) replaced by `section`.
 pub fn splice_between(

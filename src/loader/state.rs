@@ -1020,7 +1020,7 @@ impl<'s, 'c> Builder<'s, 'c> {
     ) -> (
         CameraDesc,
         FilmDesc,
-        FilterDesc,
+        crate::render::filters::Filter,
         SamplerDesc,
         IntegratorDesc,
     ) {

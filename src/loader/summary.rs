@@ -97,21 +97,7 @@ impl Summary {
         if f.cropwindow != [0.0, 1.0, 0.0, 1.0] {
             s.film += &format!(", crop {:?}", f.cropwindow);
         }
-        s.filter = match scene.filter {
-            FilterDesc::Box { radius } => format!("box, radius {} {}", radius.x, radius.y),
-            FilterDesc::Gaussian { radius, alpha } => {
-                format!("gaussian, radius {} {}, alpha {alpha}", radius.x, radius.y)
-            }
-            FilterDesc::Triangle { radius } => {
-                format!("triangle, radius {} {}", radius.x, radius.y)
-            }
-            FilterDesc::Mitchell { radius, b, c } => {
-                format!("mitchell, radius {} {}, B {b}, C {c}", radius.x, radius.y)
-            }
-            FilterDesc::LanczosSinc { radius, tau } => {
-                format!("sinc, radius {} {}, tau {tau}", radius.x, radius.y)
-            }
-        };
+        s.filter = scene.filter.describe();
         let kind = match scene.sampler.kind {
             SamplerKind::Halton => "halton".to_string(),
             SamplerKind::Random => "random".into(),

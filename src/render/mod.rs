@@ -7,6 +7,7 @@ pub mod bxdf;
 pub mod camera;
 pub mod driver;
 pub mod film;
+pub mod filters;
 pub mod geometry;
 pub mod integrators;
 pub mod lights;

@@ -30,7 +30,7 @@ use std::sync::Arc;
 pub struct SceneDescription {
     pub camera: CameraDesc,
     pub film: FilmDesc,
-    pub filter: FilterDesc,
+    pub filter: crate::render::filters::Filter,
     pub sampler: SamplerDesc,
     pub integrator: IntegratorDesc,
     /// Materials referenced by shapes (by index). Only referenced ones are built.
@@ -190,30 +190,6 @@ pub struct FilmDesc {
     /// Physical film diagonal in millimetres (`diagonal`; the realistic
     /// camera's sensor size).
     pub diagonal: f32,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FilterDesc {
-    /// Radius per axis (pbrt's `xwidth`/`ywidth`, which are radii).
-    Box {
-        radius: Vec2,
-    },
-    Gaussian {
-        radius: Vec2,
-        alpha: f32,
-    },
-    Triangle {
-        radius: Vec2,
-    },
-    Mitchell {
-        radius: Vec2,
-        b: f32,
-        c: f32,
-    },
-    LanczosSinc {
-        radius: Vec2,
-        tau: f32,
-    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

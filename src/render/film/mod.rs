@@ -1,4 +1,4 @@
-//! The film: reconstruction filters, film tiles, the final image, image
+//! The film: film tiles, the final image, image
 //! files and image comparison metrics.
 //!
 //! Follows pbrt-v3's `Film`/`FilmTile` (core/film.{h,cpp}): a 16×16 table of
@@ -8,14 +8,13 @@
 //! on the number of threads.
 
 pub mod compare;
-pub mod filter;
 pub mod io;
 pub mod part;
 
-pub use filter::Filter;
+pub use crate::render::filters::Filter;
 
 use crate::render::geometry::Bounds2i;
-use crate::scene::{FilmDesc, FilterDesc};
+use crate::scene::FilmDesc;
 use glam::{DVec3, IVec2, Vec2, Vec3};
 
 /// Width of the precomputed filter table (pbrt-v3's `filterTableWidth`).
@@ -92,7 +91,7 @@ pub struct Film {
 }
 
 impl Film {
-    pub fn new(film: &FilmDesc, filter: &FilterDesc) -> Film {
+    pub fn new(film: &FilmDesc, filter: &Filter) -> Film {
         let res = IVec2::new(film.xresolution as i32, film.yresolution as i32);
         let [cx0, cx1, cy0, cy1] = film.cropwindow;
         // pbrt-v3 computes these in Float.
@@ -106,7 +105,7 @@ impl Film {
                 (res.y as f32 * cy1).ceil() as i32,
             ),
         );
-        let filter = Filter::new(filter);
+        let filter = *filter;
         let r = filter.radius();
         let mut filter_table = [0.0f32; TABLE_SIZE];
         for y in 0..FILTER_TABLE_WIDTH {

@@ -83,7 +83,7 @@ impl PartHeader {
                 ),
             ),
             ("seed", seed.to_string()),
-            ("filter", format!("{:?}", desc.filter)),
+            ("filter", desc.filter.describe()),
             ("scale", format!("{:08x}", desc.film.scale.to_bits())),
             // Last: the hash covers the settings above too, and the merge
             // names the first setting that differs.
