@@ -275,12 +275,20 @@ fn reference_family_sections_are_generated_from_the_tables() {
             .map(|k| (k.name, k.params.iter().map(|p| p.name).collect()))
             .collect()
     }
-    let sections: Vec<Section> = vec![(
-        "render::filters::FILTERS",
-        "filters",
-        pbrs::loader::reference::filters_section,
-        rows(pbrs::render::filters::FILTERS),
-    )];
+    let sections: Vec<Section> = vec![
+        (
+            "render::filters::FILTERS",
+            "filters",
+            pbrs::loader::reference::filters_section,
+            rows(pbrs::render::filters::FILTERS),
+        ),
+        (
+            "render::samplers::SAMPLERS",
+            "samplers",
+            pbrs::loader::reference::samplers_section,
+            rows(pbrs::render::samplers::SAMPLERS),
+        ),
+    ];
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let write = std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1");
     for (table, noun, make, kinds) in sections {

@@ -416,3 +416,116 @@ fn bench_samplers() {
         );
     }
 }
+
+/// Every kind of `render::samplers::SAMPLERS`, loaded from a statement:
+/// its settings, and its sampler's values in [0, 1) and the same for the
+/// same pixel and index. Unsupported kinds render with halton and say so.
+/// A kind of the table without a case here fails.
+#[test]
+fn every_sampler_kind_loads_and_samples() {
+    use pbrs::loader::load_scene_str;
+    use pbrs::render::samplers::SAMPLERS;
+    use std::path::Path;
+    let cases: &[(&str, &str, SamplerDesc)] = &[
+        (
+            "halton",
+            "\"integer pixelsamples\" 8 \"bool samplepixelcenter\" \"true\"",
+            SamplerDesc {
+                kind: SamplerKind::Halton,
+                pixel_samples: 8,
+                sample_pixel_center: true,
+            },
+        ),
+        ("random", "", desc(SamplerKind::Random, 4)),
+        (
+            "stratified",
+            "\"integer xsamples\" 3 \"integer ysamples\" 2 \"bool jitter\" \"false\"",
+            desc(
+                SamplerKind::Stratified {
+                    jitter: false,
+                    xsamples: 3,
+                    ysamples: 2,
+                },
+                6,
+            ),
+        ),
+        (
+            "sobol",
+            "\"integer pixelsamples\" 32",
+            desc(SamplerKind::Sobol, 32),
+        ),
+        ("02sequence", "", desc(SamplerKind::ZeroTwoSequence, 16)),
+        (
+            "lowdiscrepancy",
+            "\"integer dimensions\" 2",
+            desc(SamplerKind::ZeroTwoSequence, 16),
+        ),
+        (
+            "maxmindist",
+            "\"integer pixelsamples\" 4",
+            desc(SamplerKind::MaxMinDist, 4),
+        ),
+    ];
+    for k in SAMPLERS {
+        for name in std::iter::once(k.name).chain(k.aliases.iter().copied()) {
+            assert!(
+                cases.iter().any(|c| c.0 == name),
+                "sampler \"{name}\" has no test case"
+            );
+        }
+    }
+    for (name, params, want) in cases {
+        let text = format!("Sampler \"{name}\" {params}\nWorldBegin\nWorldEnd\n");
+        let loaded = load_scene_str(&text, Path::new("s.pbrt")).unwrap();
+        assert_eq!(loaded.scene.sampler, *want, "{text}");
+        let substituted = loaded
+            .warnings
+            .iter()
+            .any(|w| w.to_string().contains("rendered with the halton sampler"));
+        let kind = pbrs::scene::kind::find(SAMPLERS, name).unwrap();
+        assert_eq!(
+            substituted,
+            !kind.is_supported(),
+            "{name}: {:?}",
+            loaded.warnings
+        );
+        assert!(loaded.warnings.len() <= 1, "{name}: {:?}", loaded.warnings);
+        let mut s = Sampler::new(want, bounds(8, 8), 0);
+        let a = read_values(&mut s, IVec2::new(3, 5), 1, 40);
+        let b = read_values(&mut s, IVec2::new(3, 5), 1, 40);
+        assert_eq!(a, b, "{name}");
+        assert!(a.iter().all(|v| (0.0..1.0).contains(v)), "{name}: {a:?}");
+    }
+}
+
+#[test]
+fn bad_sampler_counts_are_located_errors() {
+    use pbrs::loader::load_scene_str;
+    use std::path::Path;
+    for (statement, what) in [
+        (
+            "Sampler \"halton\" \"integer pixelsamples\" 0",
+            "sample count \"pixelsamples\" is 0",
+        ),
+        (
+            "Sampler \"random\" \"integer pixelsamples\" 99999999",
+            "it must be between 1 and 16777216",
+        ),
+        (
+            "Sampler \"stratified\" \"integer xsamples\" 8192 \"integer ysamples\" 8192",
+            "xsamples × ysamples = 67108864 exceeds 16777216",
+        ),
+        ("Sampler \"haltom\"", "did you mean \"halton\"?"),
+    ] {
+        let text = format!("{statement}\nWorldBegin\nWorldEnd\n");
+        let Err(err) = load_scene_str(&text, Path::new("bad.pbrt")) else {
+            panic!("{statement}: loaded");
+        };
+        let msg = format!("{err:?}");
+        assert!(msg.contains(what), "{statement}: {msg}");
+        assert!(
+            msg.contains("bad.pbrt:1:"),
+            "{statement}: not located: {msg}"
+        );
+    }
+}

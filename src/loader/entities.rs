@@ -12,6 +12,7 @@ use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
 use crate::render::filters::{Filter, FILTERS};
+use crate::render::samplers::SAMPLERS;
 use crate::scene::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::collections::HashMap;
@@ -1260,104 +1261,21 @@ pub fn filter(ctx: &mut Ctx, f: Ent) -> Filter {
         .unwrap_or_default()
 }
 
+/// `Sampler`: the kind's builder from [`SAMPLERS`] (pbrt-v3's default
+/// when there is no statement: halton, 16 samples per pixel).
 pub fn sampler(ctx: &mut Ctx, s: Ent) -> SamplerDesc {
-    let Some((name, p)) = s else {
-        return SamplerDesc {
+    let family = Family {
+        directive: "Sampler",
+        noun: "sampler",
+        table: SAMPLERS,
+        unknown: Unknown::Error,
+    };
+    s.and_then(|(name, p)| kinds::build(ctx, &family, name, p))
+        .unwrap_or(SamplerDesc {
             kind: SamplerKind::Halton,
             pixel_samples: 16,
             sample_pixel_center: false,
-        };
-    };
-    let mut center = false;
-    let (kind, spp) = match name.value.as_str() {
-        "halton" => {
-            center = boolean(p, "samplepixelcenter", false);
-            (
-                SamplerKind::Halton,
-                checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
-            )
-        }
-        "random" => (
-            SamplerKind::Random,
-            checked_count(ctx, p, "pixelsamples", 4, MAX_SAMPLES, "sample count"),
-        ),
-        "sobol" => (
-            SamplerKind::Sobol,
-            checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
-        ),
-        "02sequence" | "lowdiscrepancy" => {
-            int(p, "dimensions", 4);
-            (
-                SamplerKind::ZeroTwoSequence,
-                checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
-            )
-        }
-        "maxmindist" => {
-            int(p, "dimensions", 4);
-            (
-                SamplerKind::MaxMinDist,
-                checked_count(ctx, p, "pixelsamples", 16, MAX_SAMPLES, "sample count"),
-            )
-        }
-        "stratified" => {
-            let jitter = boolean(p, "jitter", true);
-            let xs = checked_count(ctx, p, "xsamples", 4, MAX_SAMPLES, "sample count");
-            let ys = checked_count(ctx, p, "ysamples", 4, MAX_SAMPLES, "sample count");
-            int(p, "dimensions", 4);
-            let total = xs as u64 * ys as u64;
-            if total > MAX_SAMPLES as u64 {
-                ctx.error(
-                    name.loc,
-                    format!(
-                        "stratified sampler: xsamples × ysamples = {total} exceeds {MAX_SAMPLES}"
-                    ),
-                    "too many samples",
-                    None,
-                );
-                (
-                    SamplerKind::Stratified {
-                        jitter,
-                        xsamples: 4,
-                        ysamples: 4,
-                    },
-                    16,
-                )
-            } else {
-                (
-                    SamplerKind::Stratified {
-                        jitter,
-                        xsamples: xs,
-                        ysamples: ys,
-                    },
-                    total as u32,
-                )
-            }
-        }
-        other => {
-            p.mark_all_used();
-            ctx.error(name.loc, format!("unknown sampler \"{other}\" (pbrt-v3 has halton, sobol, random, stratified, 02sequence, lowdiscrepancy, maxmindist)"), "unknown sampler", None);
-            (SamplerKind::Halton, 16)
-        }
-    };
-    if matches!(
-        kind,
-        SamplerKind::Sobol | SamplerKind::ZeroTwoSequence | SamplerKind::MaxMinDist
-    ) {
-        ctx.warn(
-            name.loc,
-            format!(
-                "sampler \"{}\" is not implemented: rendered with the halton sampler (same expected image, different noise)",
-                name.value
-            ),
-            "rendered with halton",
-        );
-    }
-    ctx.report_unused(p, &format!("Sampler \"{}\"", name.value));
-    SamplerDesc {
-        kind,
-        pixel_samples: spp,
-        sample_pixel_center: center,
-    }
+        })
 }
 
 pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {

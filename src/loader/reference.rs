@@ -284,6 +284,12 @@ pub fn filters_section() -> String {
     kinds_section((&b, &e), crate::render::filters::FILTERS)
 }
 
+/// The sampler section, from [`SAMPLERS`](crate::render::samplers::SAMPLERS).
+pub fn samplers_section() -> String {
+    let (b, e) = markers("render::samplers::SAMPLERS", "samplers");
+    kinds_section((&b, &e), crate::render::samplers::SAMPLERS)
+}
+
 /// `doc` with the part from the line `begin_marker` to the line
 /// `end_marker` (both included) replaced by `section`.
 pub fn splice_between(

@@ -5,11 +5,34 @@ use super::lowdiscrepancy::{
     inverse_radical_inverse, multiplicative_inverse, radical_inverse_base2, radical_inverse_base3,
     DigitBase, PermutationTables, BLOCK_DIM_END, BLOCK_LANES, PRIME_TABLE_SIZE,
 };
-use super::ArrayStore;
+use super::{count, ArrayStore, SamplerKindEntry, PIXELSAMPLES_16};
 use crate::render::geometry::Bounds2i;
 use crate::render::sampling::rng::{hash_to_unit, mix64};
+use crate::scene::{ParamSpec, SamplerDesc, SamplerKind, Support};
 use glam::{IVec2, Vec2};
 use std::sync::Arc;
+
+pub const PARAMS: &[ParamSpec] = &[
+    PIXELSAMPLES_16,
+    ParamSpec::boolean(
+        "samplepixelcenter",
+        false,
+        "every sample at the pixel's centre (no antialiasing)",
+    ),
+];
+
+pub const KIND: SamplerKindEntry = SamplerKindEntry {
+    name: "halton",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "pbrt-v3's global Halton sequence with its random digit permutations (past pbrt-v3's 1000 dimensions, hashed values)",
+    build: |p, r| SamplerDesc {
+        kind: SamplerKind::Halton,
+        pixel_samples: count(p, "pixelsamples", 16, r),
+        sample_pixel_center: p.boolean("samplepixelcenter"),
+    },
+};
 
 /// Resolution at which the pixel-position dimensions repeat (pbrt-v3's kMaxResolution).
 const MAX_RESOLUTION: i32 = 128;

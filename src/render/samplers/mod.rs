@@ -19,8 +19,100 @@ pub use random::RandomSampler;
 pub use stratified::StratifiedSampler;
 
 use crate::render::geometry::Bounds2i;
-use crate::scene::{SamplerDesc, SamplerKind};
+use crate::scene::{Kind, ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind, Support};
 use glam::{IVec2, Vec2};
+
+/// What a sampler kind builds from its parameters: the sampler's settings
+/// (a typed struct, since the command line edits them: `--spp`, `--quick`).
+pub type SamplerBuild = fn(&ParamValues, &mut dyn Report) -> SamplerDesc;
+
+/// One sampler kind: its pbrt-v3 name, its parameters, its builder.
+pub type SamplerKindEntry = Kind<SamplerBuild>;
+
+/// Every sampler pbrt-v3's `MakeSampler` knows (an unknown one is an error).
+pub static SAMPLERS: &[SamplerKindEntry] = &[
+    halton::KIND,
+    random::KIND,
+    stratified::KIND,
+    SOBOL,
+    ZERO_TWO_SEQUENCE,
+    MAX_MIN_DIST,
+];
+
+/// The most samples per pixel pbrs takes (each sample index must fit the
+/// samplers' 32-bit arithmetic with room to spare).
+pub const MAX_SAMPLES: i64 = 1 << 24;
+
+/// A sample count parameter, checked to be in 1..=[`MAX_SAMPLES`]
+/// (an error otherwise, and the default).
+pub fn count(p: &ParamValues, name: &'static str, default: u32, report: &mut dyn Report) -> u32 {
+    let v = p.int(name) as i64;
+    if !(1..=MAX_SAMPLES).contains(&v) {
+        report.error(
+            Some(name),
+            format!("sample count \"{name}\" is {v}: it must be between 1 and {MAX_SAMPLES}"),
+            "out of range",
+        );
+        return default;
+    }
+    v as u32
+}
+
+const PIXELSAMPLES_16: ParamSpec = ParamSpec::int("pixelsamples", 16, "samples per pixel");
+const DIMENSIONS: ParamSpec = ParamSpec::int(
+    "dimensions",
+    4,
+    "dimensions sampled with the sampler's own pattern (read; pbrs's samplers use their pattern for every dimension)",
+);
+
+/// A pbrt-v3 sampler pbrs renders with `halton`, with a warning.
+fn substituted(kind: SamplerKind, p: &ParamValues, report: &mut dyn Report) -> SamplerDesc {
+    let name = match kind {
+        SamplerKind::Sobol => "sobol",
+        SamplerKind::ZeroTwoSequence => "02sequence",
+        _ => "maxmindist",
+    };
+    report.warn(
+        None,
+        format!("sampler \"{name}\" is not implemented: rendered with the halton sampler (same expected image, different noise)"),
+        "rendered with halton",
+    );
+    SamplerDesc {
+        kind,
+        pixel_samples: count(p, "pixelsamples", 16, report),
+        sample_pixel_center: false,
+    }
+}
+
+const SUBSTITUTED: &str =
+    "rendered with `halton` (same expected image, different noise), with a warning";
+
+const SOBOL: SamplerKindEntry = SamplerKindEntry {
+    name: "sobol",
+    aliases: &[],
+    support: Support::Unsupported(SUBSTITUTED),
+    params: &[PIXELSAMPLES_16],
+    doc: "pbrt-v3's SobolSampler",
+    build: |p, r| substituted(SamplerKind::Sobol, p, r),
+};
+
+const ZERO_TWO_SEQUENCE: SamplerKindEntry = SamplerKindEntry {
+    name: "02sequence",
+    aliases: &["lowdiscrepancy"],
+    support: Support::Unsupported(SUBSTITUTED),
+    params: &[PIXELSAMPLES_16, DIMENSIONS],
+    doc: "pbrt-v3's ZeroTwoSequenceSampler",
+    build: |p, r| substituted(SamplerKind::ZeroTwoSequence, p, r),
+};
+
+const MAX_MIN_DIST: SamplerKindEntry = SamplerKindEntry {
+    name: "maxmindist",
+    aliases: &[],
+    support: Support::Unsupported(SUBSTITUTED),
+    params: &[PIXELSAMPLES_16, DIMENSIONS],
+    doc: "pbrt-v3's MaxMinDistSampler",
+    build: |p, r| substituted(SamplerKind::MaxMinDist, p, r),
+};
 
 /// What a camera needs to generate a ray.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]

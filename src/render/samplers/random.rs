@@ -1,9 +1,25 @@
 //! Independent uniform values from PCG32, seeded per (pixel, sample, seed) so
 //! that they do not depend on which thread renders what.
 
-use super::ArrayStore;
+use super::{count, ArrayStore, SamplerKindEntry};
 use crate::render::sampling::rng::{hash_words, Pcg32};
+use crate::scene::{ParamSpec, SamplerDesc, SamplerKind, Support};
 use glam::{IVec2, Vec2};
+
+pub const PARAMS: &[ParamSpec] = &[ParamSpec::int("pixelsamples", 4, "samples per pixel")];
+
+pub const KIND: SamplerKindEntry = SamplerKindEntry {
+    name: "random",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "independent uniform values",
+    build: |p, r| SamplerDesc {
+        kind: SamplerKind::Random,
+        pixel_samples: count(p, "pixelsamples", 4, r),
+        sample_pixel_center: false,
+    },
+};
 
 #[derive(Clone, Debug)]
 pub struct RandomSampler {

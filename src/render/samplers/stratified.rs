@@ -5,9 +5,57 @@
 //! changes, from a stream seeded by (pixel, seed).
 
 use super::random::stream_rng;
-use super::ArrayStore;
+use super::{count, ArrayStore, SamplerKindEntry, DIMENSIONS, MAX_SAMPLES};
 use crate::render::sampling::rng::{Pcg32, ONE_MINUS_EPSILON};
+use crate::scene::{ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind, Support};
 use glam::{IVec2, Vec2};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::boolean("jitter", true, "jitter each sample within its stratum"),
+    ParamSpec::int(
+        "xsamples",
+        4,
+        "strata in x (samples per pixel: xsamples × ysamples)",
+    ),
+    ParamSpec::int("ysamples", 4, "strata in y"),
+    DIMENSIONS,
+];
+
+pub const KIND: SamplerKindEntry = SamplerKindEntry {
+    name: "stratified",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "pbrt-v3's StratifiedSampler: jittered strata per pixel, Latin hypercube arrays",
+    build,
+};
+
+/// Samples per pixel are xsamples × ysamples, at most [`MAX_SAMPLES`].
+fn build(p: &ParamValues, r: &mut dyn Report) -> SamplerDesc {
+    let jitter = p.boolean("jitter");
+    let xs = count(p, "xsamples", 4, r);
+    let ys = count(p, "ysamples", 4, r);
+    let total = xs as u64 * ys as u64;
+    let (xsamples, ysamples) = if total > MAX_SAMPLES as u64 {
+        r.error(
+            None,
+            format!("stratified sampler: xsamples × ysamples = {total} exceeds {MAX_SAMPLES}"),
+            "too many samples",
+        );
+        (4, 4)
+    } else {
+        (xs, ys)
+    };
+    SamplerDesc {
+        kind: SamplerKind::Stratified {
+            jitter,
+            xsamples,
+            ysamples,
+        },
+        pixel_samples: xsamples * ysamples,
+        sample_pixel_center: false,
+    }
+}
 
 /// pbrt-v3's default `dimensions` for the stratified sampler.
 const SAMPLED_DIMENSIONS: usize = 4;
