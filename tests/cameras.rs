@@ -14,7 +14,7 @@ use pbrs::render::camera::realistic::LensRay;
 use pbrs::render::camera::{Camera, Projection, RealisticCamera};
 use pbrs::render::geometry::Ray;
 use pbrs::render::samplers::CameraSample;
-use pbrs::scene::{CameraKind, SceneDescription};
+use pbrs::scene::SceneDescription;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -73,7 +73,7 @@ const ORTHO: &str = "LookAt 1 2 3  0 0 0  0 1 0\nCamera \"orthographic\" \"float
 #[test]
 fn orthographic_rays_are_parallel_and_start_on_the_screen_window() {
     let s = load(ORTHO);
-    assert!(matches!(s.camera.kind, CameraKind::Orthographic { .. }));
+    assert!(matches!(s.camera.projection, Projection::Orthographic(_)));
     let cam = camera_of(&s);
     assert!(!cam.uses_lens());
     let forward = (Vec3::ZERO - Vec3::new(1.0, 2.0, 3.0)).normalize();
@@ -239,7 +239,7 @@ fn paraxial_focal_lengths_match_the_lens_files() {
             &format!("\"string lensfile\" \"lenses/{file}\" \"float focusdistance\" 1e4"),
             FILM,
         ));
-        let CameraKind::Realistic(r) = &s.camera.kind else {
+        let Projection::Realistic(r) = &s.camera.projection else {
             panic!("{file}: not realistic")
         };
         let f = r.focal_length;
@@ -247,8 +247,8 @@ fn paraxial_focal_lengths_match_the_lens_files() {
         // Focused far away, the film sits about one focal length behind the
         // rear principal plane: the rear distance is positive and below f
         // plus the lens length.
-        let rear = r.interfaces.last().unwrap().thickness;
-        let length: f32 = r.interfaces.iter().map(|e| e.thickness).sum();
+        let rear = r.lens.interfaces.last().unwrap().thickness;
+        let length: f32 = r.lens.interfaces.iter().map(|e| e.thickness).sum();
         assert!(rear > 0.0 && rear < f + length, "{file}: rear {rear}");
     }
 }
@@ -479,11 +479,11 @@ fn bad_lens_files_are_located_errors() {
         "\"float aperturediameter\" 8 \"float focusdistance\" 5",
     )
     .unwrap_or_else(|f| panic!("{f:?}"));
-    let CameraKind::Realistic(r) = &ok.scene.camera.kind else {
+    let Projection::Realistic(r) = &ok.scene.camera.projection else {
         panic!()
     };
-    assert_eq!(r.interfaces.len(), 3);
-    assert!((r.interfaces[2].aperture_radius - 0.004).abs() < 1e-8);
+    assert_eq!(r.lens.interfaces.len(), 3);
+    assert!((r.lens.interfaces[2].aperture_radius - 0.004).abs() < 1e-8);
     assert!(
         (r.focal_length - 0.0508).abs() < 0.001,
         "{}",
@@ -543,10 +543,10 @@ fn lenses_that_block_every_ray_or_cannot_focus_are_errors() {
     // An aperture larger than the stop is clamped with a warning.
     let s = with_lens(SINGLET, "\"float aperturediameter\" 30").unwrap_or_else(|f| panic!("{f:?}"));
     assert!(warnings_of(&s).contains("clamped"), "{}", warnings_of(&s));
-    let CameraKind::Realistic(r) = &s.scene.camera.kind else {
+    let Projection::Realistic(r) = &s.scene.camera.projection else {
         panic!()
     };
-    assert!((r.interfaces[2].aperture_radius - 0.005).abs() < 1e-8);
+    assert!((r.lens.interfaces[2].aperture_radius - 0.005).abs() < 1e-8);
 }
 
 #[test]
@@ -587,4 +587,45 @@ fn bad_thin_lens_parameters() {
         w.contains("\"float fov\" not used") && !w.contains("lensradius"),
         "{w}"
     );
+}
+
+/// Every kind of `render::camera::CAMERAS`, loaded from a statement: the
+/// centre of the film looks where pbrt-v3's camera of that kind looks (the
+/// projective and realistic cameras along +z, the environment camera along
+/// −x), with a positive weight, and `--check` names the kind. A kind of the
+/// table without a case here fails.
+#[test]
+fn every_camera_kind_loads_and_looks_where_pbrt_v3s_does() {
+    use pbrs::render::camera::CAMERAS;
+    let cases: &[(&str, &str, Vec3)] = &[
+        ("perspective", "\"float fov\" 30", Vec3::Z),
+        ("orthographic", "", Vec3::Z),
+        ("environment", "", -Vec3::X),
+        (
+            "realistic",
+            "\"string lensfile\" \"lenses/dgauss.50mm.dat\" \"float aperturediameter\" 2 \"float focusdistance\" 3",
+            Vec3::Z,
+        ),
+    ];
+    for k in CAMERAS {
+        assert!(
+            cases.iter().any(|c| c.0 == k.name),
+            "camera \"{}\" has no test case",
+            k.name
+        );
+    }
+    for (name, params, forward) in cases {
+        let text =
+            format!("Camera \"{name}\" {params}\nFilm \"image\" {FILM}\nWorldBegin\nWorldEnd");
+        let s = load_lens_scene(&text);
+        assert!(s.camera.projection.describe().starts_with(name));
+        let cam = camera_of(&s);
+        let (ray, w) = cam.generate_ray(&sample(24.0, 16.0, 0.5, 0.5));
+        assert!(w > 0.0, "{name}: weight {w}");
+        assert!(
+            close(ray.d.normalize(), *forward, 0.05),
+            "{name}: the film's centre looks along {}",
+            ray.d
+        );
+    }
 }

@@ -5,6 +5,7 @@ mod common;
 use common::{error_text as errors, load_text as load, warning_text as warnings};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
+use pbrs::render::camera::Projection;
 use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
 use pbrs::scene::*;
 use std::path::{Path, PathBuf};
@@ -71,15 +72,10 @@ fn defaults_without_options() {
             light_sample_strategy: LightSampleStrategy::Spatial
         }
     );
-    let CameraKind::Perspective {
-        fov,
-        focal_distance,
-        ..
-    } = s.camera.kind
-    else {
+    let Projection::Perspective(c) = &s.camera.projection else {
         panic!("not perspective")
     };
-    assert_eq!((fov, focal_distance), (90.0, 1e6));
+    assert_eq!((c.fov, c.focal_distance()), (90.0, 1e6));
 }
 
 #[test]
@@ -218,19 +214,19 @@ fn camera_coordinate_system_and_world_reset() {
         panic!()
     };
     assert!(close(position, DVec3::new(0.0, 0.0, -5.0)));
-    let CameraKind::Perspective { fov, .. } = s.camera.kind else {
+    let Projection::Perspective(c) = &s.camera.projection else {
         panic!("not perspective")
     };
-    assert_eq!(fov, 45.0);
+    assert_eq!(c.fov, 45.0);
 }
 
 #[test]
 fn halffov_and_named_coordinate_systems() {
     let s = load("Camera \"perspective\" \"float halffov\" 30\nWorldBegin\nTranslate 1 2 3\nCoordinateSystem \"here\"\nIdentity\nCoordSysTransform \"here\"\nShape \"sphere\"\nCoordSysTransform \"nowhere\"\nWorldEnd");
-    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind else {
+    let Projection::Perspective(c) = &s.scene.camera.projection else {
         panic!("not perspective")
     };
-    assert_eq!(fov, 60.0);
+    assert_eq!(c.fov, 60.0);
     assert!(close(
         s.scene.shapes[0]
             .object_to_world
@@ -544,10 +540,10 @@ fn unsupported_shapes_and_directives_warn_and_load() {
 fn phase_rules() {
     let s = load("Shape \"sphere\"\nWorldBegin\nCamera \"perspective\" \"float fov\" 10\nShape \"sphere\"\nWorldEnd\nWorldBegin\nShape \"sphere\"\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 1);
-    let CameraKind::Perspective { fov, .. } = s.scene.camera.kind else {
+    let Projection::Perspective(c) = &s.scene.camera.projection else {
         panic!("not perspective")
     };
-    assert_eq!(fov, 90.0);
+    assert_eq!(c.fov, 90.0);
     let w = warnings(&s);
     assert!(
         w.contains("mem.pbrt:1:1: `Shape` before WorldBegin is ignored"),

@@ -1126,22 +1126,6 @@ pub fn camera(
     super::camera::camera(ctx, c, film)
 }
 
-pub fn default_camera() -> CameraDesc {
-    CameraDesc {
-        camera_to_world: DMat4::IDENTITY,
-        motion: None,
-        kind: CameraKind::Perspective {
-            fov: 90.0,
-            lens_radius: 0.0,
-            focal_distance: 1e6,
-            frame_aspect_ratio: None,
-            screen_window: None,
-        },
-        shutter_open: 0.0,
-        shutter_close: 1.0,
-    }
-}
-
 fn checked_count(ctx: &mut Ctx, p: &ParamList, name: &str, def: i64, max: i64, what: &str) -> u32 {
     let (v, loc) = int(p, name, def);
     if v < 1 || v > max {

@@ -144,3 +144,34 @@ pub fn build<T>(
     report_unused(ctx, family, &r, name, p);
     Some(built)
 }
+
+/// A [`Report`] that keeps messages in order, to be replayed into a
+/// statement's report once the context is free (a builder that also reads
+/// files through the context).
+#[derive(Default)]
+pub struct Buffered {
+    messages: Vec<(bool, Option<String>, String, String)>,
+}
+
+impl Report for Buffered {
+    fn warn(&mut self, at: Option<&str>, msg: String, label: &str) {
+        self.messages
+            .push((false, at.map(str::to_string), msg, label.to_string()));
+    }
+    fn error(&mut self, at: Option<&str>, msg: String, label: &str) {
+        self.messages
+            .push((true, at.map(str::to_string), msg, label.to_string()));
+    }
+}
+
+impl Buffered {
+    pub fn replay(self, to: &mut dyn Report) {
+        for (error, at, msg, label) in self.messages {
+            if error {
+                to.error(at.as_deref(), msg, &label);
+            } else {
+                to.warn(at.as_deref(), msg, &label);
+            }
+        }
+    }
+}

@@ -397,6 +397,9 @@ pub fn read_params_as(
                     .map(|q| check_range(ctx, s, q.nums()[0] as f32, q.values_loc))
                     .unwrap_or(def),
             )),
+            ParamKind::FloatOpt => l
+                .plain(s.name, ParamType::Float)
+                .map(|q| ParamValue::Float(check_range(ctx, s, q.nums()[0] as f32, q.values_loc))),
             ParamKind::Bool(def) => Some(ParamValue::Bool(
                 l.plain(s.name, ParamType::Bool)
                     .map(|q| q.bools()[0])

@@ -162,6 +162,7 @@ fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
             &["rgb", "color", "xyz", "blackbody", "spectrum", "texture"]
         }
         ParamKind::Float(_) => &["float"],
+        ParamKind::FloatOpt => &["float"],
         ParamKind::Bool(_) => &["bool"],
         ParamKind::String(_)
         | ParamKind::NamedMaterial
@@ -231,6 +232,7 @@ fn kind_name(kind: ParamKind) -> &'static str {
         ParamKind::FloatTexture(_) => "float texture",
         ParamKind::SpectrumTexture(_) => "spectrum texture",
         ParamKind::Float(_) => "float",
+        ParamKind::FloatOpt => "float",
         ParamKind::Bool(_) => "bool",
         ParamKind::String(_) => "string",
         ParamKind::NamedMaterial => "named-material",

@@ -115,6 +115,7 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
         ParamKind::FloatTexture(d) => ("float texture".to_string(), d.map(num)),
         ParamKind::SpectrumTexture(d) => ("spectrum texture".to_string(), d.map(spectrum)),
         ParamKind::Float(d) => ("float".to_string(), Some(num(d))),
+        ParamKind::FloatOpt => ("float".to_string(), None),
         ParamKind::Bool(d) => ("bool".to_string(), Some(format!("`{d}`"))),
         ParamKind::String(d) => ("string".to_string(), Some(format!("`\"{d}\"`"))),
         ParamKind::NamedMaterial => ("string: a named material".to_string(), None),
@@ -288,6 +289,12 @@ pub fn filters_section() -> String {
 pub fn samplers_section() -> String {
     let (b, e) = markers("render::samplers::SAMPLERS", "samplers");
     kinds_section((&b, &e), crate::render::samplers::SAMPLERS)
+}
+
+/// The camera section, from [`CAMERAS`](crate::render::camera::CAMERAS).
+pub fn cameras_section() -> String {
+    let (b, e) = markers("render::camera::CAMERAS", "cameras");
+    kinds_section((&b, &e), crate::render::camera::CAMERAS)
 }
 
 /// `doc` with the part from the line `begin_marker` to the line

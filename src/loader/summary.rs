@@ -62,31 +62,7 @@ impl Summary {
             warnings,
             ..Default::default()
         };
-        s.camera = match &scene.camera.kind {
-            CameraKind::Perspective {
-                fov, lens_radius, ..
-            } => {
-                if *lens_radius > 0.0 {
-                    format!("perspective, fov {fov}°, lens radius {lens_radius}")
-                } else {
-                    format!("perspective, fov {fov}°")
-                }
-            }
-            CameraKind::Orthographic { lens_radius, .. } => {
-                if *lens_radius > 0.0 {
-                    format!("orthographic, lens radius {lens_radius}")
-                } else {
-                    "orthographic".into()
-                }
-            }
-            CameraKind::Environment => "environment (latitude-longitude)".into(),
-            CameraKind::Realistic(r) => format!(
-                "realistic, lens \"{}\" ({} interfaces, focal length {:.1} mm)",
-                r.lens_file.display(),
-                r.interfaces.len(),
-                r.focal_length * 1000.0
-            ),
-        };
+        s.camera = scene.camera.projection.describe();
         let f = &scene.film;
         s.film = format!(
             "{}×{}, \"{}\"",

@@ -117,63 +117,24 @@ pub struct CameraDesc {
     /// Camera-to-world over the shutter when the `Camera` directive saw two
     /// different CTMs (`camera_to_world` is then its start transform).
     pub motion: Option<Arc<AnimatedTransform>>,
-    pub kind: CameraKind,
+    /// The camera kind with its settings, as its builder checked them; its
+    /// mapping is derived from the film when the scene is compiled.
+    pub projection: crate::render::camera::Projection,
     pub shutter_open: f32,
     pub shutter_close: f32,
 }
 
-#[derive(Clone, Debug)]
-pub enum CameraKind {
-    Perspective {
-        /// Full field of view in degrees, spanning the shorter image axis
-        /// (after `halffov` was folded in).
-        fov: f32,
-        lens_radius: f32,
-        focal_distance: f32,
-        /// `frameaspectratio`, if given.
-        frame_aspect_ratio: Option<f32>,
-        /// `screenwindow` as [xmin, xmax, ymin, ymax], if given.
-        screen_window: Option<[f32; 4]>,
-    },
-    Orthographic {
-        lens_radius: f32,
-        focal_distance: f32,
-        frame_aspect_ratio: Option<f32>,
-        screen_window: Option<[f32; 4]>,
-    },
-    /// Latitude-longitude over the whole sphere of directions.
-    Environment,
-    Realistic(RealisticDesc),
-}
-
-/// A lens system read from a lens file and already focused for the scene's
-/// `focusdistance` (pbrt-v3 focuses when the camera is created).
-#[derive(Clone, Debug)]
-pub struct RealisticDesc {
-    /// The lens file as resolved (for messages and `--check`).
-    pub lens_file: PathBuf,
-    /// Interfaces from the front (scene side) to the rear, in metres, with
-    /// the aperture stop set to `aperturediameter` and the last thickness
-    /// (rear element to film) set by focusing.
-    pub interfaces: Vec<LensInterface>,
-    pub simple_weighting: bool,
-    /// Effective focal length of the lens system (thick-lens approximation),
-    /// in metres.
-    pub focal_length: f32,
-}
-
-/// One row of a lens file in pbrt-v3's lens-system space (metres).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LensInterface {
-    /// Signed radius of the spherical interface; 0 for the aperture stop.
-    pub curvature_radius: f32,
-    /// Distance along the axis to the next interface (to the film for the
-    /// last one).
-    pub thickness: f32,
-    /// Index of refraction of the medium behind this interface (towards the
-    /// film); 0 (the stop) and 1 are air.
-    pub eta: f32,
-    pub aperture_radius: f32,
+impl Default for CameraDesc {
+    /// pbrt-v3's camera when the scene has no `Camera`.
+    fn default() -> CameraDesc {
+        CameraDesc {
+            camera_to_world: DMat4::IDENTITY,
+            motion: None,
+            projection: Default::default(),
+            shutter_open: 0.0,
+            shutter_close: 1.0,
+        }
+    }
 }
 
 #[derive(Clone, Debug)]

@@ -34,6 +34,8 @@ pub enum ParamKind {
     /// a `texture` name).
     SpectrumTexture(Option<SpectrumDefault>),
     Float(f32),
+    /// A float without a default: absent unless given (the entity decides).
+    FloatOpt,
     Bool(bool),
     /// A bool without a default: absent unless given (the entity decides).
     BoolOpt,
@@ -165,6 +167,14 @@ impl ParamSpec {
         ParamSpec {
             name,
             kind: ParamKind::Float(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn float_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FloatOpt,
             range: Range::Any,
             doc,
         }
@@ -355,6 +365,13 @@ impl ParamValues {
         match self.get(name) {
             Some(ParamValue::Float(f)) => *f,
             v => panic!("parameter \"{name}\" is {v:?}, not a float"),
+        }
+    }
+    pub fn float_opt(&self, name: &str) -> Option<f32> {
+        match self.get(name) {
+            Some(ParamValue::Float(f)) => Some(*f),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a float"),
         }
     }
     pub fn boolean(&self, name: &str) -> bool {

@@ -8,15 +8,41 @@
 //! differential method of its own: the base `Camera::GenerateRayDifferential`
 //! estimates them by finite differences over ±0.05 pixel, as here.
 //!
-//! | parameter | type | pbrt-v3 default |
-//! |---|---|---|
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
-//! | `lensradius`, `focaldistance`, `frameaspectratio`, `screenwindow` | float | read and ignored by pbrt-v3 (0, 1e30, xres/yres, —) |
+//! Parameters: [`PARAMS`] (shown in `grammar/REFERENCE.md`): the shutter;
+//! pbrt-v3 reads the projective cameras' lens and frame parameters too and
+//! ignores them (so they are never reported unused; a malformed
+//! `screenwindow` is still reported).
 
+use super::{screen_window_param, CameraKind, Frame, Projection, SHUTTER, THIN_LENS};
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
+use crate::scene::{ParamSpec, Support};
 use glam::{Affine3A, Vec2, Vec3};
 use std::f32::consts::PI;
+
+pub const PARAMS: &[ParamSpec] = &[
+    SHUTTER[0],
+    SHUTTER[1],
+    THIN_LENS[0],
+    THIN_LENS[1],
+    THIN_LENS[2],
+    THIN_LENS[3],
+];
+
+pub const KIND: CameraKind = CameraKind {
+    name: "environment",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "latitude-longitude: every direction around the camera (lensradius, focaldistance, frameaspectratio and screenwindow are read and ignored, as pbrt-v3)",
+    build: |p, _, r| {
+        screen_window_param(p, r);
+        Some(Projection::Environment(EnvironmentCamera::new(
+            Affine3A::IDENTITY,
+            Vec2::ONE,
+        )))
+    },
+};
 
 #[derive(Clone, Debug)]
 pub struct EnvironmentCamera {
@@ -30,6 +56,29 @@ impl EnvironmentCamera {
             camera_to_world,
             resolution,
         }
+    }
+
+    pub fn prepare(&mut self, f: &Frame) {
+        *self = EnvironmentCamera::new(f.to_world, f.resolution);
+    }
+
+    pub fn describe(&self) -> String {
+        "environment (latitude-longitude)".into()
+    }
+
+    pub fn uses_lens(&self) -> bool {
+        false
+    }
+
+    #[inline(always)]
+    pub fn ray(&self, cs: &CameraSample) -> (Ray, f32) {
+        (self.generate_ray(cs), 1.0)
+    }
+
+    #[inline]
+    pub fn ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
+        let (r, d) = self.generate_ray_differential(cs, scale);
+        (r, d, 1.0)
     }
 
     /// The camera-space direction of a raster position.

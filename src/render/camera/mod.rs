@@ -1,5 +1,11 @@
-//! Cameras: pbrt-v3's four, one file each, behind a closed enum that only
-//! delegates (one `match` per camera ray, no dynamic dispatch).
+//! Cameras: pbrt-v3's four, one file each, opening with its parameters,
+//! and one table, [`CAMERAS`], that the loader (parsing, "did you mean"),
+//! `--check`, `grammar/REFERENCE.md` and the tests read. [`Projection`] is
+//! the closed set; it only delegates (one `match` per camera ray, no
+//! dynamic dispatch). A kind's builder checks its parameters as pbrt-v3
+//! does and keeps them; [`Projection::prepare`] derives what depends on the
+//! film and the camera transform when the scene is compiled (after the
+//! command line has had its say on the film).
 //!
 //! [`Camera`] is the projection with the shutter: [`Camera::time`] is a
 //! sample's ray time (pbrt-v3's `Lerp(sample.time, shutterOpen,
@@ -32,9 +38,144 @@ pub use realistic::RealisticCamera;
 
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
-use crate::scene::{AnimatedTransform, CameraDesc, CameraKind, FilmDesc};
+use crate::scene::{AnimatedTransform, CameraDesc, FilmDesc, Kind, ParamSpec, ParamValues, Report};
 use glam::{Affine3A, DMat4, Vec2, Vec3};
+use std::path::PathBuf;
 use std::sync::Arc;
+
+/// Where a camera's builder reads the files its parameters name (the
+/// realistic camera's lens file): the loader, which resolves names as
+/// pbrt-v3 does and reads each file through its file loader.
+pub trait FileSource {
+    /// The resolved path of `name` (a value of parameter `param`) and the
+    /// file's bytes, or why it cannot be read.
+    fn read(&mut self, param: &str, name: &str) -> (PathBuf, Result<Vec<u8>, String>);
+}
+
+/// What a camera's builder gets besides its parameters.
+pub struct CameraInput<'a> {
+    pub film: &'a FilmDesc,
+    pub files: &'a mut dyn FileSource,
+}
+
+/// What a camera kind builds: its projection, unprepared, or `None` after
+/// an error it reported.
+pub type CameraBuild = fn(&ParamValues, &mut CameraInput, &mut dyn Report) -> Option<Projection>;
+
+/// One camera kind: its pbrt-v3 name, its parameters, its builder.
+pub type CameraKind = Kind<CameraBuild>;
+
+/// Every camera pbrt-v3's `MakeCamera` knows (an unknown one is an error).
+pub static CAMERAS: &[CameraKind] = &[
+    perspective::KIND,
+    orthographic::KIND,
+    realistic::KIND,
+    environment::KIND,
+];
+
+/// Every camera's shutter (read by the loader for all kinds).
+pub const SHUTTER: [ParamSpec; 2] = [
+    ParamSpec::float(
+        "shutteropen",
+        0.0,
+        "time the shutter opens (the ray time, see `Camera`)",
+    ),
+    ParamSpec::float("shutterclose", 1.0, "time the shutter closes"),
+];
+
+/// The projective cameras' lens and frame parameters.
+pub const THIN_LENS: [ParamSpec; 4] = [
+    ParamSpec::float(
+        "lensradius",
+        0.0,
+        "thin-lens radius (0: pinhole; negative: warning, pinhole)",
+    ),
+    ParamSpec::float(
+        "focaldistance",
+        1e6,
+        "distance to the plane in focus (> 0 with a lens)",
+    ),
+    ParamSpec::float_opt(
+        "frameaspectratio",
+        "x/y of the screen window (default: the film's; > 0)",
+    ),
+    ParamSpec::floats(
+        "screenwindow",
+        "xmin xmax ymin ymax of the screen window (default: the shorter axis spans [-1, 1])",
+    ),
+];
+
+/// `lensradius` and `focaldistance`. A negative radius is a pinhole (pbrt-v3
+/// tests `lensRadius > 0`), with a warning; a lens focused at a distance
+/// that is not positive is an error (its rays would run backwards or be
+/// NaN).
+fn thin_lens(p: &ParamValues, r: &mut dyn Report) -> (f32, f32) {
+    let default_focus = 1e6;
+    let mut lens_radius = p.float("lensradius");
+    let mut focal_distance = p.float("focaldistance");
+    if !lens_radius.is_finite() || lens_radius < 0.0 {
+        r.warn(
+            Some("lensradius"),
+            format!("\"lensradius\" {lens_radius} is not a radius ≥ 0: a pinhole camera is used"),
+            "bad lens radius",
+        );
+        lens_radius = 0.0;
+    }
+    if lens_radius > 0.0 && !(focal_distance > 0.0 && focal_distance.is_finite()) {
+        r.error(
+            Some("focaldistance"),
+            format!("\"focaldistance\" {focal_distance} must be > 0 for a lens (\"lensradius\" {lens_radius})"),
+            "bad focal distance",
+        );
+        focal_distance = default_focus;
+    }
+    (lens_radius, focal_distance)
+}
+
+/// `frameaspectratio`, if given and positive (else an error).
+fn frame_aspect_ratio(p: &ParamValues, r: &mut dyn Report) -> Option<f32> {
+    let v = p.float_opt("frameaspectratio")?;
+    if v > 0.0 && v.is_finite() {
+        Some(v)
+    } else {
+        r.error(
+            Some("frameaspectratio"),
+            format!("\"frameaspectratio\" {v} must be > 0"),
+            "bad aspect ratio",
+        );
+        None
+    }
+}
+
+/// `screenwindow`, if given as four finite numbers spanning an area (a
+/// wrong count is a warning and ignored; an empty window an error).
+fn screen_window_param(p: &ParamValues, r: &mut dyn Report) -> Option<[f32; 4]> {
+    let v = p.floats("screenwindow");
+    if v.is_empty() && !p.has("screenwindow") {
+        return None;
+    }
+    if v.len() != 4 {
+        r.warn(
+            Some("screenwindow"),
+            format!(
+                "\"screenwindow\" needs 4 values, found {}: ignored",
+                v.len()
+            ),
+            "expected 4 values",
+        );
+        return None;
+    }
+    let w = [v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32];
+    if w.iter().any(|x| !x.is_finite()) || w[0] == w[1] || w[2] == w[3] {
+        r.error(
+            Some("screenwindow"),
+            format!("\"screenwindow\" {w:?} is empty or not finite"),
+            "bad screen window",
+        );
+        return None;
+    }
+    Some(w)
+}
 
 /// A camera-space ray (origin `o`, direction `d`) in world space as pbrt-v3's
 /// `CameraToWorld(ray)` gives it: the origin transformed, then moved along
@@ -70,12 +211,69 @@ pub struct Camera {
     motion: Option<Arc<AnimatedTransform>>,
 }
 
-#[derive(Clone, Debug)]
-pub enum Projection {
+/// What a projection derives its mapping from when the scene is compiled.
+pub struct Frame {
+    /// Camera-to-world (the identity for a moving camera, whose rays are
+    /// moved by [`Camera`]).
+    pub to_world: Affine3A,
+    /// The full film resolution (the crop window does not change the mapping).
+    pub resolution: Vec2,
+    /// The Film's `diagonal` in millimetres (the realistic camera's sensor).
+    pub diagonal_mm: f32,
+    pub shutter: (f32, f32),
+}
+
+macro_rules! projections {
+    ($($variant:ident($ty:ty),)*) => {
+        /// A camera's projection; each variant is one file of this module.
+        #[derive(Clone, Debug)]
+        pub enum Projection {
+            $($variant($ty),)*
+        }
+        impl Projection {
+            /// Derives the mapping from the film and the transform.
+            pub fn prepare(&mut self, frame: &Frame) {
+                match self { $(Projection::$variant(c) => c.prepare(frame),)* }
+            }
+            /// True if the projection reads the sample's lens position.
+            #[inline]
+            pub fn uses_lens(&self) -> bool {
+                match self { $(Projection::$variant(c) => c.uses_lens(),)* }
+            }
+            /// The camera ray for a film position (raster coordinates) and
+            /// lens sample, and its weight.
+            #[inline(always)]
+            pub fn generate_ray(&self, cs: &CameraSample) -> (Ray, f32) {
+                match self { $(Projection::$variant(c) => c.ray(cs),)* }
+            }
+            /// `generate_ray` (the same ray and weight) with the
+            /// differentials of a one-pixel step in x and y scaled by
+            /// `scale` (pbrt-v3 renders with `ScaleDifferentials(1 / √spp)`).
+            #[inline]
+            pub fn generate_ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
+                match self { $(Projection::$variant(c) => c.ray_differential(cs, scale),)* }
+            }
+            /// Its kind and settings, for `--check` and `--stats`.
+            pub fn describe(&self) -> String {
+                match self { $(Projection::$variant(c) => c.describe(),)* }
+            }
+        }
+    };
+}
+
+projections! {
     Perspective(PerspectiveCamera),
     Orthographic(OrthographicCamera),
     Environment(EnvironmentCamera),
     Realistic(RealisticCamera),
+}
+
+impl Default for Projection {
+    /// pbrt-v3's camera when the scene names none: a perspective pinhole
+    /// with a 90° field of view.
+    fn default() -> Projection {
+        Projection::Perspective(PerspectiveCamera::with(90.0, 0.0, 1e6, None, None))
+    }
 }
 
 /// pbrt-v3's default screen window for a frame aspect ratio: the shorter
@@ -98,8 +296,15 @@ impl Camera {
             Some(_) => DMat4::IDENTITY,
             None => desc.camera_to_world,
         };
+        let mut projection = desc.projection.clone();
+        projection.prepare(&Frame {
+            to_world: Affine3A::from_mat4(to_world.as_mat4()),
+            resolution: Vec2::new(film.xresolution as f32, film.yresolution as f32),
+            diagonal_mm: film.diagonal,
+            shutter: (desc.shutter_open, desc.shutter_close),
+        });
         Camera {
-            projection: Projection::new(desc, film, to_world),
+            projection,
             shutter_open: desc.shutter_open,
             shutter_close: desc.shutter_close,
             motion,
@@ -182,100 +387,6 @@ fn move_ray(to_world: &Affine3A, r: &Ray) -> Ray {
     Ray {
         t_max: r.t_max,
         ..world_ray(to_world, r.o, r.d)
-    }
-}
-
-impl Projection {
-    fn new(desc: &CameraDesc, film: &FilmDesc, to_world: DMat4) -> Projection {
-        let resolution = Vec2::new(film.xresolution as f32, film.yresolution as f32);
-        let to_world = Affine3A::from_mat4(to_world.as_mat4());
-        match &desc.kind {
-            &CameraKind::Perspective {
-                fov,
-                lens_radius,
-                focal_distance,
-                frame_aspect_ratio,
-                screen_window: window,
-            } => Projection::Perspective(PerspectiveCamera::new(
-                to_world,
-                fov,
-                lens_radius,
-                focal_distance,
-                screen_window(window, frame_aspect_ratio, resolution),
-                resolution,
-            )),
-            &CameraKind::Orthographic {
-                lens_radius,
-                focal_distance,
-                frame_aspect_ratio,
-                screen_window: window,
-            } => Projection::Orthographic(OrthographicCamera::new(
-                to_world,
-                lens_radius,
-                focal_distance,
-                screen_window(window, frame_aspect_ratio, resolution),
-                resolution,
-            )),
-            CameraKind::Environment => {
-                Projection::Environment(EnvironmentCamera::new(to_world, resolution))
-            }
-            CameraKind::Realistic(r) => Projection::Realistic(RealisticCamera::new(
-                to_world,
-                r,
-                resolution,
-                film.diagonal,
-                (desc.shutter_open, desc.shutter_close),
-            )),
-        }
-    }
-
-    /// True if the projection reads the sample's lens position.
-    #[inline]
-    pub fn uses_lens(&self) -> bool {
-        match self {
-            Projection::Perspective(c) => c.uses_lens(),
-            Projection::Orthographic(c) => c.uses_lens(),
-            Projection::Environment(_) => false,
-            Projection::Realistic(_) => true,
-        }
-    }
-
-    /// The camera ray for a film position (raster coordinates) and lens
-    /// sample, and its weight.
-    #[inline(always)]
-    pub fn generate_ray(&self, cs: &CameraSample) -> (Ray, f32) {
-        match self {
-            Projection::Perspective(c) => (c.generate_ray(cs), 1.0),
-            Projection::Orthographic(c) => (c.generate_ray(cs), 1.0),
-            Projection::Environment(c) => (c.generate_ray(cs), 1.0),
-            // The weight depends on the shifted rays too (see realistic.rs).
-            Projection::Realistic(c) => {
-                let (ray, _, w) = c.generate_ray_differential(cs, 1.0);
-                (ray, w)
-            }
-        }
-    }
-
-    /// `generate_ray` (the same ray and weight) with the differentials of a
-    /// one-pixel step in x and y scaled by `scale` (pbrt-v3 renders with
-    /// `ScaleDifferentials(1 / √spp)`).
-    #[inline]
-    pub fn generate_ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
-        match self {
-            Projection::Perspective(c) => {
-                let (r, d) = c.generate_ray_differential(cs, scale);
-                (r, d, 1.0)
-            }
-            Projection::Orthographic(c) => {
-                let (r, d) = c.generate_ray_differential(cs, scale);
-                (r, d, 1.0)
-            }
-            Projection::Environment(c) => {
-                let (r, d) = c.generate_ray_differential(cs, scale);
-                (r, d, 1.0)
-            }
-            Projection::Realistic(c) => c.generate_ray_differential(cs, scale),
-        }
     }
 }
 

@@ -9,21 +9,50 @@
 //! lens, rays from the same lens point towards the focus point of the
 //! neighbouring pixel.
 //!
-//! | parameter | type | pbrt-v3 default |
-//! |---|---|---|
-//! | `lensradius` | float | 0 (no lens) |
-//! | `focaldistance` | float | 1e6 |
-//! | `frameaspectratio` | float | xresolution / yresolution |
-//! | `screenwindow` | float[4] (xmin xmax ymin ymax, camera-space units) | [-frame, frame] × [-1, 1] if frame > 1, else [-1, 1] × [-1/frame, 1/frame] |
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
+//! Parameters: [`PARAMS`] (shown in `grammar/REFERENCE.md`); the screen
+//! window is in camera-space units, by default as the perspective camera's.
 
+use super::{
+    frame_aspect_ratio, screen_window, screen_window_param, thin_lens, CameraKind, Frame,
+    Projection, SHUTTER, THIN_LENS,
+};
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
 use crate::render::sampling::concentric_sample_disk;
+use crate::scene::{ParamSpec, Support};
 use glam::{Affine3A, Vec2, Vec3};
+
+pub const PARAMS: &[ParamSpec] = &[
+    THIN_LENS[0],
+    THIN_LENS[1],
+    THIN_LENS[2],
+    THIN_LENS[3],
+    SHUTTER[0],
+    SHUTTER[1],
+];
+
+pub const KIND: CameraKind = CameraKind {
+    name: "orthographic",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "parallel rays along +z from the screen window, or a thin lens when lensradius > 0",
+    build: |p, _, r| {
+        let (lens_radius, focal_distance) = thin_lens(p, r);
+        Some(Projection::Orthographic(OrthographicCamera::with(
+            lens_radius,
+            focal_distance,
+            frame_aspect_ratio(p, r),
+            screen_window_param(p, r),
+        )))
+    },
+};
 
 #[derive(Clone, Debug)]
 pub struct OrthographicCamera {
+    /// `frameaspectratio` and `screenwindow` as given.
+    pub frame_aspect_ratio: Option<f32>,
+    pub screen_window: Option<[f32; 4]>,
     camera_to_world: Affine3A,
     /// Screen window [xmin, xmax, ymin, ymax].
     screen: [f32; 4],
@@ -36,6 +65,61 @@ pub struct OrthographicCamera {
 }
 
 impl OrthographicCamera {
+    /// The camera as its parameters give it; [`OrthographicCamera::prepare`]
+    /// derives the mapping.
+    pub fn with(
+        lens_radius: f32,
+        focal_distance: f32,
+        frame_aspect_ratio: Option<f32>,
+        screen_window: Option<[f32; 4]>,
+    ) -> OrthographicCamera {
+        OrthographicCamera {
+            frame_aspect_ratio,
+            screen_window,
+            ..OrthographicCamera::new(
+                Affine3A::IDENTITY,
+                lens_radius,
+                focal_distance,
+                [-1.0, 1.0, -1.0, 1.0],
+                Vec2::ONE,
+            )
+        }
+    }
+
+    pub fn prepare(&mut self, f: &Frame) {
+        let screen = screen_window(self.screen_window, self.frame_aspect_ratio, f.resolution);
+        *self = OrthographicCamera {
+            frame_aspect_ratio: self.frame_aspect_ratio,
+            screen_window: self.screen_window,
+            ..OrthographicCamera::new(
+                f.to_world,
+                self.lens_radius,
+                self.focal_distance,
+                screen,
+                f.resolution,
+            )
+        };
+    }
+
+    pub fn describe(&self) -> String {
+        if self.lens_radius > 0.0 {
+            format!("orthographic, lens radius {}", self.lens_radius)
+        } else {
+            "orthographic".into()
+        }
+    }
+
+    #[inline(always)]
+    pub fn ray(&self, cs: &CameraSample) -> (Ray, f32) {
+        (self.generate_ray(cs), 1.0)
+    }
+
+    #[inline]
+    pub fn ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
+        let (r, d) = self.generate_ray_differential(cs, scale);
+        (r, d, 1.0)
+    }
+
     pub fn new(
         camera_to_world: Affine3A,
         lens_radius: f32,
@@ -45,6 +129,8 @@ impl OrthographicCamera {
     ) -> OrthographicCamera {
         let [x0, x1, y0, y1] = screen;
         OrthographicCamera {
+            frame_aspect_ratio: None,
+            screen_window: None,
             camera_to_world,
             screen,
             resolution,

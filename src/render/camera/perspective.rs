@@ -4,24 +4,80 @@
 //! [x, x+1)×[y, y+1). Ray differentials as pbrt-v3's
 //! `PerspectiveCamera::GenerateRayDifferential`.
 //!
-//! | parameter | type | pbrt-v3 default |
-//! |---|---|---|
-//! | `fov` | float (degrees, the shorter image axis) | 90 |
-//! | `halffov` | float (degrees; overrides `fov` as 2·halffov when > 0) | -1 |
-//! | `lensradius` | float | 0 (pinhole) |
-//! | `focaldistance` | float | 1e6 |
-//! | `frameaspectratio` | float | xresolution / yresolution |
-//! | `screenwindow` | float[4] (xmin xmax ymin ymax) | [-frame, frame] × [-1, 1] if frame > 1, else [-1, 1] × [-1/frame, 1/frame] |
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
+//! Parameters: [`PARAMS`] (shown in `grammar/REFERENCE.md`); `fov` spans
+//! the shorter image axis, and the screen window defaults to
+//! [-frame, frame] × [-1, 1] if frame > 1, else [-1, 1] × [-1/frame, 1/frame].
 
-use super::world_ray;
+use super::{
+    frame_aspect_ratio, screen_window, screen_window_param, thin_lens, world_ray, CameraKind,
+    Frame, Projection, SHUTTER, THIN_LENS,
+};
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
 use crate::render::sampling::concentric_sample_disk;
+use crate::scene::{ParamSpec, ParamValues, Report, Support};
 use glam::{Affine3A, Vec2, Vec3};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float(
+        "fov",
+        90.0,
+        "field of view in degrees across the shorter image axis, in (0, 180)",
+    ),
+    ParamSpec::float(
+        "halffov",
+        -1.0,
+        "half the field of view (when > 0, fov = 2·halffov)",
+    ),
+    THIN_LENS[0],
+    THIN_LENS[1],
+    THIN_LENS[2],
+    THIN_LENS[3],
+    SHUTTER[0],
+    SHUTTER[1],
+];
+
+pub const KIND: CameraKind = CameraKind {
+    name: "perspective",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a pinhole, or a thin lens when lensradius > 0",
+    build: |p, _, r| Some(Projection::Perspective(build(p, r))),
+};
+
+fn build(p: &ParamValues, r: &mut dyn Report) -> PerspectiveCamera {
+    let mut fov = p.float("fov") as f64;
+    let half = p.float("halffov") as f64;
+    if half > 0.0 {
+        fov = 2.0 * half;
+    }
+    if !(fov > 0.0 && fov < 180.0) {
+        r.error(
+            Some("fov"),
+            format!("field of view {} is outside (0, 180) degrees", fov as f32),
+            "bad fov",
+        );
+        fov = 90.0;
+    }
+    let (lens_radius, focal_distance) = thin_lens(p, r);
+    PerspectiveCamera::with(
+        fov as f32,
+        lens_radius,
+        focal_distance,
+        frame_aspect_ratio(p, r),
+        screen_window_param(p, r),
+    )
+}
 
 #[derive(Clone, Debug)]
 pub struct PerspectiveCamera {
+    /// Full field of view in degrees, spanning the shorter image axis
+    /// (after `halffov` was folded in).
+    pub fov: f32,
+    /// `frameaspectratio` and `screenwindow` as given.
+    pub frame_aspect_ratio: Option<f32>,
+    pub screen_window: Option<[f32; 4]>,
     camera_to_world: Affine3A,
     /// Screen window [xmin, xmax, ymin, ymax].
     screen: [f32; 4],
@@ -33,6 +89,77 @@ pub struct PerspectiveCamera {
 }
 
 impl PerspectiveCamera {
+    /// The camera as its parameters give it; [`PerspectiveCamera::prepare`]
+    /// derives the mapping.
+    pub fn with(
+        fov: f32,
+        lens_radius: f32,
+        focal_distance: f32,
+        frame_aspect_ratio: Option<f32>,
+        screen_window: Option<[f32; 4]>,
+    ) -> PerspectiveCamera {
+        PerspectiveCamera {
+            fov,
+            frame_aspect_ratio,
+            screen_window,
+            ..PerspectiveCamera::new(
+                Affine3A::IDENTITY,
+                fov,
+                lens_radius,
+                focal_distance,
+                [-1.0, 1.0, -1.0, 1.0],
+                Vec2::ONE,
+            )
+        }
+    }
+
+    pub fn prepare(&mut self, f: &Frame) {
+        let screen = screen_window(self.screen_window, self.frame_aspect_ratio, f.resolution);
+        *self = PerspectiveCamera {
+            fov: self.fov,
+            frame_aspect_ratio: self.frame_aspect_ratio,
+            screen_window: self.screen_window,
+            ..PerspectiveCamera::new(
+                f.to_world,
+                self.fov,
+                self.lens_radius,
+                self.focal_distance,
+                screen,
+                f.resolution,
+            )
+        };
+    }
+
+    pub fn describe(&self) -> String {
+        if self.lens_radius > 0.0 {
+            format!(
+                "perspective, fov {}°, lens radius {}",
+                self.fov, self.lens_radius
+            )
+        } else {
+            format!("perspective, fov {}°", self.fov)
+        }
+    }
+
+    pub fn lens_radius(&self) -> f32 {
+        self.lens_radius
+    }
+
+    pub fn focal_distance(&self) -> f32 {
+        self.focal_distance
+    }
+
+    #[inline(always)]
+    pub fn ray(&self, cs: &CameraSample) -> (Ray, f32) {
+        (self.generate_ray(cs), 1.0)
+    }
+
+    #[inline]
+    pub fn ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
+        let (r, d) = self.generate_ray_differential(cs, scale);
+        (r, d, 1.0)
+    }
+
     pub fn new(
         camera_to_world: Affine3A,
         fov: f32,
@@ -42,6 +169,9 @@ impl PerspectiveCamera {
         resolution: Vec2,
     ) -> PerspectiveCamera {
         PerspectiveCamera {
+            fov,
+            frame_aspect_ratio: None,
+            screen_window: None,
             camera_to_world,
             screen,
             resolution,

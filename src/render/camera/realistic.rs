@@ -20,26 +20,165 @@
 //! pbrt-v3 also runs a binary search on the traced focus but only logs its
 //! result; pbrs does not run it.
 //!
-//! | parameter | type | pbrt-v3 default |
-//! |---|---|---|
-//! | `lensfile` | string (relative to the scene file) | none: an error |
-//! | `aperturediameter` | float (mm; clamped to the stop's diameter in the file) | 1 |
-//! | `focusdistance` | float (scene units, from the film) | 10 |
-//! | `simpleweighting` | bool | true |
-//! | `shutteropen`, `shutterclose` | float | 0, 1 (the ray time, see `Camera`) |
+//! Parameters: [`PARAMS`] (shown in `grammar/REFERENCE.md`).
 //!
 //! Lens file: rows of curvature radius (0 for the aperture stop), thickness
 //! to the next interface, index of refraction behind the interface (0 or 1
 //! for air) and aperture diameter, all lengths in millimetres, from the
 //! scene side to the film side; `#` starts a comment.
 
-use super::finite_differences;
+use super::{finite_differences, CameraInput, CameraKind, Frame, Projection, SHUTTER};
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::lowdiscrepancy::{radical_inverse, radical_inverse_base2, DigitBase};
 use crate::render::samplers::CameraSample;
-use crate::scene::{LensInterface, RealisticDesc};
+use crate::scene::{ParamSpec, ParamValues, Report, Support};
 use glam::{Affine3A, Vec2, Vec3};
 use rayon::prelude::*;
+use std::path::PathBuf;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::filename(
+        "lensfile",
+        "the lens description (required; relative to the top-level scene file)",
+    ),
+    ParamSpec::float(
+        "aperturediameter",
+        1.0,
+        "aperture stop diameter in mm (clamped to the stop's diameter in the file)",
+    ),
+    ParamSpec::float(
+        "focusdistance",
+        10.0,
+        "distance from the film in focus, scene units",
+    ),
+    ParamSpec::boolean(
+        "simpleweighting",
+        true,
+        "cos⁴ weighting over the centre's pupil area (false: the physical weight)",
+    ),
+    SHUTTER[0],
+    SHUTTER[1],
+];
+
+pub const KIND: CameraKind = CameraKind {
+    name: "realistic",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "rays traced through the spherical lens interfaces and aperture stop of a lens file, focused by the thick-lens approximation",
+    build: |p, input, r| build(p, input, r).map(Projection::Realistic),
+};
+
+/// More rows than any real lens system has; bounds the per-ray tracing cost.
+pub const MAX_LENS_INTERFACES: usize = 256;
+
+/// One row of a lens file in pbrt-v3's lens-system space (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LensInterface {
+    /// Signed radius of the spherical interface; 0 for the aperture stop.
+    pub curvature_radius: f32,
+    /// Distance along the axis to the next interface (to the film for the
+    /// last one).
+    pub thickness: f32,
+    /// Index of refraction of the medium behind this interface (towards the
+    /// film); 0 (the stop) and 1 are air.
+    pub eta: f32,
+    pub aperture_radius: f32,
+}
+
+/// The lens system of the `lensfile`, focused at `focusdistance` for the
+/// Film's `diagonal` (pbrt-v3 focuses when the camera is created), with
+/// pbrt-v3's checks as located errors.
+fn build(p: &ParamValues, input: &mut CameraInput, r: &mut dyn Report) -> Option<RealisticCamera> {
+    let aperture = p.float("aperturediameter");
+    let focus = p.float("focusdistance");
+    let simple_weighting = p.boolean("simpleweighting");
+    let file = p.string("lensfile");
+    if file.is_empty() {
+        r.error(
+            None,
+            "the realistic camera needs a \"string lensfile\" parameter (pbrt-v3: \"No lens description file supplied!\")".into(),
+            "no lens file",
+        );
+        return None;
+    }
+    let (path, bytes) = input.files.read("lensfile", file);
+    let shown = path.display().to_string();
+    let mut ok = true;
+    if !(aperture > 0.0 && aperture.is_finite()) {
+        r.error(Some("aperturediameter"), format!("\"aperturediameter\" {aperture} mm must be > 0: no ray could pass the aperture stop"), "bad aperture");
+        ok = false;
+    }
+    if !(focus > 0.0 && focus.is_finite()) {
+        r.error(
+            Some("focusdistance"),
+            format!("\"focusdistance\" {focus} must be > 0"),
+            "bad focus distance",
+        );
+        ok = false;
+    }
+    let diagonal = input.film.diagonal;
+    if !(diagonal > 0.0 && diagonal.is_finite()) {
+        r.error(
+            None,
+            format!("the Film's \"diagonal\" {diagonal} mm must be > 0 for the realistic camera"),
+            "film size",
+        );
+        ok = false;
+    }
+    let rows = match bytes {
+        Err(e) => {
+            r.error(
+                Some("lensfile"),
+                format!("cannot read lens file \"{shown}\": {e}"),
+                "lens file not read",
+            );
+            return None;
+        }
+        Ok(bytes) => match parse_lens_file(&String::from_utf8_lossy(&bytes)) {
+            Ok(rows) => rows,
+            Err(e) => {
+                r.error(
+                    Some("lensfile"),
+                    format!("lens file \"{shown}\": {e}"),
+                    "bad lens file",
+                );
+                return None;
+            }
+        },
+    };
+    if !ok {
+        return None;
+    }
+    if !rows.iter().any(|r| r[0] == 0.0) {
+        r.warn(
+            Some("aperturediameter"),
+            format!("lens file \"{shown}\" has no aperture stop (a row with radius 0): \"aperturediameter\" has no effect"),
+            "no aperture stop",
+        );
+    }
+    match focus_lens(&rows, aperture, focus, diagonal) {
+        Ok(f) => {
+            for w in f.warnings {
+                r.warn(Some("aperturediameter"), w, "aperture clamped");
+            }
+            Some(RealisticCamera::with(
+                path,
+                f.interfaces,
+                simple_weighting,
+                f.focal_length,
+            ))
+        }
+        Err(e) => {
+            r.error(
+                None,
+                format!("realistic camera with lens file \"{shown}\": {e}"),
+                "lens cannot be used",
+            );
+            None
+        }
+    }
+}
 
 /// Radial exit-pupil bounds over the film's half diagonal (pbrt-v3's count).
 pub const EXIT_PUPIL_BOUNDS: usize = 64;
@@ -382,8 +521,66 @@ pub fn focus_lens(
     })
 }
 
+/// A lens file in pbrt-v3's format: `#` starts a comment, and each other
+/// non-blank line is one interface of four numbers (curvature radius,
+/// thickness, index of refraction, aperture diameter; millimetres). pbrt-v3
+/// reads the file as one stream of numbers; pbrs insists on one interface
+/// per line so that a missing or extra value is caught at its line.
+pub fn parse_lens_file(text: &str) -> Result<Vec<[f32; 4]>, String> {
+    let mut rows = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let data = line.split('#').next().unwrap_or("");
+        let fields: Vec<&str> = data.split_whitespace().collect();
+        if fields.is_empty() {
+            continue;
+        }
+        if fields.len() != 4 {
+            return Err(format!("line {line_no}: {} values, expected 4 (curvature radius, thickness, eta, aperture diameter)", fields.len()));
+        }
+        let mut row = [0f32; 4];
+        for (v, f) in row.iter_mut().zip(&fields) {
+            *v = match f.parse::<f32>() {
+                Ok(x) if x.is_finite() => x,
+                _ => return Err(format!("line {line_no}: \"{f}\" is not a finite number")),
+            };
+        }
+        let [radius, thickness, eta, aperture] = row;
+        if thickness < 0.0 {
+            return Err(format!("line {line_no}: thickness {thickness} is negative"));
+        }
+        if aperture <= 0.0 {
+            return Err(format!(
+                "line {line_no}: aperture diameter {aperture} must be > 0"
+            ));
+        }
+        if radius != 0.0 && eta <= 0.0 {
+            return Err(format!("line {line_no}: index of refraction {eta} of a lens interface must be > 0 (only the aperture stop, radius 0, has 0)"));
+        }
+        if eta < 0.0 {
+            return Err(format!(
+                "line {line_no}: index of refraction {eta} is negative"
+            ));
+        }
+        if rows.len() == MAX_LENS_INTERFACES {
+            return Err(format!("more than {MAX_LENS_INTERFACES} interfaces"));
+        }
+        rows.push(row);
+    }
+    if rows.is_empty() {
+        return Err("no lens interface (an empty file, or only comments)".into());
+    }
+    Ok(rows)
+}
+
 #[derive(Clone, Debug)]
 pub struct RealisticCamera {
+    /// The lens file as resolved (for messages and `--check`).
+    pub lens_file: PathBuf,
+    pub simple_weighting: bool,
+    /// Effective focal length of the lens system (thick-lens approximation),
+    /// in metres.
+    pub focal_length: f32,
     camera_to_world: Affine3A,
     pub lens: LensSystem,
     /// Exit-pupil bounds for film radii [i, i+1)·(diagonal/2)/64.
@@ -399,16 +596,65 @@ pub struct RealisticCamera {
 }
 
 impl RealisticCamera {
-    pub fn new(
+    /// The focused lens system as the builder made it;
+    /// [`RealisticCamera::prepare`] bounds its exit pupil for the film.
+    pub fn with(
+        lens_file: PathBuf,
+        interfaces: Vec<LensInterface>,
+        simple_weighting: bool,
+        focal_length: f32,
+    ) -> RealisticCamera {
+        RealisticCamera {
+            lens_file,
+            simple_weighting,
+            focal_length,
+            camera_to_world: Affine3A::IDENTITY,
+            lens: LensSystem { interfaces },
+            exit_pupil: Vec::new(),
+            resolution: Vec2::ONE,
+            half_extent: Vec2::ZERO,
+            half_diagonal: 0.0,
+            weight_scale: 0.0,
+        }
+    }
+
+    pub fn prepare(&mut self, f: &Frame) {
+        *self = RealisticCamera::new(self, f.to_world, f.resolution, f.diagonal_mm, f.shutter);
+    }
+
+    pub fn describe(&self) -> String {
+        format!(
+            "realistic, lens \"{}\" ({} interfaces, focal length {:.1} mm)",
+            self.lens_file.display(),
+            self.lens.interfaces.len(),
+            self.focal_length * 1000.0
+        )
+    }
+
+    pub fn uses_lens(&self) -> bool {
+        true
+    }
+
+    /// The ray and its weight (which depends on the shifted rays too).
+    #[inline(always)]
+    pub fn ray(&self, cs: &CameraSample) -> (Ray, f32) {
+        let (ray, _, w) = self.generate_ray_differential(cs, 1.0);
+        (ray, w)
+    }
+
+    #[inline]
+    pub fn ray_differential(&self, cs: &CameraSample, scale: f32) -> (Ray, RayDiff, f32) {
+        self.generate_ray_differential(cs, scale)
+    }
+
+    fn new(
+        unprepared: &RealisticCamera,
         camera_to_world: Affine3A,
-        desc: &RealisticDesc,
         resolution: Vec2,
         film_diagonal_mm: f32,
         shutter: (f32, f32),
     ) -> RealisticCamera {
-        let lens = LensSystem {
-            interfaces: desc.interfaces.clone(),
-        };
+        let lens = unprepared.lens.clone();
         let diagonal = film_diagonal_mm * 0.001;
         let n = EXIT_PUPIL_BOUNDS;
         let exit_pupil: Vec<Bounds2> = (0..n)
@@ -422,12 +668,15 @@ impl RealisticCamera {
         let aspect = resolution.y / resolution.x;
         let x = (diagonal * diagonal / (1.0 + aspect * aspect)).sqrt();
         let rear = lens.rear_z();
-        let weight_scale = if desc.simple_weighting {
+        let weight_scale = if unprepared.simple_weighting {
             1.0 / exit_pupil[0].area()
         } else {
             (shutter.1 - shutter.0) / (rear * rear)
         };
         RealisticCamera {
+            lens_file: unprepared.lens_file.clone(),
+            simple_weighting: unprepared.simple_weighting,
+            focal_length: unprepared.focal_length,
             camera_to_world,
             lens,
             exit_pupil,
@@ -479,7 +728,7 @@ impl RealisticCamera {
 
     /// The world-space ray and its weight, or `None` if the lens blocks it.
     #[inline]
-    fn ray(&self, cs: &CameraSample) -> Option<(Ray, f32)> {
+    fn traced_ray(&self, cs: &CameraSample) -> Option<(Ray, f32)> {
         let p_film = self.film_point(cs.p_film);
         let (p_rear, area) = self.sample_exit_pupil(p_film.truncate(), cs.p_lens);
         let r_film = LensRay {
@@ -506,10 +755,10 @@ impl RealisticCamera {
             let r = Ray::new(self.camera_to_world.transform_point3(Vec3::ZERO), Vec3::Z);
             (r, RayDiff::none(&r), 0.0)
         };
-        let Some((ray, w)) = self.ray(cs) else {
+        let Some((ray, w)) = self.traced_ray(cs) else {
             return blocked();
         };
-        match finite_differences(cs, &ray, |s| self.ray(s).map(|(r, _)| r)) {
+        match finite_differences(cs, &ray, |s| self.traced_ray(s).map(|(r, _)| r)) {
             Some(d) => (ray, d.scaled(&ray, scale), w),
             None => blocked(),
         }
