@@ -14,9 +14,10 @@ use pbrs::render::film::compare::compare;
 use pbrs::render::film::Image;
 use pbrs::render::geometry::{Bounds2i, Ray};
 use pbrs::render::media::{phase_hg, HenyeyGreenstein, Medium, MEDIA};
+use pbrs::render::media::{Coefficients, Density, Grid, Homogeneous};
 use pbrs::render::samplers::Sampler;
 use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::scene::{MediumDesc, MediumKind, SamplerDesc, SamplerKind, SceneDescription};
+use pbrs::scene::{SamplerDesc, SamplerKind, SceneDescription};
 use std::sync::Arc;
 
 fn render_desc(desc: &SceneDescription, seed: u64) -> Image {
@@ -57,13 +58,16 @@ fn sampler() -> Sampler {
 }
 
 fn homogeneous(sigma_a: Vec3, sigma_s: Vec3) -> Medium {
-    Medium::new(&MediumDesc {
-        name: "m".into(),
+    let c = Coefficients {
         sigma_a,
         sigma_s,
         g: 0.0,
-        kind: MediumKind::Homogeneous,
-    })
+    };
+    Medium::new(
+        "m",
+        c,
+        Density::Homogeneous(Homogeneous::new(sigma_a, sigma_s)),
+    )
 }
 
 #[test]
@@ -270,20 +274,20 @@ fn henyey_greenstein_sign_convention() {
 #[test]
 fn grid_density_is_trilinear_between_voxel_centres() {
     let density = vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
-    let m = Medium::new(&MediumDesc {
-        name: "g".into(),
+    let c = Coefficients {
         sigma_a: Vec3::ONE,
         sigma_s: Vec3::ONE,
         g: 0.0,
-        kind: MediumKind::Grid {
-            nx: 2,
-            ny: 2,
-            nz: 2,
-            density: Arc::new(density),
-            medium_to_world: DMat4::IDENTITY,
-        },
-    });
-    let pbrs::render::media::Kind::Grid(grid) = &m.kind else {
+    };
+    let grid = Grid::new(
+        Vec3::ONE,
+        Vec3::ONE,
+        [2, 2, 2],
+        Arc::new(density),
+        DMat4::IDENTITY.as_mat4(),
+    );
+    let m = Medium::new("g", c, Density::Grid(grid));
+    let Density::Grid(grid) = &m.density else {
         panic!("not a grid")
     };
     // Voxel centres hold the values (x fastest, then y, then z).
@@ -344,8 +348,11 @@ fn constant_grid_renders_as_the_homogeneous_medium() {
         "\"string type\" \"heterogeneous\" {coeffs} \"float scale\" 0.5 \"integer nx\" 4 \"integer ny\" 4 \"integer nz\" 4 \"point3 p0\" [-3 -3 -3] \"point3 p1\" [3 3 3] \"float density\" [{}]",
         vec!["2"; 64].join(" ")
     )));
-    assert_eq!(homogeneous.scene.media[0].sigma_s, Vec3::splat(1.6));
-    assert_eq!(grid.scene.media[0].sigma_s, Vec3::splat(0.8));
+    assert_eq!(
+        homogeneous.scene.media[0].coefficients.sigma_s,
+        Vec3::splat(1.6)
+    );
+    assert_eq!(grid.scene.media[0].coefficients.sigma_s, Vec3::splat(0.8));
     let a = render_desc(&homogeneous.scene, 0);
     let b = render_desc(&grid.scene, 1);
     let c = compare(&b, &a);
@@ -393,16 +400,16 @@ WorldEnd",
             .unwrap_or_else(|| panic!("{n} not built"))
     };
     let a = by_name("a");
-    assert_eq!(a.sigma_a, Vec3::new(0.0011, 0.0024, 0.014));
-    assert_eq!(a.sigma_s, Vec3::new(2.55, 3.21, 3.77));
-    assert_eq!(a.g, 0.0);
+    assert_eq!(a.coefficients.sigma_a, Vec3::new(0.0011, 0.0024, 0.014));
+    assert_eq!(a.coefficients.sigma_s, Vec3::new(2.55, 3.21, 3.77));
+    assert_eq!(a.coefficients.g, 0.0);
     let b = by_name("b");
-    assert_eq!(b.sigma_a, Vec3::new(0.061, 0.97, 1.45) * 2.0);
-    assert_eq!(b.sigma_s, Vec3::new(0.18, 0.07, 0.03) * 2.0);
+    assert_eq!(b.coefficients.sigma_a, Vec3::new(0.061, 0.97, 1.45) * 2.0);
+    assert_eq!(b.coefficients.sigma_s, Vec3::new(0.18, 0.07, 0.03) * 2.0);
     let c = by_name("c");
-    assert_eq!(c.sigma_a, Vec3::new(1.0, 2.0, 3.0));
-    assert_eq!(c.sigma_s, Vec3::new(2.29, 2.39, 1.97));
-    assert_eq!(c.g, 0.5);
+    assert_eq!(c.coefficients.sigma_a, Vec3::new(1.0, 2.0, 3.0));
+    assert_eq!(c.coefficients.sigma_s, Vec3::new(2.29, 2.39, 1.97));
+    assert_eq!(c.coefficients.g, 0.5);
     // The camera is in the outside medium current at WorldEnd: "" here.
     assert_eq!(s.scene.camera_medium, None);
     let inside = |i: usize| s.scene.shapes[i].medium_interface;
@@ -574,8 +581,8 @@ WorldEnd",
         .iter()
         .find(|m| m.name == "a")
         .expect("a built");
-    assert_eq!(d.sigma_a, Vec3::new(0.0, 0.5, 0.5));
-    assert!(d.g < 1.0);
+    assert_eq!(d.coefficients.sigma_a, Vec3::new(0.0, 0.5, 0.5));
+    assert!(d.coefficients.g < 1.0);
     // The instanced sphere keeps the interface of its Shape statement.
     assert!(s.scene.objects[0].shapes[0]
         .medium_interface

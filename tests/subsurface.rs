@@ -20,7 +20,7 @@ fn kind(name: &str) -> &'static MaterialKind {
 
 /// The kind's parameters at their defaults, with `extra` set on top.
 fn params(k: &MaterialKind, extra: Vec<(&'static str, ParamValue)>) -> ParamValues {
-    let mut p = ParamValues { values: Vec::new() };
+    let mut p = ParamValues::default();
     for s in k.params {
         let v = match s.kind {
             ParamKind::FloatTexture(Some(d)) => ParamValue::FloatTexture(Tex::Constant(d)),

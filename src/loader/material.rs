@@ -467,6 +467,10 @@ pub fn read_params_as(
         if let Some(v) = value {
             out.set(s.name, v);
         }
+        let given = |list: &ParamList| list.items.iter().any(|q| q.name == s.name && q.used.get());
+        if l.lists().any(given) {
+            out.given.push(s.name);
+        }
     }
     (out, refs)
 }

@@ -124,13 +124,13 @@ pub struct Builder<'s, 'c> {
     pub unsupported_shapes: usize,
     /// Every medium `MakeNamedMedium` made, with its statement's location
     /// and its index in `scene_media` once something refers to it.
-    medium_defs: Vec<(MediumDesc, Loc, Option<MediumId>)>,
+    medium_defs: Vec<(crate::render::media::Medium, Loc, Option<MediumId>)>,
     /// The definition each name refers to now (a redefinition replaces it
     /// for later statements, as pbrt-v3's `namedMedia[name] = medium`).
     medium_names: HashMap<String, usize>,
     /// Undefined medium names already reported, by the interface statement.
     reported_media: HashSet<(String, u32, u32, u32)>,
-    pub scene_media: Vec<MediumDesc>,
+    pub scene_media: Vec<crate::render::media::Medium>,
     pub camera_medium: Option<MediumId>,
     /// The first `MediumInterface` statement (pbrt-v3's `haveScatteringMedia`).
     pub first_medium_interface: Option<Loc>,
@@ -1139,31 +1139,7 @@ fn look_at(v: &[f64]) -> Option<DMat4> {
     Some(camera_to_world.inverse())
 }
 
-pub(crate) fn closest_name<'a>(word: &str, names: &[&'a str]) -> Option<&'a str> {
-    let d = |a: &str, b: &str| strsim(a, b);
-    names
-        .iter()
-        .map(|n| (*n, d(word, n)))
-        .filter(|&(n, dist)| dist <= (n.chars().count() / 3).max(2))
-        .min_by_key(|&(_, dist)| dist)
-        .map(|(n, _)| n)
-}
-
-fn strsim(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.to_lowercase().chars().take(128).collect();
-    let b: Vec<char> = b.to_lowercase().chars().take(128).collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for i in 1..=a.len() {
-        let mut cur = vec![i; b.len() + 1];
-        for j in 1..=b.len() {
-            cur[j] = (prev[j - 1] + usize::from(a[i - 1] != b[j - 1]))
-                .min(prev[j] + 1)
-                .min(cur[j - 1] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
-}
+pub(crate) use crate::scene::kind::closest_name;
 
 #[cfg(test)]
 mod tests {

@@ -100,20 +100,7 @@ impl Summary {
                 format!("volpath, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}").to_lowercase()
             }
         };
-        for m in &scene.media {
-            let v = |c: glam::Vec3| format!("{} {} {}", c.x, c.y, c.z);
-            let kind = match &m.kind {
-                MediumKind::Homogeneous => "homogeneous".to_string(),
-                MediumKind::Grid { nx, ny, nz, .. } => format!("heterogeneous {nx}×{ny}×{nz}"),
-            };
-            s.media.push(format!(
-                "\"{}\": {kind}, sigma_a {}, sigma_s {}, g {}",
-                m.name,
-                v(m.sigma_a),
-                v(m.sigma_s),
-                m.g
-            ));
-        }
+        s.media = scene.media.iter().map(|m| m.describe()).collect();
         s.camera_medium = scene
             .camera_medium
             .and_then(|id| scene.media.get(id.0 as usize))

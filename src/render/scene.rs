@@ -346,7 +346,7 @@ impl RenderScene {
         }
         let material_needs_geom = materials.iter().map(Material::needs_geom).collect();
         let differentials = materials.iter().any(|m| m.needs_geom());
-        let media: Vec<Medium> = desc.media.iter().map(Medium::new).collect();
+        let media: Vec<Medium> = desc.media.clone();
         if !media.is_empty() {
             notes.push(format!(
                 "media: {} ({} material slots for medium boundaries)",

@@ -96,3 +96,32 @@ impl Report for Collected {
         self.errors.push(msg);
     }
 }
+
+/// The name of `names` closest to `word` (a case-insensitive edit distance
+/// of at most a third of the name's length, and at least 2), for "did you
+/// mean".
+pub fn closest_name<'a>(word: &str, names: &[&'a str]) -> Option<&'a str> {
+    let d = |a: &str, b: &str| strsim(a, b);
+    names
+        .iter()
+        .map(|n| (*n, d(word, n)))
+        .filter(|&(n, dist)| dist <= (n.chars().count() / 3).max(2))
+        .min_by_key(|&(_, dist)| dist)
+        .map(|(n, _)| n)
+}
+
+fn strsim(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.to_lowercase().chars().take(128).collect();
+    let b: Vec<char> = b.to_lowercase().chars().take(128).collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for i in 1..=a.len() {
+        let mut cur = vec![i; b.len() + 1];
+        for j in 1..=b.len() {
+            cur[j] = (prev[j - 1] + usize::from(a[i - 1] != b[j - 1]))
+                .min(prev[j] + 1)
+                .min(cur[j - 1] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}

@@ -45,7 +45,7 @@ pub struct SceneDescription {
     pub instances: Vec<InstanceDesc>,
     /// Participating media referenced by the camera or by a shape's
     /// interface (by index: [`MediumId`]).
-    pub media: Vec<MediumDesc>,
+    pub media: Vec<crate::render::media::Medium>,
     /// The camera's medium (pbrt-v3: the outside medium of the graphics
     /// state when the camera is made, at WorldEnd).
     pub camera_medium: Option<MediumId>,
@@ -57,35 +57,6 @@ pub struct SceneDescription {
 /// Index into [`SceneDescription::media`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MediumId(pub u32);
-
-/// A medium: pbrt-v3's `HomogeneousMedium` or `GridDensityMedium`, with
-/// `scale` already applied to both coefficients (per unit length).
-#[derive(Clone, Debug)]
-pub struct MediumDesc {
-    /// The name given to `MakeNamedMedium` (for messages and `--check`).
-    pub name: String,
-    pub sigma_a: Vec3,
-    pub sigma_s: Vec3,
-    /// Henyey–Greenstein asymmetry, in (-1, 1).
-    pub g: f32,
-    pub kind: MediumKind,
-}
-
-#[derive(Clone, Debug)]
-pub enum MediumKind {
-    Homogeneous,
-    /// A density grid over the unit cube of its own space, which
-    /// `medium_to_world` maps to the world (the CTM at `MakeNamedMedium`
-    /// times pbrt-v3's `Translate(p0) * Scale(p1 - p0)`). `density` has
-    /// `nx * ny * nz` values, x fastest.
-    Grid {
-        nx: u32,
-        ny: u32,
-        nz: u32,
-        density: Arc<Vec<f32>>,
-        medium_to_world: DMat4,
-    },
-}
 
 /// pbrt-v3's `MediumInterface` of a shape: the media on the side its
 /// normal points away from (`inside`) and towards (`outside`); `None` is

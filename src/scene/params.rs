@@ -335,6 +335,8 @@ pub enum ParamValue {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ParamValues {
     pub values: Vec<(&'static str, ParamValue)>,
+    /// The parameters the statement gave (the others have their defaults).
+    pub given: Vec<&'static str>,
 }
 
 impl ParamValues {
@@ -436,6 +438,12 @@ impl ParamValues {
     /// for kinds whose pbrt-v3 code treats "given" differently.
     pub fn has(&self, name: &str) -> bool {
         self.get(name).is_some()
+    }
+    /// True when the statement gave the parameter (it may still hold its
+    /// default's value): pbrt-v3's defaults that depend on other
+    /// parameters (a medium's `preset`) need to know.
+    pub fn given(&self, name: &str) -> bool {
+        self.given.contains(&name)
     }
     pub fn fourier(&self, name: &str) -> Option<Arc<FourierTable>> {
         match self.get(name) {

@@ -17,11 +17,15 @@
 //! density, transmittance estimated by ratio tracking with pbrt-v3's
 //! Russian roulette below 0.1, each drawing from the sampler as pbrt-v3.
 
-use super::{MediumType, Support, COMMON};
+use super::{fix, Coefficients, Density, Medium, MediumInput, MediumType, Support, COMMON};
 use crate::render::geometry::{gamma, Ray};
 use crate::render::samplers::Sampler;
-use crate::scene::ParamSpec;
-use glam::{Mat4, Vec3};
+use crate::scene::{ParamSpec, ParamValues, Report};
+use glam::{DMat4, Mat4, Vec3};
+use std::sync::Arc;
+
+/// The most voxels a density grid may have (1 GiB of f32).
+pub const MAX_GRID_VOXELS: i64 = 1 << 28;
 
 pub const KIND: MediumType = MediumType {
     name: "heterogeneous",
@@ -41,8 +45,111 @@ pub const KIND: MediumType = MediumType {
         ParamSpec::point3("p1", [1.0; 3], "the grid box's opposite corner"),
     ],
     doc: "a density grid scaling the coefficients, trilinearly interpolated (pbrt-v3's GridDensityMedium)",
-    build: (),
+    build,
 };
+
+/// pbrt-v3's `GridDensityMedium` checks: `density` with nx·ny·nz finite,
+/// non-negative values (within the memory budget), one attenuation
+/// coefficient, a box p0…p1 of some extent in the current space.
+fn build(p: &ParamValues, input: &MediumInput, r: &mut dyn Report) -> Option<Medium> {
+    let what = format!("MakeNamedMedium \"{}\"", input.name);
+    let c = Coefficients::read(p, &what, r);
+    if !p.given("density") {
+        r.error(
+            None,
+            format!("{what}: a heterogeneous medium needs \"float density\" values (pbrt-v3: \"No density values provided\")"),
+            "no \"float density\"",
+        );
+        return None;
+    }
+    let mut n = [0i64; 3];
+    for (i, axis) in ["nx", "ny", "nz"].into_iter().enumerate() {
+        let v = p.int(axis) as i64;
+        if v < 1 {
+            r.error(
+                Some(axis),
+                format!(
+                    "{what}: \"{axis}\" is {v}: the grid needs at least one voxel along each axis"
+                ),
+                "must be ≥ 1",
+            );
+            return None;
+        }
+        n[i] = v;
+    }
+    let voxels = n[0].saturating_mul(n[1]).saturating_mul(n[2]);
+    let values = p.floats("density");
+    if voxels > MAX_GRID_VOXELS || values.len() as i64 != voxels {
+        let why = if voxels > MAX_GRID_VOXELS {
+            format!(
+                "{} × {} × {} voxels is more than pbrs takes ({MAX_GRID_VOXELS})",
+                n[0], n[1], n[2]
+            )
+        } else {
+            format!(
+                "\"density\" has {} values; nx·ny·nz = {} × {} × {} = {voxels} expected (pbrt-v3 reports the same error)",
+                values.len(),
+                n[0],
+                n[1],
+                n[2]
+            )
+        };
+        r.error(
+            Some("density"),
+            format!("{what}: {why}"),
+            "wrong number of densities",
+        );
+        return None;
+    }
+    if let Err(why) = crate::scene::memory::check_budget(
+        &format!("{what}: the {} × {} × {} density grid", n[0], n[1], n[2]),
+        (voxels as u64).saturating_mul(4),
+    ) {
+        r.error(Some("density"), why, "too large for this machine");
+        return None;
+    }
+    let mut density: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+    if density.iter().any(|d| !(d.is_finite() && *d >= 0.0)) {
+        r.warn(
+            Some("density"),
+            format!("{what}: negative or non-finite densities are set to 0"),
+            "densities must be finite and ≥ 0",
+        );
+        for d in &mut density {
+            *d = fix(*d);
+        }
+    }
+    let sigma_t = c.sigma_a + c.sigma_s;
+    if sigma_t.x != sigma_t.y || sigma_t.x != sigma_t.z {
+        let at = ["sigma_a", "sigma_s", "preset"]
+            .into_iter()
+            .find(|n| p.given(n));
+        r.warn(
+            at,
+            format!("{what}: sigma_a + sigma_s = {} {} {} differs by channel: a heterogeneous medium needs one attenuation coefficient (pbrt-v3 reports an error and uses the first channel's, as pbrs does)", sigma_t.x, sigma_t.y, sigma_t.z),
+            "spectrally varying attenuation",
+        );
+    }
+    let (p0, p1) = (p.point("p0"), p.point("p1"));
+    let data_to_medium = DMat4::from_translation(p0) * DMat4::from_scale(p1 - p0);
+    let medium_to_world = input.ctm * data_to_medium;
+    if !medium_to_world.is_finite() || medium_to_world.determinant() == 0.0 {
+        r.error(
+            None,
+            format!("{what}: the grid's box p0…p1 in the current transform is degenerate (zero extent along an axis, or a singular transform)"),
+            "degenerate grid box",
+        );
+        return None;
+    }
+    let grid = Grid::new(
+        c.sigma_a,
+        c.sigma_s,
+        [n[0] as u32, n[1] as u32, n[2] as u32],
+        Arc::new(density),
+        medium_to_world.inverse().as_mat4(),
+    );
+    Some(Medium::new(input.name, c, Density::Grid(grid)))
+}
 
 #[derive(Clone, Debug)]
 pub struct Grid {

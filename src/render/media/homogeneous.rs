@@ -14,7 +14,7 @@
 //! channel chosen uniformly, an exponential step in its σt, and the
 //! weight divided by the density averaged over the channels.
 
-use super::{MediumType, Support, COMMON};
+use super::{Coefficients, Density, Medium, MediumType, Support, COMMON};
 use crate::render::geometry::Ray;
 use crate::render::samplers::Sampler;
 use glam::Vec3;
@@ -25,7 +25,12 @@ pub const KIND: MediumType = MediumType {
     support: Support::Supported,
     params: &[COMMON[0], COMMON[1], COMMON[2], COMMON[3], COMMON[4]],
     doc: "constant coefficients everywhere (pbrt-v3's HomogeneousMedium)",
-    build: (),
+    build: |p, input, r| {
+        let what = format!("MakeNamedMedium \"{}\"", input.name);
+        let c = Coefficients::read(p, &what, r);
+        let density = Density::Homogeneous(Homogeneous::new(c.sigma_a, c.sigma_s));
+        Some(Medium::new(input.name, c, density))
+    },
 };
 
 #[derive(Clone, Debug)]
