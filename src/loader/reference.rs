@@ -145,6 +145,12 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
             Some(format!("{} {} {}", num(x), num(y), num(z))),
         ),
         ParamKind::Floats => ("float list".to_string(), None),
+        ParamKind::SpectrumOrFloat(d) => (
+            "spectrum or float".to_string(),
+            Some(spectrum(SpectrumDefault::Rgb(d))),
+        ),
+        ParamKind::IntOpt => ("integer".to_string(), None),
+        ParamKind::Image(_) => ("string: an image file".to_string(), None),
     };
     (
         format!("{ty}{nonneg}"),
