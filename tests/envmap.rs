@@ -295,7 +295,10 @@ fn float_scale_is_ignored_as_pbrt_v3_does() {
         panic!()
     };
     let radiance = light.map.le(Vec3::Z);
-    assert!((radiance - Vec3::ONE).abs().max_element() < 1e-6, "{radiance}");
+    assert!(
+        (radiance - Vec3::ONE).abs().max_element() < 1e-6,
+        "{radiance}"
+    );
     let w: Vec<String> = r.warnings.iter().map(|w| w.to_string()).collect();
     assert!(w.iter().any(|w| w.contains("scale")), "{w:?}");
 }

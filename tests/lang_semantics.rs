@@ -271,9 +271,7 @@ fn lights() {
     let s = load("WorldBegin\nTranslate 1 0 0\nLightSource \"point\" \"rgb I\" [1 1 1] \"rgb scale\" [2 2 2] \"point from\" [0 1 0]\nLightSource \"distant\" \"point from\" [0 0 0] \"point to\" [0 0 1]\nLightSource \"spot\" \"point from\" [0 0 0] \"point to\" [0 1 0] \"float coneangle\" 20\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\nLightSource \"goniometric\"\nWorldEnd");
     let l = &s.scene.lights;
     assert_eq!(l.len(), 4);
-    let Light::Point(point) = &l[0] else {
-        panic!()
-    };
+    let Light::Point(point) = &l[0] else { panic!() };
     assert!(close32(point.p, Vec3::new(1.0, 1.0, 0.0)));
     assert_eq!(point.intensity, Vec3::splat(2.0));
     let Light::Distant(distant) = &l[1] else {

@@ -48,7 +48,7 @@ pub const KIND: LightKind = LightKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a point light emitting I·scale in a cone from `from` towards `to`, falling off smoothly over conedeltaangle (from = to: warning, skipped)",
+    doc: "a point light emitting I·scale in a cone from `from` towards `to` (light-to-world = CTM · Translate(from) · frame(to − from), as pbrt-v3), falling off smoothly over conedeltaangle (from = to: warning, skipped)",
     build: |p, ctm, report| SpotLight::new(p, ctm, report).map(Into::into),
 };
 
