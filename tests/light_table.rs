@@ -427,3 +427,26 @@ fn every_type_builds_with_its_defaults() {
         assert!(sc.lights[0].power() > 0.0, "{}", k.name);
     }
 }
+
+/// Unknown types: a warning (with "did you mean" from the table for
+/// `LightSource`), nothing built, later shapes not emissive.
+#[test]
+fn unknown_types_are_warned_about_and_ignored() {
+    let s = load_text(&scene("LightSource \"pont\" \"rgb I\" [1 1 1]"));
+    assert!(s.scene.lights.is_empty());
+    let w = warning_text(&s);
+    assert!(
+        w.contains("unknown light type \"pont\" (did you mean \"point\"?): ignored"),
+        "{w}"
+    );
+    assert!(!w.contains("not used"), "{w}");
+    let s = load_text(&scene(
+        "AreaLightSource \"glow\" \"rgb L\" [1 1 1]\nShape \"sphere\"",
+    ));
+    assert!(s.scene.shapes.iter().all(|sh| sh.area_light.is_none()));
+    let w = warning_text(&s);
+    assert!(
+        w.contains("unknown area light \"glow\" (pbrt-v3 has \"diffuse\", alias \"area\"): ignored, later shapes are not emissive"),
+        "{w}"
+    );
+}

@@ -78,12 +78,6 @@ impl DiffuseEmission {
             n_samples: n.clamp(1, MAX_SAMPLES) as u32,
         }
     }
-
-    /// Emits anything at all (shapes with black emission are lights of
-    /// zero power: neither built nor sampled).
-    pub fn emits(&self) -> bool {
-        self.l.max_element() > 0.0
-    }
 }
 
 /// The area light of one triangle or analytic shape.
