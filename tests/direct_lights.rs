@@ -15,7 +15,7 @@
 mod common;
 use common::*;
 use glam::{Vec2, Vec3};
-use pbrs::render::lights::{AreaShape, Light, LightSampler, LightSamplerKind};
+use pbrs::render::lights::{AreaShape, DiffuseLight, Light, LightSampler, LightSamplerKind};
 use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::render::scene::RenderScene;
 use pbrs::render::shapes::SurfacePoint;
@@ -29,15 +29,15 @@ fn scene(rel: &str) -> RenderScene {
 /// numbers in the file.
 fn expected_power(l: &Light) -> f64 {
     match *l {
-        Light::Point { intensity, .. } => 4.0 * PI * intensity.x as f64,
-        Light::Area {
+        Light::Point(p) => 4.0 * PI * p.intensity.x as f64,
+        Light::Diffuse(DiffuseLight {
             shape: AreaShape::Quadric(_),
             ..
-        } => 4.0 * (4.0 * PI * 0.25) * PI,
-        Light::Area {
+        }) => 4.0 * (4.0 * PI * 0.25) * PI,
+        Light::Diffuse(DiffuseLight {
             shape: AreaShape::Triangle { .. },
             ..
-        } => 3.0 * 2.0 * PI,
+        }) => 3.0 * 2.0 * PI,
         _ => panic!("unexpected light {l:?}"),
     }
 }
@@ -111,7 +111,7 @@ fn uniform_picks_every_light_equally() {
 fn point_light(sc: &RenderScene, i: f32) -> usize {
     sc.lights
         .iter()
-        .position(|l| matches!(l, Light::Point { intensity, .. } if intensity.x == i))
+        .position(|l| matches!(l, Light::Point(p) if p.intensity.x == i))
         .unwrap()
 }
 
@@ -201,10 +201,10 @@ fn area_light_sampling_matches_its_density() {
     let sphere = find(&|l| {
         matches!(
             l,
-            Light::Area {
+            Light::Diffuse(DiffuseLight {
                 shape: AreaShape::Quadric(_),
                 ..
-            }
+            })
         )
     });
     let cases = [

@@ -288,6 +288,12 @@ fn reference_family_sections_are_generated_from_the_tables() {
             pbrs::loader::reference::samplers_section,
             rows(pbrs::render::samplers::SAMPLERS),
         ),
+        (
+            "render::camera::CAMERAS",
+            "cameras",
+            pbrs::loader::reference::cameras_section,
+            rows(pbrs::render::camera::CAMERAS),
+        ),
     ];
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let write = std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1");
@@ -315,6 +321,52 @@ fn reference_family_sections_are_generated_from_the_tables() {
                 assert!(
                     section.contains(&format!("| `{p}` |")),
                     "{noun} {name}: {p}"
+                );
+            }
+        }
+    }
+}
+
+/// The lights section of REFERENCE.md is what the generator writes from
+/// `render::lights::LIGHTS` and `AREA_LIGHTS` (`PBRS_WRITE_REFERENCE=1`
+/// rewrites it).
+#[test]
+fn reference_lights_section_is_generated_from_the_tables() {
+    use pbrs::loader::reference::{lights_section, splice_between, LIGHTS_BEGIN, LIGHTS_END};
+    use pbrs::render::lights::{AREA_LIGHTS, LIGHTS};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
+    let doc = std::fs::read_to_string(&path).unwrap();
+    let section = lights_section();
+    let Some(expected) = splice_between(&doc, &section, LIGHTS_BEGIN, LIGHTS_END) else {
+        panic!("REFERENCE.md lacks the lines {LIGHTS_BEGIN:?} and, after it, {LIGHTS_END:?}");
+    };
+    if std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1") {
+        if expected != doc {
+            std::fs::write(&path, &expected).unwrap();
+        }
+        return;
+    }
+    assert!(
+        expected == doc,
+        "grammar/REFERENCE.md's lights section differs from the light tables; regenerate it with \
+         `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` and commit the diff"
+    );
+    let kinds = LIGHTS
+        .iter()
+        .map(|k| (k.name, k.params, k.is_supported()))
+        .chain(
+            AREA_LIGHTS
+                .iter()
+                .map(|k| (k.name, k.params, k.is_supported())),
+        );
+    for (name, params, supported) in kinds {
+        assert!(section.contains(&format!("`{name}`")), "{name}");
+        if supported {
+            for p in params {
+                assert!(
+                    section.contains(&format!("| `{}` |", p.name)),
+                    "{name}: {}",
+                    p.name
                 );
             }
         }

@@ -17,7 +17,7 @@ use common::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::load_scene_str;
 use pbrs::render::geometry::{offset_ray_origin, Frame};
-use pbrs::render::lights::{AreaShape, Light};
+use pbrs::render::lights::{AreaShape, DiffuseLight, Light};
 use pbrs::render::sampling::Pcg32;
 use pbrs::render::scene::RenderScene;
 use pbrs::render::shapes::{Cylinder, Disk, SurfacePoint};
@@ -171,10 +171,10 @@ fn the_light(sc: &RenderScene) -> &Light {
     let l = &sc.lights[0];
     assert!(matches!(
         l,
-        Light::Area {
+        Light::Diffuse(DiffuseLight {
             shape: AreaShape::Quadric(_),
             ..
-        }
+        })
     ));
     l
 }

@@ -11,7 +11,7 @@ use crate::render::driver::{
 use crate::render::film::io::{check_output_path, format_for_path, write_image, ImageFormat};
 use crate::render::film::part::PartKind;
 use crate::render::film::Image;
-use crate::scene::{LightDesc, SamplerKind, SceneDescription};
+use crate::scene::{Light, SamplerKind, SceneDescription};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -74,10 +74,8 @@ pub fn apply_quick(desc: &mut SceneDescription) {
             quarter(&mut a.n_samples);
         }
     }
-    for l in &mut desc.lights {
-        if let LightDesc::Infinite { n_samples, .. } = l {
-            quarter(n_samples);
-        }
+    for l in desc.lights.iter_mut().filter_map(Light::n_samples_mut) {
+        quarter(l);
     }
 }
 
@@ -511,7 +509,7 @@ WorldEnd
         ));
         assert_eq!(d.shapes[0].area_light.unwrap().n_samples, 2);
         let inf = d.lights.iter().find_map(|l| match l {
-            LightDesc::Infinite { n_samples, .. } => Some(*n_samples),
+            Light::Infinite(i) => Some(i.n_samples),
             _ => None,
         });
         assert_eq!(inf, Some(1));

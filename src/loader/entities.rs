@@ -3,7 +3,7 @@
 //! shapes. Every lookup marks its parameter used.
 
 use super::color::{blackbody_to_rgb, repeated_wavelength, sampled_to_rgb, xyz_to_rgb};
-use super::kinds::{self, Family, Unknown};
+use super::kinds::{self, Family, StatementReport, Unknown};
 use super::meshfile::{read_gltf, read_obj};
 use super::ply::{read_ply, PlyMesh};
 use super::spd;
@@ -12,7 +12,9 @@ use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
 use crate::render::filters::{Filter, FILTERS};
+use crate::render::lights::{AreaLightBuild, LightBuild, AREA_LIGHTS, LIGHTS};
 use crate::render::samplers::SAMPLERS;
+use crate::scene::kind;
 use crate::scene::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::collections::HashMap;
@@ -152,14 +154,6 @@ pub fn spectrum(ctx: &mut Ctx, p: &ParamList, name: &str, def: Vec3) -> Vec3 {
         .unwrap_or(def)
 }
 
-/// Light `scale`: a spectrum in pbrt-v3; a plain float is accepted too.
-fn light_scale(ctx: &mut Ctx, p: &ParamList) -> Vec3 {
-    if let Some((f, _)) = float_opt(p, "scale") {
-        return Vec3::splat(f as f32);
-    }
-    spectrum(ctx, p, "scale", Vec3::ONE)
-}
-
 /// pbrt-v3 `shapeMaySetMaterialParameters` (api.cpp): whether a shape's parameters
 /// may override its material's.
 pub fn shape_may_set_material_params(p: &ParamList) -> bool {
@@ -176,140 +170,88 @@ pub fn shape_may_set_material_params(p: &ParamList) -> bool {
 
 // ---------------------------------------------------------------- lights
 
-pub fn area_light(ctx: &mut Ctx, p: &ParamList) -> AreaLightDesc {
-    let l = spectrum(ctx, p, "L", Vec3::ONE) * light_scale(ctx, p);
-    let (ns, _) = int(p, "nsamples", 1);
-    let (n, _) = int(p, "samples", ns);
-    let two_sided = boolean(p, "twosided", false);
-    AreaLightDesc {
-        l,
-        two_sided,
-        n_samples: n.clamp(1, MAX_SAMPLES) as u32,
+const LIGHT_FAMILY: Family<LightBuild> = Family {
+    directive: "LightSource",
+    noun: "light type",
+    table: LIGHTS,
+    unknown: Unknown::Warn,
+};
+
+const AREA_LIGHT_FAMILY: Family<AreaLightBuild> = Family {
+    directive: "AreaLightSource",
+    noun: "area light",
+    table: AREA_LIGHTS,
+    unknown: Unknown::Warn,
+};
+
+/// `LightSource`: a type of `render::lights::LIGHTS`, its parameters read
+/// through its table and the light built by its builder with the CTM as
+/// light-to-world; types pbrs does not render, unknown types and lights
+/// the builder refuses are warned about and skipped.
+pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Light> {
+    let r = kinds::read(ctx, &LIGHT_FAMILY, name, p)?;
+    if r.kind.unsupported().is_some() {
+        p.mark_all_used();
+        ctx.warn(
+            name.loc,
+            format!("light \"{}\" is not supported by pbrs: ignored", name.value),
+            "light ignored",
+        );
+        return None;
     }
+    let mut report = StatementReport {
+        ctx,
+        at: name.loc,
+        params: p,
+    };
+    let light = (r.kind.build)(&r.params, ctm, &mut report);
+    kinds::report_unused(ctx, &LIGHT_FAMILY, &r, name, p);
+    light
 }
 
-/// `LightSource`: point, spot, distant, infinite; others are warned about and skipped.
-pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<LightDesc> {
-    match name.value.as_str() {
-        "point" => {
-            let i = spectrum(ctx, p, "I", Vec3::ONE) * light_scale(ctx, p);
-            let from = point3(p, "from", DVec3::ZERO);
-            // pbrt-v3 point.cpp: light-to-world = Translate(from) · CTM, so the light
-            // sits at CTM·origin + from (not CTM·from when the CTM scales or rotates).
-            Some(LightDesc::Point {
-                position: ctm.transform_point3(DVec3::ZERO) + from,
-                intensity: i,
-            })
-        }
-        "spot" => {
-            let i = spectrum(ctx, p, "I", Vec3::ONE) * light_scale(ctx, p);
-            let cone = float(p, "coneangle", 30.0);
-            let delta = float(p, "conedeltaangle", 5.0);
-            let from = point3(p, "from", DVec3::ZERO);
-            let to = point3(p, "to", DVec3::Z);
-            let dir = to - from;
-            if dir.length_squared() == 0.0 {
-                ctx.warn(
-                    name.loc,
-                    "spot light with \"from\" equal to \"to\" has no direction: skipped",
-                    "degenerate spot light",
-                );
-                return None;
-            }
-            let dir = dir.normalize();
-            // pbrt-v3 CoordinateSystem(dir, &du, &dv); light2world = CTM · Translate(from) · Inverse(dirToZ).
-            let du = if dir.x.abs() > dir.y.abs() {
-                DVec3::new(-dir.z, 0.0, dir.x) / (dir.x * dir.x + dir.z * dir.z).sqrt()
-            } else {
-                DVec3::new(0.0, dir.z, -dir.y) / (dir.y * dir.y + dir.z * dir.z).sqrt()
-            };
-            let dv = dir.cross(du);
-            let frame = DMat4::from_cols(
-                du.extend(0.0),
-                dv.extend(0.0),
-                dir.extend(0.0),
-                glam::DVec4::W,
-            );
-            let light_to_world = ctm * DMat4::from_translation(from) * frame;
-            if !light_to_world.is_finite() {
-                ctx.warn(
-                    name.loc,
-                    "spot light transform is not finite (from/to too large): skipped",
-                    "degenerate spot light",
-                );
-                return None;
-            }
-            Some(LightDesc::Spot {
-                light_to_world,
-                intensity: i,
-                cone_angle: cone as f32,
-                cone_delta_angle: delta as f32,
-            })
-        }
-        "distant" => {
-            let l = spectrum(ctx, p, "L", Vec3::ONE) * light_scale(ctx, p);
-            let from = point3(p, "from", DVec3::ZERO);
-            let to = point3(p, "to", DVec3::Z);
-            let d = ctm.transform_vector3(from - to);
-            if d.length_squared() == 0.0 || !d.is_finite() {
-                ctx.warn(
-                    name.loc,
-                    "distant light with \"from\" equal to \"to\" has no direction: skipped",
-                    "degenerate distant light",
-                );
-                return None;
-            }
-            Some(LightDesc::Distant {
-                radiance: l,
-                direction: d.normalize(),
-            })
-        }
-        "infinite" | "exinfinite" => {
-            // pbrt-v3 reads `scale` as a spectrum only: "float scale" stays unused.
-            let l = spectrum(ctx, p, "L", Vec3::ONE) * spectrum(ctx, p, "scale", Vec3::ONE);
-            let (ns, _) = int(p, "nsamples", 1);
-            let (n, _) = int(p, "samples", ns);
-            let image = match string(p, "mapname") {
-                Some((map, loc)) if !map.is_empty() => {
-                    // Raw values: pbrt-v3's infinite light does not sRGB-decode.
-                    Some(super::image::load_image(ctx, loc, map, Decode::Raw)?)
-                }
-                _ => None,
-            };
-            let sampling = match string(p, "sampling") {
-                None | Some(("map", _)) => EnvSampling::Map,
-                Some(("uniform", _)) => EnvSampling::Uniform,
-                Some((other, loc)) => {
-                    ctx.warn(
-                        loc,
-                        format!("unknown infinite light sampling \"{other}\" (pbrs has \"map\" and \"uniform\"): \"map\" is used"),
-                        "unknown sampling",
-                    );
-                    EnvSampling::Map
-                }
-            };
-            Some(LightDesc::Infinite {
-                radiance: l,
-                image,
-                light_to_world: ctm,
-                n_samples: n.clamp(1, MAX_SAMPLES) as u32,
-                sampling,
-            })
-        }
-        other => {
-            p.mark_all_used();
-            if matches!(other, "goniometric" | "projection") {
-                ctx.warn(
-                    name.loc,
-                    format!("light \"{other}\" is not supported by pbrs: ignored"),
-                    "light ignored",
-                );
-            } else {
-                ctx.warn(name.loc, format!("unknown light type \"{other}\": ignored (pbrt-v3 has point, spot, goniometric, projection, distant, infinite)"), "unknown light");
-            }
-            None
-        }
+/// Whether `AreaLightSource` names a type of `render::lights::AREA_LIGHTS`
+/// (else a warning: later shapes do not emit). Its parameters are read by
+/// [`area_light`] when a shape first uses it.
+pub fn area_light_known(ctx: &mut Ctx, name: &Name, p: &ParamList) -> bool {
+    if kind::find(AREA_LIGHTS, &name.value).is_some() {
+        return true;
     }
+    p.mark_all_used();
+    let known = AREA_LIGHTS
+        .iter()
+        .map(|k| {
+            let aliases: String = k
+                .aliases
+                .iter()
+                .map(|a| format!(", alias \"{a}\""))
+                .collect();
+            format!("\"{}\"{aliases}", k.name)
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    ctx.warn(
+        name.loc,
+        format!(
+            "unknown area light \"{}\" (pbrt-v3 has {known}): ignored, later shapes are not emissive",
+            name.value
+        ),
+        "not an area light type",
+    );
+    false
+}
+
+/// `AreaLightSource`'s emission, read through its type's table (`None`
+/// for an unknown type, which [`area_light_known`] reported).
+pub fn area_light(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<DiffuseEmission> {
+    let r = kinds::read(ctx, &AREA_LIGHT_FAMILY, name, p)?;
+    let mut report = StatementReport {
+        ctx,
+        at: name.loc,
+        params: p,
+    };
+    let emission = (r.kind.build)(&r.params, &mut report);
+    kinds::report_unused(ctx, &AREA_LIGHT_FAMILY, &r, name, p);
+    Some(emission)
 }
 
 // ---------------------------------------------------------------- shapes

@@ -463,6 +463,25 @@ pub fn read_params_as(
                     q.used.set(true);
                     ParamValue::Floats(Arc::from(q.nums()))
                 }),
+            ParamKind::SpectrumOrFloat(def) => Some(ParamValue::Spectrum(
+                match l.plain(s.name, ParamType::Float) {
+                    Some(q) => Vec3::splat(q.nums()[0] as f32),
+                    None => l
+                        .lists()
+                        .find_map(|list| find_spectrum(list, s.name))
+                        .and_then(|q| spectrum_value(ctx, q))
+                        .unwrap_or(Vec3::from_array(def)),
+                },
+            )),
+            ParamKind::IntOpt => l.plain(s.name, ParamType::Integer).map(|q| {
+                ParamValue::Int(q.nums()[0].clamp(i32::MIN as f64, i32::MAX as f64) as i32)
+            }),
+            // pbrt-v3 reads no image for an empty name.
+            ParamKind::Image(decode) => l
+                .plain(s.name, ParamType::String)
+                .filter(|q| !q.strs()[0].is_empty())
+                .and_then(|q| super::image::load_image(ctx, q.values_loc, &q.strs()[0], decode))
+                .map(ParamValue::Image),
         };
         if let Some(v) = value {
             out.set(s.name, v);

@@ -187,6 +187,9 @@ fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
         ParamKind::Spectrum(_) => &["rgb", "color", "xyz", "blackbody", "spectrum"],
         ParamKind::Point3(_) => &["point3", "point"],
         ParamKind::Floats => &["float"],
+        ParamKind::SpectrumOrFloat(_) => &["rgb", "color", "xyz", "blackbody", "spectrum", "float"],
+        ParamKind::IntOpt => &["integer"],
+        ParamKind::Image(_) => &["string"],
     }
 }
 
@@ -247,6 +250,9 @@ fn kind_name(kind: ParamKind) -> &'static str {
         ParamKind::Spectrum(_) => "spectrum",
         ParamKind::Point3(_) => "point3",
         ParamKind::Floats => "float list",
+        ParamKind::SpectrumOrFloat(_) => "spectrum",
+        ParamKind::IntOpt => "integer",
+        ParamKind::Image(_) => "file-name",
     }
 }
 

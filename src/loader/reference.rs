@@ -146,6 +146,12 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
             Some(format!("{} {} {}", num(x), num(y), num(z))),
         ),
         ParamKind::Floats => ("float list".to_string(), None),
+        ParamKind::SpectrumOrFloat(d) => (
+            "spectrum or float".to_string(),
+            Some(spectrum(SpectrumDefault::Rgb(d))),
+        ),
+        ParamKind::IntOpt => ("integer".to_string(), None),
+        ParamKind::Image(_) => ("string: an image file".to_string(), None),
     };
     (
         format!("{ty}{nonneg}"),
@@ -295,6 +301,62 @@ pub fn samplers_section() -> String {
 pub fn cameras_section() -> String {
     let (b, e) = markers("render::camera::CAMERAS", "cameras");
     kinds_section((&b, &e), crate::render::camera::CAMERAS)
+}
+
+/// The line that opens the generated lights section.
+pub const LIGHTS_BEGIN: &str = "<!-- BEGIN generated from render::lights::LIGHTS and AREA_LIGHTS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+/// The line that closes it.
+pub const LIGHTS_END: &str = "<!-- END generated lights -->";
+
+/// The lights section, between its markers (both included), from
+/// [`LIGHTS`](crate::render::lights::LIGHTS) (`LightSource`) and
+/// [`AREA_LIGHTS`](crate::render::lights::AREA_LIGHTS) (`AreaLightSource`).
+pub fn lights_section() -> String {
+    use crate::render::lights::{AREA_LIGHTS, LIGHTS};
+    use crate::scene::Kind;
+    fn title<B>(k: &Kind<B>) -> String {
+        let mut t = format!("`{}`", k.name);
+        for a in k.aliases {
+            let _ = write!(t, " (alias `{a}`)");
+        }
+        t
+    }
+    fn kind<B>(out: &mut String, what: &str, k: &Kind<B>) {
+        let _ = write!(out, "\n### {what} {}\n\n{}\n", title(k), sentence(k.doc));
+        out.push_str("\n| parameter | type | default | meaning |\n|---|---|---|---|\n");
+        for p in k.params {
+            let (ty, default) = describe(p);
+            let _ = writeln!(out, "| `{}` | {ty} | {default} | {} |", p.name, cell(p.doc));
+        }
+    }
+    let mut out = String::new();
+    out.push_str(LIGHTS_BEGIN);
+    out.push('\n');
+    for k in LIGHTS.iter().filter(|k| k.is_supported()) {
+        kind(&mut out, "LightSource", k);
+    }
+    for k in AREA_LIGHTS.iter().filter(|k| k.is_supported()) {
+        kind(&mut out, "AreaLightSource", k);
+    }
+    out.push_str("\n### Known to pbrt-v3, not rendered by pbrs\n\n");
+    out.push_str("A warning (`light \"…\" is not supported by pbrs: ignored`), and the light is skipped; its parameters are not reported as unused.\n\n");
+    out.push_str("| type | what it is |\n|---|---|\n");
+    let unsupported = LIGHTS
+        .iter()
+        .filter_map(|k| Some((k.name, k.unsupported()?)))
+        .chain(
+            AREA_LIGHTS
+                .iter()
+                .filter_map(|k| Some((k.name, k.unsupported()?))),
+        );
+    for (name, why) in unsupported {
+        let _ = writeln!(out, "| `{name}` | {} |", cell(why));
+    }
+    out.push_str("\nAn unknown `LightSource` type gives a warning (with a \"did you mean\" when a known type is close) and is ignored; an unknown `AreaLightSource` type gives a warning, and the shapes after it in its scope do not emit.\n");
+    out.push('\n');
+    out.push_str(LIGHTS_END);
+    out.push('\n');
+    out
 }
 
 /// `doc` with the part from the line `begin_marker` to the line

@@ -104,7 +104,7 @@ pub struct Builder<'s, 'c> {
     material_ids: HashMap<Option<usize>, MaterialId>,
     material_keys: HashMap<String, MaterialId>,
     reported_materials: HashSet<Option<usize>>,
-    area_lights: HashMap<usize, AreaLightDesc>,
+    area_lights: HashMap<usize, Option<DiffuseEmission>>,
     named_material_defs: Vec<(String, Rc<MaterialSpec>)>,
     pub meshes: HashMap<std::path::PathBuf, Option<Arc<MeshData>>>,
     /// Shared MIP maps and texture counts.
@@ -117,7 +117,7 @@ pub struct Builder<'s, 'c> {
     /// The most lobes each scene material can add to a BSDF.
     material_lobes: Vec<usize>,
     pub shapes: Vec<ShapeDesc>,
-    pub lights: Vec<LightDesc>,
+    pub lights: Vec<Light>,
     pub scene_objects: Vec<ObjectDesc>,
     pub instances: Vec<InstanceDesc>,
     pub skipped: Vec<String>,
@@ -510,6 +510,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 }
                 if !self.ctm[0].is_finite() {
                     self.ctx.error(s.loc, "the light's transform has non-finite entries (overflow in the transform statements)", "this LightSource", None);
+                    self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
                 } else if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
                     // pbrt-v3 resolves the interface for every light (its
                     // media matter to bdpt only): undefined names are errors.
@@ -521,18 +522,10 @@ impl<'s, 'c> Builder<'s, 'c> {
                     }
                     self.lights.push(l);
                 }
-                self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
             }
             K::AreaLightSource => {
                 let Directive::Entity { name, params } = &s.dir else { return };
-                match name.value.as_str() {
-                    "diffuse" | "area" => self.graphics.area_light = Some((i, name.loc)),
-                    other => {
-                        params.mark_all_used();
-                        self.ctx.warn(name.loc, format!("unknown area light \"{other}\" (pbrt-v3 has \"diffuse\", alias \"area\"): ignored, later shapes are not emissive"), "not an area light type");
-                        self.graphics.area_light = None;
-                    }
-                }
+                self.graphics.area_light = entities::area_light_known(self.ctx, name, params).then_some((i, name.loc));
             }
             K::Shape => self.shape(i, s),
             K::MakeNamedMedium => {
@@ -813,7 +806,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             _ => (None, None),
         };
         let material = self.material_for_shape(&g.material, params, &g.textures);
-        let mut area_light = area.map(|a| self.area_light(a));
+        let mut area_light = area.and_then(|a| self.area_light(a));
         if matches!(geometry, Geometry::Curve(_)) && area_light.is_some() {
             // pbrt-v3 aborts when it samples one (`Curve::Sample`).
             self.ctx.warn(stmts[i].loc, "an area light on a curve is not supported by pbrs (pbrt-v3 cannot sample curves): the curve does not emit", "this curve is not emissive");
@@ -892,7 +885,9 @@ impl<'s, 'c> Builder<'s, 'c> {
         Some(id)
     }
 
-    fn area_light(&mut self, i: usize) -> AreaLightDesc {
+    /// The emission of `AreaLightSource` statement `i`, read at its first
+    /// use.
+    fn area_light(&mut self, i: usize) -> Option<DiffuseEmission> {
         if let Some(a) = self.area_lights.get(&i) {
             return *a;
         }
@@ -900,9 +895,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         let Directive::Entity { name, params } = &stmts[i].dir else {
             unreachable!("area light statement")
         };
-        let a = entities::area_light(self.ctx, params);
-        self.ctx
-            .report_unused(params, &format!("AreaLightSource \"{}\"", name.value));
+        let a = entities::area_light(self.ctx, name, params);
         self.area_lights.insert(i, a);
         a
     }

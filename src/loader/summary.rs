@@ -120,13 +120,7 @@ impl Summary {
             s.alpha_shapes += usize::from(sh.alpha.is_some() || sh.shadow_alpha.is_some());
         }
         for l in &scene.lights {
-            let k = match l {
-                LightDesc::Point { .. } => "point",
-                LightDesc::Spot { .. } => "spot",
-                LightDesc::Distant { .. } => "distant",
-                LightDesc::Infinite { .. } => "infinite",
-            };
-            *s.lights_by_type.entry(k).or_default() += 1;
+            *s.lights_by_type.entry(l.name()).or_default() += 1;
         }
         for k in material_kinds {
             match k {

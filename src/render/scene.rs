@@ -4,18 +4,15 @@
 
 use crate::render::accel::{Geometry, Instance, MovingInstance, Object};
 use crate::render::camera::Camera;
-use crate::render::geometry::Frame;
-use crate::render::lights::{AreaShape, EnvMap, Light, TriangleCache};
+use crate::render::lights::{AreaShape, DiffuseEmission, DiffuseLight, Light};
 use crate::render::materials::{link_materials, Material};
 use crate::render::media::Medium;
 use crate::render::shapes::{
     AlphaMask, Cone, Curve, CurveCommon, Cylinder, Disk, Hyperboloid, Paraboloid, Quadric, Sphere,
     TriangleMesh,
 };
-use crate::scene::{
-    self, AreaLightDesc, LightDesc, MediumInterfaceDesc, SceneDescription, ShapeDesc,
-};
-use glam::{DMat3, DMat4, DVec3, Vec3};
+use crate::scene::{self, MediumInterfaceDesc, SceneDescription, ShapeDesc};
+use glam::{DMat3, DMat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -102,7 +99,7 @@ impl RenderScene {
         let slots = slots;
         let mut meshes = Vec::new();
         let mut quadrics = Vec::new();
-        let mut area: Vec<(AreaShape, AreaLightDesc)> = Vec::new();
+        let mut area: Vec<(AreaShape, DiffuseEmission)> = Vec::new();
         let mut notes = Vec::new();
 
         let mut add_shape = |s: &ShapeDesc, to_world: DMat4| {
@@ -225,87 +222,17 @@ impl RenderScene {
             notes.push("no geometry: no BVH built".into());
         }
 
-        let (_, scene_radius) = geometry.bounds.bounding_sphere();
         let mut lights: Vec<Light> = area
             .iter()
-            .map(|&(shape, a)| {
-                let area = match shape {
-                    AreaShape::Triangle { mesh, tri } => geometry.meshes[mesh as usize].area(tri),
-                    AreaShape::Quadric(i) => geometry.quadrics[i as usize].area(),
-                };
-                let tri = match shape {
-                    AreaShape::Triangle { mesh, tri } => TriangleCache::new(&geometry, mesh, tri),
-                    AreaShape::Quadric(_) => TriangleCache::default(),
-                };
-                Light::Area {
-                    shape,
-                    l: a.l,
-                    two_sided: a.two_sided,
-                    n_samples: a.n_samples.max(1),
-                    area,
-                    tri,
-                }
-            })
+            .map(|&(shape, a)| DiffuseLight::new(a, shape, &geometry).into())
             .collect();
         let mut infinite_lights = Vec::new();
         for l in &desc.lights {
-            let light = match *l {
-                LightDesc::Point {
-                    position,
-                    intensity,
-                } => Light::Point {
-                    p: position.as_vec3(),
-                    intensity,
-                },
-                LightDesc::Spot {
-                    light_to_world,
-                    intensity,
-                    cone_angle,
-                    cone_delta_angle,
-                } => {
-                    let p = light_to_world.transform_point3(DVec3::ZERO).as_vec3();
-                    let dir = light_to_world
-                        .transform_vector3(DVec3::Z)
-                        .normalize()
-                        .as_vec3();
-                    let cos_total = cone_angle.to_radians().cos();
-                    let cos_falloff_start = (cone_angle - cone_delta_angle).to_radians().cos();
-                    Light::Spot {
-                        p,
-                        frame: Frame::from_normal(dir),
-                        intensity,
-                        cos_total,
-                        cos_falloff_start,
-                    }
-                }
-                LightDesc::Distant {
-                    radiance,
-                    direction,
-                } => Light::Distant {
-                    w: direction.normalize().as_vec3(),
-                    l: radiance,
-                    scene_radius,
-                },
-                LightDesc::Infinite {
-                    radiance,
-                    ref image,
-                    light_to_world,
-                    n_samples,
-                    sampling,
-                } => {
-                    infinite_lights.push(lights.len() as u32);
-                    Light::Infinite {
-                        n_samples,
-                        scene_radius,
-                        map: Arc::new(EnvMap::new(
-                            image.as_deref(),
-                            radiance,
-                            light_to_world,
-                            sampling,
-                        )),
-                    }
-                }
-            };
+            let mut light = l.clone();
+            light.preprocess(&geometry);
+            if light.is_infinite() {
+                infinite_lights.push(lights.len() as u32);
+            }
             lights.push(light);
         }
         let zero = lights.iter().filter(|l| l.power() <= 0.0).count();

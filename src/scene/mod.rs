@@ -21,7 +21,8 @@ pub use motion::AnimatedTransform;
 pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};
 
-use glam::{DMat4, DVec3, Vec2, Vec3};
+pub use crate::render::lights::{DiffuseEmission, Light};
+use glam::{DMat4, Vec2, Vec3};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -37,8 +38,10 @@ pub struct SceneDescription {
     pub materials: Vec<MaterialDesc>,
     /// Shapes in world space (their `object_to_world` maps to world).
     pub shapes: Vec<ShapeDesc>,
-    /// Lights other than area lights (area lights live on their shapes).
-    pub lights: Vec<LightDesc>,
+    /// Lights other than area lights (area lights live on their shapes),
+    /// as their kinds built them (what depends on the whole scene is set
+    /// when it is built: `Light::preprocess`).
+    pub lights: Vec<Light>,
     /// Object definitions that are instanced at least once.
     pub objects: Vec<ObjectDesc>,
     /// Placements of objects.
@@ -205,14 +208,6 @@ impl MaterialDesc {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AreaLightDesc {
-    /// Emitted radiance, `L` times `scale`.
-    pub l: Vec3,
-    pub two_sided: bool,
-    pub n_samples: u32,
-}
-
 #[derive(Clone, Debug)]
 pub struct ShapeDesc {
     pub geometry: Geometry,
@@ -223,7 +218,10 @@ pub struct ShapeDesc {
     pub motion: Option<Arc<AnimatedTransform>>,
     pub reverse_orientation: bool,
     pub material: MaterialId,
-    pub area_light: Option<AreaLightDesc>,
+    /// What the `AreaLightSource` in scope says (each of the shape's
+    /// triangles, or the shape, becomes a `DiffuseLight` when the scene is
+    /// built).
+    pub area_light: Option<DiffuseEmission>,
     /// pbrt-v3's `alpha` mask (triangle meshes): hits where it is 0 are
     /// ignored by every ray. `None`: no test.
     pub alpha: Option<FloatTex>,
@@ -331,43 +329,6 @@ impl MeshData {
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
-}
-
-#[derive(Clone, Debug)]
-pub enum LightDesc {
-    /// Position in world space, intensity `I`·`scale`.
-    Point { position: DVec3, intensity: Vec3 },
-    Spot {
-        /// Light-to-world, already including the from/to frame.
-        light_to_world: DMat4,
-        intensity: Vec3,
-        /// Degrees.
-        cone_angle: f32,
-        cone_delta_angle: f32,
-    },
-    /// `direction` is the world-space direction the light travels *from*
-    /// (pbrt's `from - to`, transformed), normalised.
-    Distant { radiance: Vec3, direction: DVec3 },
-    /// pbrt-v3's `InfiniteAreaLight`: `radiance` is `L`·`scale`; `image`
-    /// the lat-long map as read (raw values, top row = light-space +z),
-    /// multiplied by `radiance` when the light is built.
-    Infinite {
-        radiance: Vec3,
-        image: Option<Arc<RgbImage>>,
-        light_to_world: DMat4,
-        n_samples: u32,
-        sampling: EnvSampling,
-    },
-}
-
-/// How an infinite light samples directions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum EnvSampling {
-    /// pbrt-v3's: the map's luminance times sin θ.
-    Map,
-    /// Uniformly over the sphere: the pbrs extension `"string sampling"
-    /// "uniform"`, to compare against importance sampling.
-    Uniform,
 }
 
 #[derive(Clone, Debug)]

@@ -73,6 +73,16 @@ pub enum ParamKind {
     Point3([f32; 3]),
     /// A list of floats of any length, e.g. a grid medium's `density`.
     Floats,
+    /// A plain spectrum, or a `float` taken as a grey (a light's `scale`:
+    /// a spectrum in pbrt-v3, a float too in pbrs).
+    SpectrumOrFloat([f32; 3]),
+    /// An integer without a default: absent unless given (the entity
+    /// decides, e.g. `samples`, which defaults to `nsamples`).
+    IntOpt,
+    /// An image file, read (once per scene) and converted as the `Decode`
+    /// says; absent when not given or empty (a file that cannot be read is
+    /// an error).
+    Image(super::Decode),
 }
 
 /// A constraint the loader checks on constant values (with a located
@@ -300,6 +310,47 @@ impl ParamSpec {
             doc,
         }
     }
+    /// A plain spectrum of any sign (a light's `L`).
+    pub const fn spectrum_any(
+        name: &'static str,
+        default: [f32; 3],
+        doc: &'static str,
+    ) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Spectrum(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn spectrum_or_float(
+        name: &'static str,
+        default: [f32; 3],
+        doc: &'static str,
+    ) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::SpectrumOrFloat(default),
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn int_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::IntOpt,
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn image(name: &'static str, decode: super::Decode, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::Image(decode),
+            range: Range::Any,
+            doc,
+        }
+    }
     /// pbrt-v3's `bumpmap`: a float texture of displacements along the
     /// shading normal, applied by `Material::bsdf_into` for every material.
     pub const BUMPMAP: ParamSpec = ParamSpec::float_tex_opt(
@@ -326,6 +377,8 @@ pub enum ParamValue {
     Point(glam::DVec3),
     /// A list of numbers, as written (`ParamKind::Floats`).
     Floats(Arc<[f64]>),
+    /// An image as read (`ParamKind::Image`).
+    Image(Arc<super::RgbImage>),
 }
 
 /// The values of one entity's parameters, by name (absent: no value and no
@@ -399,6 +452,20 @@ impl ParamValues {
         match self.get(name) {
             Some(ParamValue::Int(i)) => *i,
             v => panic!("parameter \"{name}\" is {v:?}, not an integer"),
+        }
+    }
+    pub fn int_opt(&self, name: &str) -> Option<i32> {
+        match self.get(name) {
+            Some(ParamValue::Int(i)) => Some(*i),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not an integer"),
+        }
+    }
+    pub fn image(&self, name: &str) -> Option<Arc<super::RgbImage>> {
+        match self.get(name) {
+            Some(ParamValue::Image(i)) => Some(i.clone()),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not an image"),
         }
     }
     pub fn vector(&self, name: &str) -> Vec3 {

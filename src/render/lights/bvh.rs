@@ -13,9 +13,9 @@
 //! rest of the time. Point and spot lights are in the tree (a point with a
 //! sphere or cone of directions).
 
-use super::{AreaShape, Light};
+use super::Light;
 use crate::render::accel::Geometry;
-use crate::render::geometry::{luminance, Bounds3};
+use crate::render::geometry::Bounds3;
 use crate::render::sampling::ONE_MINUS_EPSILON;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -40,7 +40,7 @@ fn safe_sqrt(x: f32) -> f32 {
 }
 
 #[inline]
-fn safe_acos(x: f32) -> f32 {
+pub(super) fn safe_acos(x: f32) -> f32 {
     x.clamp(-1.0, 1.0).acos()
 }
 
@@ -157,76 +157,14 @@ fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
     (w.normalize(), theta_o.cos())
 }
 
-/// The bounds of a light, None for lights at infinity (distant, infinite)
-/// and lights that emit nothing.
+/// The bounds of a light (each kind's [`LightModel::bounds`](super::LightModel::bounds)),
+/// None for lights at infinity (distant, infinite) and lights that emit
+/// nothing.
 pub fn light_bounds(light: &Light, geom: &Geometry) -> Option<LightBounds> {
-    // pbrt-v4's phi: L·area (twice for two-sided) for area lights, 4π·I
-    // for point and spot lights.
-    let phi = match *light {
-        Light::Area {
-            l, two_sided, area, ..
-        } => luminance(l) * area * if two_sided { 2.0 } else { 1.0 },
-        Light::Point { intensity, .. } | Light::Spot { intensity, .. } => {
-            4.0 * PI * luminance(intensity)
-        }
-        _ => 0.0,
-    };
-    if !(phi > 0.0 && phi.is_finite()) {
+    let b = light.bounds(geom)?;
+    if !(b.phi > 0.0 && b.phi.is_finite()) {
         return None;
     }
-    let b = match *light {
-        Light::Area {
-            shape,
-            two_sided,
-            tri,
-            ..
-        } => {
-            let (bounds, w, cos_theta_o) = match shape {
-                AreaShape::Triangle { .. } => {
-                    let bounds = Bounds3::from_point(tri.p[0])
-                        .union_point(tri.p[1])
-                        .union_point(tri.p[2]);
-                    if tri.n != Vec3::ZERO {
-                        (bounds, tri.n, 1.0)
-                    } else {
-                        (bounds, Vec3::Z, -1.0)
-                    }
-                }
-                AreaShape::Quadric(i) => (geom.quadrics[i as usize].bounds(), Vec3::Z, -1.0),
-            };
-            LightBounds {
-                bounds,
-                w,
-                phi,
-                cos_theta_o,
-                cos_theta_e: 0.0,
-                two_sided,
-            }
-        }
-        Light::Point { p, .. } => LightBounds {
-            bounds: Bounds3::from_point(p),
-            w: Vec3::Z,
-            phi,
-            cos_theta_o: -1.0,
-            cos_theta_e: 0.0,
-            two_sided: false,
-        },
-        Light::Spot {
-            p,
-            frame,
-            cos_total,
-            cos_falloff_start,
-            ..
-        } => LightBounds {
-            bounds: Bounds3::from_point(p),
-            w: frame.n,
-            phi,
-            cos_theta_o: cos_falloff_start,
-            cos_theta_e: (safe_acos(cos_total) - safe_acos(cos_falloff_start)).cos(),
-            two_sided: false,
-        },
-        Light::Distant { .. } | Light::Infinite { .. } => return None,
-    };
     (b.bounds.min.is_finite() && b.bounds.max.is_finite()).then_some(b)
 }
 
@@ -267,10 +205,7 @@ impl LightBvh {
             match light_bounds(&lights[i as usize], geom) {
                 Some(b) => items.push((i, b)),
                 None => {
-                    if matches!(
-                        lights[i as usize],
-                        Light::Distant { .. } | Light::Infinite { .. }
-                    ) {
+                    if lights[i as usize].at_infinity() {
                         infinite.push(i);
                         is_infinite[i as usize] = true;
                     }

@@ -1,14 +1,16 @@
-//! The infinite area light (pbrt-v3's `InfiniteAreaLight`): radiance from
-//! every direction, from an equal-area-in-(φ, θ) lat-long map times `L`
-//! (`L` × `scale`), or `L` alone without a map.
+//! `infinite` (alias `exinfinite`): the infinite area light (pbrt-v3's
+//! `InfiniteAreaLight`): radiance from every direction, from an
+//! equal-area-in-(φ, θ) lat-long map times `L` (`L` × `scale`), or `L`
+//! alone without a map.
 //!
-//! | parameter | type | pbrt-v3 default |
-//! |---|---|---|
-//! | `L` | spectrum | 1 |
-//! | `scale` | spectrum | 1 |
-//! | `mapname` | string (file) | none: constant `L` |
-//! | `samples` / `nsamples` | integer | 1 |
-//! | `sampling` | string: `"map"` or `"uniform"` | `"map"` (**pbrs extension**) |
+//! | parameter | type | pbrt-v3 default | |
+//! |---|---|---|---|
+//! | `L` | spectrum | 1 | radiance (times the map) |
+//! | `scale` | spectrum | 1 | multiplies `L`; a spectrum only, as pbrt-v3 (a `float scale` is unused) |
+//! | `mapname` | string (image file) | none: constant `L` | lat-long map, read raw |
+//! | `nsamples` | integer | 1 | shadow samples for `directlighting` "all" |
+//! | `samples` | integer | `nsamples` | the same; wins over `nsamples` |
+//! | `sampling` | string: `"map"` or `"uniform"` | `"map"` | how directions are sampled (**pbrs extension**) |
 //!
 //! As pbrt-v3 does it:
 //! - The map is read raw (8-bit files are not sRGB-decoded) and multiplied
@@ -24,21 +26,168 @@
 //!   0.5 / min(2w, 2h))` (a filtered lookup, usually bilinear on level 0)
 //!   of the luminance times sin θ; the solid-angle density is
 //!   `pdf(s, t) / (2π² sin θ)`, 0 at the poles.
-//! - Power: `π r² · Lookup((0.5, 0.5), 0.5)`, r the scene's bounding radius.
+//! - Power: `π r² · Lookup((0.5, 0.5), 0.5)`, r the scene's bounding radius
+//!   (set when the scene is built, [`LightModel::preprocess`]).
 //! - A one-pixel map is the same as no map: both are a 1 × 1 MIP map.
 //!
 //! `sampling "uniform"` samples the sphere uniformly instead (density
-//! 1/4π), for comparisons with the importance-sampled map (`pbrs converge`).
-//! Directions leave the light's transform normalised (pbrt-v3 leaves them
-//! as transformed, which differs only for a transform that scales).
+//! 1/4π), for comparisons with the importance-sampled map (`pbrs converge`);
+//! another value: warning, `"map"`. Directions leave the light's transform
+//! normalised (pbrt-v3 leaves them as transformed, which differs only for a
+//! transform that scales).
 
-use crate::render::geometry::luminance;
+use super::{LightKind, LightModel, LightSample};
+use crate::render::accel::Geometry;
+use crate::render::geometry::spawn_ray;
+use crate::render::geometry::{luminance, Ray};
 use crate::render::sampling::{uniform_sample_sphere, uniform_sphere_pdf, Distribution2D};
-pub use crate::scene::EnvSampling;
+use crate::render::shapes::SurfacePoint;
 use crate::scene::RgbImage;
+use crate::scene::{Decode, ParamSpec, ParamValues, Report, Support};
 use glam::{DMat4, Mat3, Vec2, Vec3};
 use rayon::prelude::*;
 use std::f32::consts::PI;
+use std::sync::Arc;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::spectrum_any("L", [1.0; 3], "radiance, times the map's values"),
+    ParamSpec::spectrum_any(
+        "scale",
+        [1.0; 3],
+        "multiplies L (a spectrum only, as pbrt-v3: a float scale is unused)",
+    ),
+    ParamSpec::image(
+        "mapname",
+        Decode::Raw,
+        "lat-long environment map (values read raw, top row +z); none: constant L",
+    ),
+    ParamSpec::int(
+        "nsamples",
+        1,
+        "shadow samples for directlighting's \"all\" strategy (at least 1)",
+    ),
+    ParamSpec::int_opt("samples", "the same as nsamples, which it overrides"),
+    ParamSpec::string(
+        "sampling",
+        "map",
+        "pbrs extension: \"map\" (importance by the map, pbrt-v3's) or \"uniform\" (the sphere uniformly)",
+    ),
+];
+
+pub const KIND: LightKind = LightKind {
+    name: "infinite",
+    aliases: &["exinfinite"],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "radiance L·scale from every direction, times a lat-long environment map when mapname is given",
+    build: |p, ctm, report| Some(InfiniteLight::new(p, ctm, report).into()),
+};
+
+/// The most shadow samples a light takes (the loader's sample limit).
+const MAX_SAMPLES: i32 = 1 << 24;
+
+/// How an infinite light samples directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvSampling {
+    /// pbrt-v3's: the map's luminance times sin θ.
+    Map,
+    /// Uniformly over the sphere: the pbrs extension `"string sampling"
+    /// "uniform"`, to compare against importance sampling.
+    Uniform,
+}
+
+#[derive(Clone, Debug)]
+pub struct InfiniteLight {
+    pub n_samples: u32,
+    /// The scene's bounding radius (0 until [`LightModel::preprocess`]).
+    pub scene_radius: f32,
+    pub map: Arc<EnvMap>,
+}
+
+impl InfiniteLight {
+    /// pbrt-v3's `CreateInfiniteLight`, with `ctm` as light-to-world.
+    pub fn new(p: &ParamValues, ctm: DMat4, report: &mut dyn Report) -> InfiniteLight {
+        let l = p.spectrum("L") * p.spectrum("scale");
+        let n = p.int_opt("samples").unwrap_or(p.int("nsamples"));
+        let sampling = match p.string("sampling") {
+            "map" => EnvSampling::Map,
+            "uniform" => EnvSampling::Uniform,
+            other => {
+                report.warn(
+                    Some("sampling"),
+                    format!("unknown infinite light sampling \"{other}\" (pbrs has \"map\" and \"uniform\"): \"map\" is used"),
+                    "unknown sampling",
+                );
+                EnvSampling::Map
+            }
+        };
+        let image = p.image("mapname");
+        InfiniteLight {
+            n_samples: n.clamp(1, MAX_SAMPLES) as u32,
+            scene_radius: 0.0,
+            map: Arc::new(EnvMap::new(image.as_deref(), l, ctm, sampling)),
+        }
+    }
+}
+
+impl LightModel for InfiniteLight {
+    #[inline]
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn is_infinite(&self) -> bool {
+        true
+    }
+
+    fn at_infinity(&self) -> bool {
+        true
+    }
+
+    fn n_samples(&self) -> u32 {
+        self.n_samples.max(1)
+    }
+
+    fn n_samples_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.n_samples)
+    }
+
+    fn power(&self) -> Vec3 {
+        self.map.power_radiance() * PI * self.scene_radius * self.scene_radius
+    }
+
+    #[inline]
+    fn le(&self, d: Vec3) -> Vec3 {
+        self.map.le(d)
+    }
+
+    #[inline]
+    fn sample_li(&self, r: &SurfacePoint, u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+        let (wi, li, pdf) = self.map.sample(u)?;
+        // Anything in the way occludes an infinitely distant light.
+        let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
+        Some(LightSample {
+            li,
+            wi,
+            pdf,
+            shadow,
+        })
+    }
+
+    #[inline]
+    fn pdf_li(&self, _r: &SurfacePoint, wi: Vec3, _geom: &Geometry) -> f32 {
+        self.map.pdf(wi)
+    }
+
+    #[inline]
+    fn pdf_li_ray(&self, _r: &SurfacePoint, ray: &Ray, _geom: &Geometry) -> f32 {
+        self.map.pdf(ray.d)
+    }
+
+    fn preprocess(&mut self, geom: &Geometry) {
+        self.scene_radius = geom.bounds.bounding_sphere().1;
+    }
+}
 
 /// One level of the MIP map: RGB texels, row-major, row 0 at t = 0.
 #[derive(Clone, Debug)]
@@ -292,6 +441,11 @@ impl EnvMap {
             return 0.0;
         }
         self.distribution.pdf(st) / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// Width and height of the map's finest level (a power of two each).
+    pub fn size(&self) -> (usize, usize) {
+        (self.levels[0].w, self.levels[0].h)
     }
 
     /// Radiance for pbrt-v3's `Power` (times π r² there): the map filtered

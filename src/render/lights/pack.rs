@@ -4,7 +4,8 @@
 //! light `4k + i`; a pack's unused lanes repeat its first light and are
 //! masked off by `count`.
 
-use super::{AreaShape, Light, HIT_SLACK};
+use super::diffuse::HIT_SLACK;
+use super::{AreaShape, DiffuseLight, Light};
 use crate::render::geometry::gamma;
 use glam::{BVec4A, Vec3, Vec4};
 
@@ -66,14 +67,14 @@ pub fn pack_triangle_lights(lights: &[Light]) -> Option<Vec<TriangleLightPack>> 
         let mut lanes = Vec::with_capacity(4);
         for light in chunk {
             match *light {
-                Light::Area {
+                Light::Diffuse(DiffuseLight {
                     shape: AreaShape::Triangle { .. },
                     l,
                     two_sided,
                     area,
                     tri,
                     ..
-                } if tri.n != Vec3::ZERO => lanes.push((tri, l, two_sided, area)),
+                }) if tri.n != Vec3::ZERO => lanes.push((tri, l, two_sided, area)),
                 _ => return None,
             }
         }
