@@ -50,8 +50,8 @@ fn subsurface_defaults_and_presets() {
     let (sa, ss) = m.coefficients(&at.sc());
     assert_eq!(sa, Vec3::new(0.0011, 0.0024, 0.014));
     assert_eq!(ss, Vec3::new(2.55, 3.21, 3.77));
-    assert_eq!((m.g, m.eta), (0.0, 1.33));
-    assert_eq!(m.table.rho_eff.len(), RHO_SAMPLES);
+    assert_eq!((m.boundary.g, m.boundary.eta), (0.0, 1.33));
+    assert_eq!(m.boundary.table.rho_eff.len(), RHO_SAMPLES);
 
     // A preset sets both coefficients (σ′s as σs), forces g = 0; scale
     // multiplies; a given sigma_a overrides the preset's.
@@ -71,7 +71,7 @@ fn subsurface_defaults_and_presets() {
         panic!()
     };
     let (sa, ss) = m.coefficients(&at.sc());
-    assert_eq!(m.g, 0.0);
+    assert_eq!(m.boundary.g, 0.0);
     assert_eq!(sa, Vec3::splat(5.0));
     assert_eq!(ss, 10.0 * Vec3::from(skim.sigma_prime_s));
     assert!(pbrs::render::materials::Subsurface::load_warnings(&params(k, vec![])).is_empty());

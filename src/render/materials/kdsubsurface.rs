@@ -18,9 +18,9 @@
 //!
 //! The boundary is `glass`'s BSDF with `eta`, as for `subsurface`.
 
-use super::{BsdfContext, Glass, Material, MaterialKind, ShadingContext, Support};
-use crate::render::bssrdf::{subsurface_from_diffuse, BssrdfTable};
-use crate::render::bxdf::Bsdf;
+use super::subsurface::Boundary;
+use super::{Material, MaterialKind, ShadingContext, Support};
+use crate::render::bssrdf::subsurface_from_diffuse;
 use crate::scene::{ParamSpec, ParamValues, SpectrumTex};
 use glam::Vec3;
 use std::sync::Arc;
@@ -55,54 +55,32 @@ pub const KIND: MaterialKind = MaterialKind {
 
 #[derive(Clone, Debug)]
 pub struct KdSubsurface {
-    pub boundary: Glass,
+    pub boundary: Boundary,
     pub kd: SpectrumTex,
     pub mfp: SpectrumTex,
-    pub scale: f32,
-    pub g: f32,
-    pub eta: f32,
-    pub table: Arc<BssrdfTable>,
 }
 
 impl KdSubsurface {
     pub fn new(p: &ParamValues) -> KdSubsurface {
-        let (g, eta) = (p.float("g"), p.float("eta"));
         KdSubsurface {
-            boundary: Glass::with_eta(p, eta),
+            boundary: Boundary::new(p, p.float("g")),
             kd: p.spectrum_tex("Kd").expect("default"),
             mfp: p.spectrum_tex("mfp").expect("default"),
-            scale: p.float("scale"),
-            g,
-            eta,
-            table: Arc::new(BssrdfTable::beam_diffusion(g, eta)),
         }
     }
 
-    pub fn anisotropic(&self) -> bool {
-        self.boundary.anisotropic()
-    }
-
     pub fn needs_geom(&self) -> bool {
-        self.boundary.needs_geom()
+        self.boundary.glass.needs_geom()
             || self.kd.as_constant().is_none()
             || self.mfp.as_constant().is_none()
-    }
-
-    pub fn max_lobes(&self) -> usize {
-        self.boundary.max_lobes()
-    }
-
-    #[inline]
-    pub fn scatter(&self, sc: &ShadingContext, ctx: &BsdfContext, bsdf: &mut Bsdf) {
-        self.boundary.scatter(sc, ctx, bsdf);
     }
 
     /// The medium's `(sigma_a, sigma_s)` at a hit: the albedo whose
     /// tabulated effective albedo is `Kd` (clamped to ≥ 0), over `scale · mfp`.
     #[inline]
     pub fn coefficients(&self, sc: &ShadingContext) -> (Vec3, Vec3) {
-        let mfp = self.scale * self.mfp.eval(sc).max(Vec3::ZERO);
+        let mfp = self.boundary.scale * self.mfp.eval(sc).max(Vec3::ZERO);
         let kd = self.kd.eval(sc).max(Vec3::ZERO);
-        subsurface_from_diffuse(&self.table, kd, mfp)
+        subsurface_from_diffuse(&self.boundary.table, kd, mfp)
     }
 }

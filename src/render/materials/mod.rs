@@ -213,8 +213,8 @@ impl Material {
             Material::Uber(m) => m.anisotropic(),
             Material::Bumped(b) => b.material.anisotropic(),
             Material::Disney(m) => m.anisotropic(),
-            Material::Subsurface(m) => m.anisotropic(),
-            Material::KdSubsurface(m) => m.anisotropic(),
+            Material::Subsurface(m) => m.boundary.anisotropic(),
+            Material::KdSubsurface(m) => m.boundary.anisotropic(),
             // pbrt-v3's FourierBSDF is isotropic.
             Material::Matte(_)
             | Material::Plastic(_)
@@ -241,8 +241,8 @@ impl Material {
             Material::Uber(m) => m.max_lobes(),
             Material::Disney(m) => m.max_lobes(),
             Material::Fourier(m) => m.max_lobes(),
-            Material::Subsurface(m) => m.max_lobes(),
-            Material::KdSubsurface(m) => m.max_lobes(),
+            Material::Subsurface(m) => m.boundary.max_lobes(),
+            Material::KdSubsurface(m) => m.boundary.max_lobes(),
             Material::None => 0,
             Material::Bumped(b) => b.material.max_lobes(lobes_of),
         }
@@ -266,14 +266,8 @@ impl Material {
     /// then never find a hit of that material, so its paths end there).
     pub fn bssrdf<'a>(&'a self, sc: &ShadingContext) -> Option<TabulatedBssrdf<'a>> {
         match self {
-            Material::Subsurface(m) => {
-                let (sa, ss) = m.coefficients(sc);
-                Some(TabulatedBssrdf::new(&m.table, sa, ss, m.eta))
-            }
-            Material::KdSubsurface(m) => {
-                let (sa, ss) = m.coefficients(sc);
-                Some(TabulatedBssrdf::new(&m.table, sa, ss, m.eta))
-            }
+            Material::Subsurface(m) => Some(m.boundary.bssrdf(m.coefficients(sc))),
+            Material::KdSubsurface(m) => Some(m.boundary.bssrdf(m.coefficients(sc))),
             Material::Bumped(b) => b.material.bssrdf(sc),
             _ => None,
         }
@@ -366,8 +360,8 @@ impl Material {
             Material::Uber(m) => m.scatter(sc, bsdf),
             Material::Disney(m) => m.scatter(sc, bsdf),
             Material::Fourier(m) => m.scatter(sc, bsdf),
-            Material::Subsurface(m) => m.scatter(sc, ctx, bsdf),
-            Material::KdSubsurface(m) => m.scatter(sc, ctx, bsdf),
+            Material::Subsurface(m) => m.boundary.scatter(sc, ctx, bsdf),
+            Material::KdSubsurface(m) => m.boundary.scatter(sc, ctx, bsdf),
             Material::None => {}
             // The caller bumped the hit if this material leads the BSDF
             // (see `leading_bump`); a mix's second material's bump map

@@ -27,7 +27,7 @@
 //! for its `g` and `eta`).
 
 use super::{BsdfContext, Glass, Material, MaterialKind, ShadingContext, Support};
-use crate::render::bssrdf::BssrdfTable;
+use crate::render::bssrdf::{BssrdfTable, TabulatedBssrdf};
 use crate::render::bxdf::Bsdf;
 use crate::render::media::presets;
 use crate::scene::{ParamSpec, ParamValues, SpectrumTex};
@@ -77,16 +77,55 @@ pub const KIND: MaterialKind = MaterialKind {
     build: |p| Material::Subsurface(Arc::new(Subsurface::new(p))),
 };
 
+/// What `subsurface` and `kdsubsurface` share besides their coefficients:
+/// the dielectric boundary (`Kr`, `Kt`, `eta`, roughness: `glass`'s BSDF)
+/// and the medium's `scale`, asymmetry, index and photon-beam-diffusion
+/// table (computed once per material, for its `g` and `eta`).
 #[derive(Clone, Debug)]
-pub struct Subsurface {
-    /// The dielectric boundary (`Kr`, `Kt`, `eta`, roughness).
-    pub boundary: Glass,
-    pub sigma_a: SpectrumTex,
-    pub sigma_s: SpectrumTex,
+pub struct Boundary {
+    pub glass: Glass,
     pub scale: f32,
     pub g: f32,
     pub eta: f32,
     pub table: Arc<BssrdfTable>,
+}
+
+impl Boundary {
+    pub fn new(p: &ParamValues, g: f32) -> Boundary {
+        let eta = p.float("eta");
+        Boundary {
+            glass: Glass::with_eta(p, eta),
+            scale: p.float("scale"),
+            g,
+            eta,
+            table: Arc::new(BssrdfTable::beam_diffusion(g, eta)),
+        }
+    }
+
+    pub fn anisotropic(&self) -> bool {
+        self.glass.anisotropic()
+    }
+
+    pub fn max_lobes(&self) -> usize {
+        self.glass.max_lobes()
+    }
+
+    #[inline]
+    pub fn scatter(&self, sc: &ShadingContext, ctx: &BsdfContext, bsdf: &mut Bsdf) {
+        self.glass.scatter(sc, ctx, bsdf);
+    }
+
+    /// The BSSRDF under the boundary for the medium's coefficients at a hit.
+    pub fn bssrdf(&self, (sigma_a, sigma_s): (Vec3, Vec3)) -> TabulatedBssrdf<'_> {
+        TabulatedBssrdf::new(&self.table, sigma_a, sigma_s, self.eta)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Subsurface {
+    pub boundary: Boundary,
+    pub sigma_a: SpectrumTex,
+    pub sigma_s: SpectrumTex,
 }
 
 impl Subsurface {
@@ -96,19 +135,14 @@ impl Subsurface {
             Some(m) => (m.sigma_a, m.sigma_prime_s, 0.0),
             None => (DEFAULT_SIGMA_A, DEFAULT_SIGMA_S, p.float("g")),
         };
-        let eta = p.float("eta");
         Subsurface {
-            boundary: Glass::with_eta(p, eta),
+            boundary: Boundary::new(p, g),
             sigma_a: p
                 .spectrum_tex("sigma_a")
                 .unwrap_or(SpectrumTex::Constant(Vec3::from(sa))),
             sigma_s: p
                 .spectrum_tex("sigma_s")
                 .unwrap_or(SpectrumTex::Constant(Vec3::from(ss))),
-            scale: p.float("scale"),
-            g,
-            eta,
-            table: Arc::new(BssrdfTable::beam_diffusion(g, eta)),
         }
     }
 
@@ -124,31 +158,19 @@ impl Subsurface {
         out
     }
 
-    pub fn anisotropic(&self) -> bool {
-        self.boundary.anisotropic()
-    }
-
     pub fn needs_geom(&self) -> bool {
-        self.boundary.needs_geom()
+        self.boundary.glass.needs_geom()
             || self.sigma_a.as_constant().is_none()
             || self.sigma_s.as_constant().is_none()
-    }
-
-    pub fn max_lobes(&self) -> usize {
-        self.boundary.max_lobes()
-    }
-
-    #[inline]
-    pub fn scatter(&self, sc: &ShadingContext, ctx: &BsdfContext, bsdf: &mut Bsdf) {
-        self.boundary.scatter(sc, ctx, bsdf);
     }
 
     /// The medium's `(sigma_a, sigma_s)` at a hit (scaled, clamped to ≥ 0).
     #[inline]
     pub fn coefficients(&self, sc: &ShadingContext) -> (Vec3, Vec3) {
+        let scale = self.boundary.scale;
         (
-            self.scale * self.sigma_a.eval(sc).max(Vec3::ZERO),
-            self.scale * self.sigma_s.eval(sc).max(Vec3::ZERO),
+            scale * self.sigma_a.eval(sc).max(Vec3::ZERO),
+            scale * self.sigma_s.eval(sc).max(Vec3::ZERO),
         )
     }
 }

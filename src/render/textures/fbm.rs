@@ -5,24 +5,20 @@
 //! |---|---|---|---|
 //! | `octaves` | integer | 8 | most octaves (fewer where the footprint is large) |
 //! | `roughness` | float | 0.5 | amplitude factor per octave (ω) |
+//!
+//! The parameters and their reading are shared with the other octave sum
+//! ([`super::noise::Octaves`]).
 
-use super::noise::fbm;
-use super::{
-    Class, Mapping3D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
-};
+use super::noise::{fbm, Octaves, OCTAVE_PARAMS};
+use super::{Class, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
-use crate::scene::{ParamSpec, Tex};
-
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec::int("octaves", 8, "most octaves"),
-    ParamSpec::float("roughness", 0.5, "amplitude factor per octave"),
-];
+use crate::scene::Tex;
 
 pub const CLASS: TextureClass = TextureClass {
     name: "fbm",
     aliases: &[],
     support: Support::Supported,
-    params: PARAMS,
+    params: OCTAVE_PARAMS,
     doc: "fractional Brownian motion (sum of noise octaves)",
     build: TexBuild {
         mapping: MappingUse::ThreeD,
@@ -31,26 +27,17 @@ pub const CLASS: TextureClass = TextureClass {
     },
 };
 
-pub struct Fbm {
-    pub mapping: Mapping3D,
-    pub octaves: i32,
-    pub omega: f32,
-}
+pub struct Fbm(pub Octaves);
 
 fn build<T: TexValue>(b: &mut TexBuilder) -> Result<Tex<T>, String> {
     Ok(Texture::new_handle(
         b.name,
-        Class::Fbm(Fbm {
-            mapping: b.mapping3d,
-            octaves: b.params.int("octaves"),
-            omega: b.params.float("roughness"),
-        }),
+        Class::Fbm(Fbm(Octaves::read(b))),
     ))
 }
 
 impl Fbm {
     pub fn eval(&self, sc: &ShadingContext) -> f32 {
-        let (p, dpdx, dpdy) = self.mapping.map(sc);
-        fbm(p, dpdx, dpdy, self.omega, self.octaves)
+        self.0.eval(sc, fbm)
     }
 }

@@ -182,3 +182,43 @@ mod tests {
         assert!(max > 0.3, "noise is nearly flat: {max}");
     }
 }
+
+/// What `fbm` and `wrinkled` share: the 3D mapping, the most octaves, and
+/// the amplitude factor per octave (their parameters, [`OCTAVE_PARAMS`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Octaves {
+    pub mapping: super::Mapping3D,
+    pub octaves: i32,
+    pub omega: f32,
+}
+
+/// The parameter table of `fbm` and `wrinkled`.
+pub const OCTAVE_PARAMS: &[crate::scene::ParamSpec] = &[
+    crate::scene::ParamSpec::int(
+        "octaves",
+        8,
+        "most octaves (fewer where the footprint is large)",
+    ),
+    crate::scene::ParamSpec::float("roughness", 0.5, "amplitude factor per octave (ω)"),
+];
+
+impl Octaves {
+    pub fn read(b: &super::TexBuilder) -> Octaves {
+        Octaves {
+            mapping: b.mapping3d,
+            octaves: b.params.int("octaves"),
+            omega: b.params.float("roughness"),
+        }
+    }
+
+    /// `sum(p, dp/dx, dp/dy, ω, octaves)` at the mapped point.
+    #[inline]
+    pub fn eval(
+        &self,
+        sc: &crate::render::materials::ShadingContext,
+        sum: impl Fn(Vec3, Vec3, Vec3, f32, i32) -> f32,
+    ) -> f32 {
+        let (p, dpdx, dpdy) = self.mapping.map(sc);
+        sum(p, dpdx, dpdy, self.omega, self.octaves)
+    }
+}

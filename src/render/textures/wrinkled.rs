@@ -3,26 +3,22 @@
 //!
 //! | parameter | type | default | |
 //! |---|---|---|---|
-//! | `octaves` | integer | 8 | most octaves |
+//! | `octaves` | integer | 8 | most octaves (fewer where the footprint is large) |
 //! | `roughness` | float | 0.5 | amplitude factor per octave (ω) |
+//!
+//! The parameters and their reading are shared with the other octave sum
+//! ([`super::noise::Octaves`]).
 
-use super::noise::turbulence;
-use super::{
-    Class, Mapping3D, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass,
-};
+use super::noise::{turbulence, Octaves, OCTAVE_PARAMS};
+use super::{Class, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass};
 use crate::render::materials::ShadingContext;
-use crate::scene::{ParamSpec, Tex};
-
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec::int("octaves", 8, "most octaves"),
-    ParamSpec::float("roughness", 0.5, "amplitude factor per octave"),
-];
+use crate::scene::Tex;
 
 pub const CLASS: TextureClass = TextureClass {
     name: "wrinkled",
     aliases: &[],
     support: Support::Supported,
-    params: PARAMS,
+    params: OCTAVE_PARAMS,
     doc: "turbulence (sum of |noise| octaves)",
     build: TexBuild {
         mapping: MappingUse::ThreeD,
@@ -31,26 +27,17 @@ pub const CLASS: TextureClass = TextureClass {
     },
 };
 
-pub struct Wrinkled {
-    pub mapping: Mapping3D,
-    pub octaves: i32,
-    pub omega: f32,
-}
+pub struct Wrinkled(pub Octaves);
 
 fn build<T: TexValue>(b: &mut TexBuilder) -> Result<Tex<T>, String> {
     Ok(Texture::new_handle(
         b.name,
-        Class::Wrinkled(Wrinkled {
-            mapping: b.mapping3d,
-            octaves: b.params.int("octaves"),
-            omega: b.params.float("roughness"),
-        }),
+        Class::Wrinkled(Wrinkled(Octaves::read(b))),
     ))
 }
 
 impl Wrinkled {
     pub fn eval(&self, sc: &ShadingContext) -> f32 {
-        let (p, dpdx, dpdy) = self.mapping.map(sc);
-        turbulence(p, dpdx, dpdy, self.omega, self.octaves)
+        self.0.eval(sc, turbulence)
     }
 }
