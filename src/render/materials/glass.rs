@@ -19,7 +19,8 @@
 //! from 1 into `eta`, anisotropic when the roughnesses differ. Each
 //! reflection or transmission lobe only if Kr or Kt is not black.
 
-use super::{trowbridge_reitz, BsdfContext, Material, MaterialKind, ShadingContext, Support};
+use super::Roughness;
+use super::{BsdfContext, Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{
     Bsdf, Fresnel, FresnelSpecular, MicrofacetReflection, MicrofacetTransmission,
     SpecularReflection, SpecularTransmission,
@@ -56,9 +57,7 @@ pub struct Glass {
     pub kr: SpectrumTex,
     pub kt: SpectrumTex,
     pub eta: FloatTex,
-    pub u_roughness: FloatTex,
-    pub v_roughness: FloatTex,
-    pub remap_roughness: bool,
+    pub roughness: Roughness,
 }
 
 impl Glass {
@@ -69,9 +68,7 @@ impl Glass {
             eta: p
                 .float_tex("eta")
                 .unwrap_or_else(|| p.float_tex("index").expect("default")),
-            u_roughness: p.float_tex("uroughness").expect("default"),
-            v_roughness: p.float_tex("vroughness").expect("default"),
-            remap_roughness: p.boolean("remaproughness"),
+            roughness: Roughness::read(p),
         }
     }
 
@@ -82,23 +79,19 @@ impl Glass {
             kr: p.spectrum_tex("Kr").expect("default"),
             kt: p.spectrum_tex("Kt").expect("default"),
             eta: FloatTex::Constant(eta),
-            u_roughness: p.float_tex("uroughness").expect("default"),
-            v_roughness: p.float_tex("vroughness").expect("default"),
-            remap_roughness: p.boolean("remaproughness"),
+            roughness: Roughness::read(p),
         }
     }
 
     pub fn anisotropic(&self) -> bool {
-        super::may_differ(&self.u_roughness, &self.v_roughness)
+        self.roughness.anisotropic()
     }
 
     pub fn needs_geom(&self) -> bool {
         self.kr.as_constant().is_none()
             || self.kt.as_constant().is_none()
             || self.eta.as_constant().is_none()
-            || self.u_roughness.as_constant().is_none()
-            || self.v_roughness.as_constant().is_none()
-            || self.anisotropic()
+            || self.roughness.needs_geom()
     }
 
     pub fn max_lobes(&self) -> usize {
@@ -114,7 +107,7 @@ impl Glass {
         if r == Vec3::ZERO && t == Vec3::ZERO {
             return;
         }
-        let (u, v) = (self.u_roughness.eval(sc), self.v_roughness.eval(sc));
+        let (u, v) = self.roughness.eval(sc);
         let fresnel = Fresnel::Dielectric {
             eta_i: 1.0,
             eta_t: eta,
@@ -141,7 +134,7 @@ impl Glass {
             }
             return;
         }
-        let distribution = trowbridge_reitz(u, v, self.remap_roughness);
+        let distribution = self.roughness.distribution((u, v));
         if r != Vec3::ZERO {
             bsdf.add(MicrofacetReflection {
                 r,

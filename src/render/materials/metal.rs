@@ -15,9 +15,10 @@
 //! The default η and k are pbrt-v3's measured copper, converted to RGB by the
 //! loader as pbrt-v3's `RGBSpectrum::FromSampled` does.
 
-use super::{trowbridge_reitz, Material, MaterialKind, ShadingContext, Support};
+use super::Roughness;
+use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{Bsdf, Fresnel, MicrofacetReflection};
-use crate::scene::{FloatTex, ParamSpec, ParamValues, SpectrumDefault, SpectrumTex};
+use crate::scene::{ParamSpec, ParamValues, SpectrumDefault, SpectrumTex};
 use glam::Vec3;
 
 // Measured copper, 56 samples: wavelengths (nm), index of refraction n and
@@ -145,9 +146,7 @@ pub const KIND: MaterialKind = MaterialKind {
 pub struct Metal {
     pub eta: SpectrumTex,
     pub k: SpectrumTex,
-    pub u_roughness: FloatTex,
-    pub v_roughness: FloatTex,
-    pub remap_roughness: bool,
+    pub roughness: Roughness,
 }
 
 impl Metal {
@@ -156,22 +155,22 @@ impl Metal {
         Metal {
             eta: p.spectrum_tex("eta").expect("default"),
             k: p.spectrum_tex("k").expect("default"),
-            u_roughness: p.float_tex("uroughness").unwrap_or(roughness.clone()),
-            v_roughness: p.float_tex("vroughness").unwrap_or(roughness),
-            remap_roughness: p.boolean("remaproughness"),
+            roughness: Roughness {
+                u: p.float_tex("uroughness").unwrap_or(roughness.clone()),
+                v: p.float_tex("vroughness").unwrap_or(roughness),
+                remap: p.boolean("remaproughness"),
+            },
         }
     }
 
     pub fn anisotropic(&self) -> bool {
-        super::may_differ(&self.u_roughness, &self.v_roughness)
+        self.roughness.anisotropic()
     }
 
     pub fn needs_geom(&self) -> bool {
         self.eta.as_constant().is_none()
             || self.k.as_constant().is_none()
-            || self.u_roughness.as_constant().is_none()
-            || self.v_roughness.as_constant().is_none()
-            || self.anisotropic()
+            || self.roughness.needs_geom()
     }
 
     pub fn max_lobes(&self) -> usize {
@@ -180,10 +179,10 @@ impl Metal {
 
     #[inline]
     pub fn scatter(&self, sc: &ShadingContext, bsdf: &mut Bsdf) {
-        let (u, v) = (self.u_roughness.eval(sc), self.v_roughness.eval(sc));
+        let (u, v) = self.roughness.eval(sc);
         bsdf.add(MicrofacetReflection {
             r: Vec3::ONE,
-            distribution: trowbridge_reitz(u, v, self.remap_roughness),
+            distribution: self.roughness.distribution((u, v)),
             fresnel: Fresnel::Conductor {
                 eta_i: Vec3::ONE,
                 eta_t: self.eta.eval(sc),

@@ -394,11 +394,51 @@ pub fn trowbridge_reitz(u: f32, v: f32, remap: bool) -> MicrofacetDistribution {
     TrowbridgeReitz::new(ax, ay).into()
 }
 
-/// True unless both roughness textures are the same constant.
-fn may_differ(u: &FloatTex, v: &FloatTex) -> bool {
-    match (u.as_constant(), v.as_constant()) {
-        (Some(a), Some(b)) => a != b,
-        _ => true,
+/// The microfacet roughness of `glass`, `metal`, `substrate`, `uber` and
+/// the subsurface boundaries: along dp/du and dp/dv, and whether it is
+/// remapped to α by pbrt-v3's `RoughnessToAlpha`.
+#[derive(Clone, Debug)]
+pub struct Roughness {
+    pub u: FloatTex,
+    pub v: FloatTex,
+    pub remap: bool,
+}
+
+impl Roughness {
+    /// `uroughness`, `vroughness` and `remaproughness` with the defaults
+    /// of the material's table.
+    pub fn read(p: &ParamValues) -> Roughness {
+        Roughness {
+            u: p.float_tex("uroughness").expect("default"),
+            v: p.float_tex("vroughness").expect("default"),
+            remap: p.boolean("remaproughness"),
+        }
+    }
+
+    /// True unless both are the same constant.
+    pub fn anisotropic(&self) -> bool {
+        match (self.u.as_constant(), self.v.as_constant()) {
+            (Some(a), Some(b)) => a != b,
+            _ => true,
+        }
+    }
+
+    /// True if either is a texture (or they may differ): the hit's
+    /// differential geometry is needed.
+    pub fn needs_geom(&self) -> bool {
+        self.u.as_constant().is_none() || self.v.as_constant().is_none() || self.anisotropic()
+    }
+
+    /// The roughness at a hit, along u and v.
+    #[inline]
+    pub fn eval(&self, sc: &ShadingContext) -> (f32, f32) {
+        (self.u.eval(sc), self.v.eval(sc))
+    }
+
+    /// The Trowbridge–Reitz distribution of roughness `(u, v)`.
+    #[inline]
+    pub fn distribution(&self, (u, v): (f32, f32)) -> MicrofacetDistribution {
+        trowbridge_reitz(u, v, self.remap)
     }
 }
 

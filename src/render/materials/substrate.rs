@@ -14,9 +14,10 @@
 //!
 //! Lobes: the FresnelBlend if Kd or Ks ≠ 0.
 
-use super::{trowbridge_reitz, Material, MaterialKind, ShadingContext, Support};
+use super::Roughness;
+use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{Bsdf, FresnelBlend};
-use crate::scene::{FloatTex, ParamSpec, ParamValues, SpectrumTex};
+use crate::scene::{ParamSpec, ParamValues, SpectrumTex};
 use glam::Vec3;
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -45,9 +46,7 @@ pub const KIND: MaterialKind = MaterialKind {
 pub struct Substrate {
     pub kd: SpectrumTex,
     pub ks: SpectrumTex,
-    pub u_roughness: FloatTex,
-    pub v_roughness: FloatTex,
-    pub remap_roughness: bool,
+    pub roughness: Roughness,
 }
 
 impl Substrate {
@@ -55,22 +54,18 @@ impl Substrate {
         Substrate {
             kd: p.spectrum_tex("Kd").expect("default"),
             ks: p.spectrum_tex("Ks").expect("default"),
-            u_roughness: p.float_tex("uroughness").expect("default"),
-            v_roughness: p.float_tex("vroughness").expect("default"),
-            remap_roughness: p.boolean("remaproughness"),
+            roughness: Roughness::read(p),
         }
     }
 
     pub fn anisotropic(&self) -> bool {
-        super::may_differ(&self.u_roughness, &self.v_roughness)
+        self.roughness.anisotropic()
     }
 
     pub fn needs_geom(&self) -> bool {
         self.kd.as_constant().is_none()
             || self.ks.as_constant().is_none()
-            || self.u_roughness.as_constant().is_none()
-            || self.v_roughness.as_constant().is_none()
-            || self.anisotropic()
+            || self.roughness.needs_geom()
     }
 
     pub fn max_lobes(&self) -> usize {
@@ -84,11 +79,11 @@ impl Substrate {
         if rd == Vec3::ZERO && rs == Vec3::ZERO {
             return;
         }
-        let (u, v) = (self.u_roughness.eval(sc), self.v_roughness.eval(sc));
+        let (u, v) = self.roughness.eval(sc);
         bsdf.add(FresnelBlend {
             rd,
             rs,
-            distribution: trowbridge_reitz(u, v, self.remap_roughness),
+            distribution: self.roughness.distribution((u, v)),
         });
     }
 }

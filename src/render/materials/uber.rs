@@ -25,7 +25,8 @@
 //! 4. specular reflection op·Kr, `FresnelDielectric(1, eta)`,
 //! 5. specular transmission op·Kt from η 1 into `eta`.
 
-use super::{may_scatter, trowbridge_reitz, Material, MaterialKind, ShadingContext, Support};
+use super::Roughness;
+use super::{may_scatter, Material, MaterialKind, ShadingContext, Support};
 use crate::render::bxdf::{
     Bsdf, Fresnel, LambertianReflection, MicrofacetReflection, SpecularReflection,
     SpecularTransmission,
@@ -74,11 +75,9 @@ pub struct Uber {
     pub ks: SpectrumTex,
     pub kr: SpectrumTex,
     pub kt: SpectrumTex,
-    pub u_roughness: FloatTex,
-    pub v_roughness: FloatTex,
+    pub roughness: Roughness,
     pub eta: FloatTex,
     pub opacity: SpectrumTex,
-    pub remap_roughness: bool,
 }
 
 impl Uber {
@@ -91,28 +90,28 @@ impl Uber {
             ks: p.spectrum_tex("Ks").expect("default"),
             kr: p.spectrum_tex("Kr").expect("default"),
             kt: p.spectrum_tex("Kt").expect("default"),
-            v_roughness: p.float_tex("vroughness").unwrap_or(u_roughness.clone()),
-            u_roughness,
+            roughness: Roughness {
+                v: p.float_tex("vroughness").unwrap_or(u_roughness.clone()),
+                u: u_roughness,
+                remap: p.boolean("remaproughness"),
+            },
             eta: p
                 .float_tex("eta")
                 .unwrap_or_else(|| p.float_tex("index").expect("default")),
             opacity: p.spectrum_tex("opacity").expect("default"),
-            remap_roughness: p.boolean("remaproughness"),
         }
     }
 
     pub fn anisotropic(&self) -> bool {
-        super::may_differ(&self.u_roughness, &self.v_roughness)
+        self.roughness.anisotropic()
     }
 
     pub fn needs_geom(&self) -> bool {
         [&self.kd, &self.ks, &self.kr, &self.kt, &self.opacity]
             .iter()
             .any(|t| t.as_constant().is_none())
-            || [&self.u_roughness, &self.v_roughness, &self.eta]
-                .iter()
-                .any(|t| t.as_constant().is_none())
-            || self.anisotropic()
+            || self.eta.as_constant().is_none()
+            || self.roughness.needs_geom()
     }
 
     pub fn max_lobes(&self) -> usize {
@@ -153,10 +152,10 @@ impl Uber {
         };
         let ks = op * self.ks.eval(sc).max(Vec3::ZERO);
         if ks != Vec3::ZERO {
-            let (u, v) = (self.u_roughness.eval(sc), self.v_roughness.eval(sc));
+            let (u, v) = self.roughness.eval(sc);
             bsdf.add(MicrofacetReflection {
                 r: ks,
-                distribution: trowbridge_reitz(u, v, self.remap_roughness),
+                distribution: self.roughness.distribution((u, v)),
                 fresnel: dielectric,
             });
         }
