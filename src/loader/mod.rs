@@ -23,6 +23,7 @@ pub mod meshfile;
 pub mod ply;
 pub mod reference;
 pub mod refine;
+pub mod shapes;
 pub mod spd;
 pub mod state;
 pub mod summary;
@@ -31,7 +32,7 @@ pub mod texture;
 use crate::lang::params::{Param, ParamList};
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
 use crate::lang::{Diags, Loc, SourceMap};
-use crate::scene::{FourierTable, ParamKind, ParamSpec, SceneDescription};
+use crate::scene::{Elem, FourierTable, ParamKind, ParamSpec, SceneDescription};
 use glam::Vec3;
 use miette::Severity;
 use std::collections::HashMap;
@@ -185,7 +186,12 @@ fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
         ParamKind::Unsupported(_) => &[],
         ParamKind::Spectrum(_) => &["rgb", "color", "xyz", "blackbody", "spectrum"],
         ParamKind::Point3(_) => &["point3", "point"],
-        ParamKind::Floats => &["float"],
+        ParamKind::Floats | ParamKind::FloatOpt => &["float"],
+        ParamKind::List(Elem::Number) => &["float", "integer"],
+        ParamKind::List(Elem::Int) => &["integer"],
+        ParamKind::List(Elem::Point2) => &["point2", "float"],
+        ParamKind::List(Elem::Point3) => &["point3", "point"],
+        ParamKind::List(Elem::Normal) => &["normal"],
     }
 }
 
@@ -245,6 +251,8 @@ fn kind_name(kind: ParamKind) -> &'static str {
         ParamKind::Spectrum(_) => "spectrum",
         ParamKind::Point3(_) => "point3",
         ParamKind::Floats => "float list",
+        ParamKind::FloatOpt => "float",
+        ParamKind::List(e) => e.name(),
     }
 }
 

@@ -145,6 +145,8 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
             Some(format!("{} {} {}", num(x), num(y), num(z))),
         ),
         ParamKind::Floats => ("float list".to_string(), None),
+        ParamKind::FloatOpt => ("float".to_string(), None),
+        ParamKind::List(e) => (format!("{} values", e.name()), None),
     };
     (
         format!("{ty}{nonneg}"),

@@ -18,7 +18,7 @@ pub use fourier::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
 pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
 pub use kind::{Collected, Kind, Report, Support};
 pub use motion::AnimatedTransform;
-pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
+pub use params::{Elem, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};
 
 use glam::{DMat4, DVec3, Vec2, Vec3};

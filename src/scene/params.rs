@@ -71,6 +71,37 @@ pub enum ParamKind {
     Point3([f32; 3]),
     /// A list of floats of any length, e.g. a grid medium's `density`.
     Floats,
+    /// A float without a default: absent unless given (the kind's default
+    /// depends on other parameters, e.g. a sphere's `zmin` is `-radius`).
+    FloatOpt,
+    /// Values of one element type, any count, as numbers (no default):
+    /// a mesh's `P`, `indices`, `N`, `uv`.
+    List(Elem),
+}
+
+/// The element type of a [`ParamKind::List`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Elem {
+    /// `float` or `integer` values.
+    Number,
+    Int,
+    /// `point2` values (or `float`, as pbrt-v3 takes uv).
+    Point2,
+    Point3,
+    Normal,
+}
+
+impl Elem {
+    /// Its name in messages and `grammar/REFERENCE.md`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Elem::Number => "number",
+            Elem::Int => "integer",
+            Elem::Point2 => "point2",
+            Elem::Point3 => "point3",
+            Elem::Normal => "normal",
+        }
+    }
 }
 
 /// A constraint the loader checks on constant values (with a located
@@ -290,6 +321,22 @@ impl ParamSpec {
             doc,
         }
     }
+    pub const fn float_opt(name: &'static str, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::FloatOpt,
+            range: Range::Any,
+            doc,
+        }
+    }
+    pub const fn list(name: &'static str, elem: Elem, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::List(elem),
+            range: Range::Any,
+            doc,
+        }
+    }
     /// pbrt-v3's `bumpmap`: a float texture of displacements along the
     /// shading normal, applied by `Material::bsdf_into` for every material.
     pub const BUMPMAP: ParamSpec = ParamSpec::float_tex_opt(
@@ -355,6 +402,14 @@ impl ParamValues {
         match self.get(name) {
             Some(ParamValue::Float(f)) => *f,
             v => panic!("parameter \"{name}\" is {v:?}, not a float"),
+        }
+    }
+    /// A [`ParamKind::FloatOpt`]: `None` unless given.
+    pub fn float_opt(&self, name: &str) -> Option<f32> {
+        match self.get(name) {
+            Some(ParamValue::Float(f)) => Some(*f),
+            None => None,
+            Some(v) => panic!("parameter \"{name}\" is {v:?}, not a float"),
         }
     }
     pub fn boolean(&self, name: &str) -> bool {

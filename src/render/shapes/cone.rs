@@ -19,6 +19,43 @@
 //! a cone area light is a pbrs extension: uniform by area (v = 1 − √(1 − ξ)),
 //! with the exact world-area density.
 
+use super::{check_floats, phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius of its base (> 0)"),
+    ParamSpec::float("height", 1.0, "height of its apex (> 0)"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "cone",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a cone (or a sector of one) from a base at z = 0 to its apex",
+    build,
+};
+
+/// pbrt-v3's checks: radius and height positive 32-bit floats (error),
+/// phimax > 0 (warning, skipped).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let height = p.float("height");
+    if !check_floats(
+        "cone",
+        r,
+        &[("radius", radius, true), ("height", height, true)],
+    ) {
+        return None;
+    }
+    Some(Geometry::Cone {
+        radius,
+        height,
+        phi_max: phi_max("cone", p, r)?,
+    })
+}
+
 use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};

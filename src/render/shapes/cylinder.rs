@@ -14,6 +14,62 @@
 //! sampling is pbrt-v3's `Cylinder::Sample` (uniform in z and φ), density
 //! 1/(world area) (pbrt-v3 uses the object-space area).
 
+use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius (> 0)"),
+    ParamSpec::float("zmin", -1.0, "lower end (pbrt-v3 orders zmin and zmax)"),
+    ParamSpec::float("zmax", 1.0, "upper end"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "cylinder",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a cylinder (or a sector of one) about the z axis",
+    build,
+};
+
+/// pbrt-v3's checks: a positive radius and finite ends (error), a
+/// non-empty extent (warning, skipped).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    if radius.is_nan()
+        || radius <= 0.0
+        || !radius.is_finite()
+        || !zmin.is_finite()
+        || !zmax.is_finite()
+    {
+        r.error(
+            Some("radius"),
+            format!("cylinder radius {radius} (zmin {zmin}, zmax {zmax}) is not a positive 32-bit float"),
+            "bad cylinder",
+        );
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax itself.
+    let (z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z0 >= z1 || phimax <= 0.0 {
+        r.warn(
+            None,
+            "cylinder with an empty extent (zmin = zmax or phimax 0): skipped".into(),
+            "empty cylinder",
+        );
+        return None;
+    }
+    Some(Geometry::Cylinder {
+        radius,
+        z_min: z0,
+        z_max: z1,
+        phi_max: phimax,
+    })
+}
+
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};

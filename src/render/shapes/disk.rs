@@ -21,6 +21,73 @@
 //! match. Unlike pbrt-v3, the area is the world area (the transform's
 //! Jacobian is constant for a plane), so scaled disk lights are unbiased.
 
+use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("height", 0.0, "z of its plane"),
+    ParamSpec::float("radius", 1.0, "outer radius (> 0)"),
+    ParamSpec::float(
+        "innerradius",
+        0.0,
+        "inner radius (0 ≤ innerradius < radius)",
+    ),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "disk",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a disk or annulus (or a sector of one) in a plane z = height",
+    build,
+};
+
+/// pbrt-v3's checks: a positive radius (error), a negative inner radius is
+/// 0 (warning), an empty annulus or sector is skipped (warning).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let height = p.float("height");
+    let radius = p.float("radius");
+    let mut inner = p.float("innerradius");
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    if radius.is_nan()
+        || radius <= 0.0
+        || !radius.is_finite()
+        || !height.is_finite()
+        || !inner.is_finite()
+    {
+        r.error(
+            Some("radius"),
+            format!("disk radius {radius} (height {height}, innerradius {inner}) is not a positive 32-bit float"),
+            "bad disk",
+        );
+        return None;
+    }
+    if inner < 0.0 {
+        r.warn(
+            Some("innerradius"),
+            format!("disk innerradius {inner} is negative: 0 is used"),
+            "negative innerradius",
+        );
+        inner = 0.0;
+    }
+    if inner >= radius || phimax <= 0.0 {
+        r.warn(
+            None,
+            format!("disk with an empty extent (innerradius {inner} >= radius {radius}, or phimax 0): skipped"),
+            "empty disk",
+        );
+        return None;
+    }
+    Some(Geometry::Disk {
+        height,
+        radius,
+        inner_radius: inner,
+        phi_max: phimax,
+    })
+}
+
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
 use crate::render::sampling::concentric_sample_disk;

@@ -24,6 +24,68 @@
 //! `p2` only). pbrt-v3 cannot sample hyperboloids; a hyperboloid area light is
 //! a pbrs extension: uniform in z and φ, with its exact world-area density.
 
+use super::{phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::point3("p1", [0.0, 0.0, 0.0], "a point of the line swept about z"),
+    ParamSpec::point3("p2", [1.0, 1.0, 1.0], "another point of it (p1.z ≠ p2.z)"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "hyperboloid",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "the hyperboloid of one sheet swept by the line p1 p2 about z",
+    build,
+};
+
+/// pbrt-v3's fitting, checked: p1 and p2 finite, at different heights, on a
+/// line that misses the z axis, and the fitted surface has points at every
+/// height between them (errors otherwise: pbrt-v3 divides by zero, loops
+/// forever or makes NaNs).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let (p1, p2) = (p.point("p1"), p.point("p2"));
+    let at = Some("p1");
+    if !(p1.as_vec3().is_finite() && p2.as_vec3().is_finite()) {
+        r.error(
+            at,
+            "hyperboloid p1/p2 are not finite 32-bit floats".into(),
+            "bad point",
+        );
+        return None;
+    }
+    let (p1, p2) = (p1.as_vec3(), p2.as_vec3());
+    let bad = |why: &str| {
+        format!(
+            "hyperboloid p1 [{} {} {}], p2 [{} {} {}]: {why}",
+            p1.x, p1.y, p1.z, p2.x, p2.y, p2.z
+        )
+    };
+    if p1.z == p2.z {
+        r.error(at, bad("p1 and p2 are at the same height, so they define no hyperboloid (pbrt-v3 divides by zero); use a disk for an annulus"), "p1.z = p2.z");
+        return None;
+    }
+    let Some((a, c)) = hyperboloid_coefficients(p1.as_dvec3(), p2.as_dvec3()) else {
+        r.error(at, bad("the line through them meets the z axis, which makes a cone, not a hyperboloid (pbrt-v3 never finishes building it); use a cone"), "no hyperboloid");
+        return None;
+    };
+    let (z0, z1) = (p1.z.min(p2.z) as f64, p1.z.max(p2.z) as f64);
+    let rho2 = |z: f64| (1.0 + c * z * z) / a;
+    let inside = z0 < 0.0 && z1 > 0.0;
+    if !(rho2(z0) > 0.0 && rho2(z1) > 0.0 && (!inside || rho2(0.0) > 0.0)) {
+        r.error(at, bad("the implicit surface pbrt-v3 fits to them has no points at some heights between p1 and p2 (not a hyperboloid of one sheet there)"), "not a hyperboloid");
+        return None;
+    }
+    Some(Geometry::Hyperboloid {
+        p1,
+        p2,
+        phi_max: phi_max("hyperboloid", p, r)?,
+    })
+}
+
 use super::quadric::{pbrt_closest, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};

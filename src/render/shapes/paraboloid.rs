@@ -18,6 +18,75 @@
 //! above z grows as (4cz + 1)^{3/2}, inverted in closed form), with the
 //! exact world-area density.
 
+use super::{check_floats, phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius at zmax (> 0)"),
+    ParamSpec::float("zmin", 0.0, "lower end (≥ 0; pbrt-v3 orders zmin and zmax)"),
+    ParamSpec::float("zmax", 1.0, "upper end (> 0)"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "paraboloid",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a paraboloid (or a sector of one) opening upwards from z = 0",
+    build,
+};
+
+/// pbrt-v3's checks: finite values, a positive radius and zmax (error); a
+/// zmin below the apex is 0 (warning); an empty extent is skipped.
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
+    let values = [
+        ("radius", radius, true),
+        ("zmin", zmin, false),
+        ("zmax", zmax, false),
+    ];
+    if !check_floats("paraboloid", r, &values) {
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax; its surface x² + y² = r² z / zmax has
+    // points only where z / zmax >= 0.
+    let (mut z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z1 <= 0.0 {
+        r.error(
+            Some("zmax"),
+            format!(
+                "paraboloid zmax {z1} is not positive (the paraboloid opens upwards from z = 0)"
+            ),
+            "zmax must be > 0",
+        );
+        return None;
+    }
+    if z0 < 0.0 {
+        r.warn(
+            Some("zmin"),
+            format!("paraboloid zmin {z0} is below its apex at z = 0: 0 is used (the surface has no points below)"),
+            "negative zmin",
+        );
+        z0 = 0.0;
+    }
+    if z0 >= z1 {
+        r.warn(
+            None,
+            format!("paraboloid with zmin = zmax = {z1}: an empty surface, skipped"),
+            "empty paraboloid",
+        );
+        return None;
+    }
+    Some(Geometry::Paraboloid {
+        radius,
+        z_min: z0,
+        z_max: z1,
+        phi_max: phi_max("paraboloid", p, r)?,
+    })
+}
+
 use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};

@@ -1,3 +1,81 @@
+//! pbrt-v3's `sphere`: a sphere of `radius` about its object-space origin,
+//! cut to the zone `zmin`..`zmax` and to φ in [0, `phimax`].
+//!
+//! | parameter | type  | pbrt-v3 default |
+//! |-----------|-------|-----------------|
+//! | `radius`  | float | 1               |
+//! | `zmin`    | float | -`radius`       |
+//! | `zmax`    | float | `radius`        |
+//! | `phimax`  | float | 360 (degrees)   |
+
+use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius (> 0)"),
+    ParamSpec::float_opt(
+        "zmin",
+        "lower end of the zone (default -radius; clamped to the sphere)",
+    ),
+    ParamSpec::float_opt(
+        "zmax",
+        "upper end of the zone (default radius; clamped to the sphere)",
+    ),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "sphere",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a sphere (or a zone and sector of one) about the origin",
+    build,
+};
+
+/// pbrt-v3's checks: radius > 0 (error), a non-empty zone and sector
+/// (warning, skipped), a radius that fits a 32-bit float.
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    if radius <= 0.0 {
+        r.error(
+            Some("radius"),
+            format!("sphere radius {radius} is not positive"),
+            "radius must be > 0",
+        );
+        return None;
+    }
+    let zmin = p.float_opt("zmin").unwrap_or(-radius);
+    let zmax = p.float_opt("zmax").unwrap_or(radius);
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    let (z0, z1) = (
+        zmin.min(zmax).clamp(-radius, radius),
+        zmin.max(zmax).clamp(-radius, radius),
+    );
+    if phimax <= 0.0 || z0 >= z1 {
+        r.warn(
+            None,
+            "sphere with an empty extent (phimax 0 or zmin = zmax): skipped".into(),
+            "empty sphere",
+        );
+        return None;
+    }
+    if radius == f32::INFINITY {
+        r.error(
+            None,
+            "sphere radius does not fit a 32-bit float".into(),
+            "radius too large",
+        );
+        return None;
+    }
+    Some(Geometry::Sphere {
+        radius,
+        z_min: z0,
+        z_max: z1,
+        phi_max: phimax,
+    })
+}
+
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, offset_ray_origin, Bounds3, Frame};
 use crate::render::sampling::uniform_cone_pdf;

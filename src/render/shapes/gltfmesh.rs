@@ -1,0 +1,26 @@
+//! `gltfmesh` (a pbrs extension): the triangle meshes of a glTF 2.0 file (`.gltf` or `.glb`).
+//!
+//! | parameter  | type   | pbrt-v3 default |
+//! |------------|--------|-----------------|
+//! | `filename` | string | required        |
+//!
+//! The loader reads the file (once, however many shapes name it) through
+//! [`ShapeInput::mesh_file`]; `alpha` and `shadowalpha` are read with the
+//! graphics state, as for `trianglemesh`.
+
+use super::{mesh_file, MeshFormat, ShapeKind};
+use crate::scene::{ParamSpec, Support};
+
+pub const PARAMS: &[ParamSpec] = &[ParamSpec::filename(
+    "filename",
+    "the glTF file (relative to the scene file)",
+)];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "gltfmesh",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a triangle mesh read from a glTF file (alpha/shadowalpha textures)",
+    build: |p, r| mesh_file(KIND.name, MeshFormat::Gltf, p, r),
+};
