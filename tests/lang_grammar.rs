@@ -288,6 +288,12 @@ fn reference_family_sections_are_generated_from_the_tables() {
             pbrs::loader::reference::samplers_section,
             rows(pbrs::render::samplers::SAMPLERS),
         ),
+        (
+            "render::shapes::SHAPES",
+            "shapes",
+            pbrs::loader::reference::shapes_section,
+            rows(pbrs::render::shapes::SHAPES),
+        ),
     ];
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let write = std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1");

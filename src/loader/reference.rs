@@ -292,6 +292,12 @@ pub fn samplers_section() -> String {
     kinds_section((&b, &e), crate::render::samplers::SAMPLERS)
 }
 
+/// The shape section, from [`SHAPES`](crate::render::shapes::SHAPES).
+pub fn shapes_section() -> String {
+    let (b, e) = markers("render::shapes::SHAPES", "shapes");
+    kinds_section((&b, &e), crate::render::shapes::SHAPES)
+}
+
 /// `doc` with the part from the line `begin_marker` to the line
 /// `end_marker` (both included) replaced by `section`.
 pub fn splice_between(

@@ -33,7 +33,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a cone (or a sector of one) from a base at z = 0 to its apex",
+    doc: "a cone (or a sector of one) from a base at z = 0 to its apex. Open at the base; radius or height ≤ 0 or not a 32-bit float: error; phimax 0: warning, skipped. Intersected as pbrt-v3 (f32 with running error bounds). Area lights: a pbrs extension (pbrt-v3 cannot sample cones), uniform by area",
     build,
 };
 

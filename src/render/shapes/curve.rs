@@ -67,7 +67,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a cubic (or quadratic) Bézier or b-spline curve: flat, ribbon or cylinder",
+    doc: "a cubic (or quadratic) Bézier or b-spline curve of varying width: `flat` (a strip facing the ray), `cylinder` (shaded as a tube) or `ribbon` (oriented by `N`), intersected as pbrt-v3 (recursive subdivision). Degree other than 2 or 3, an unknown basis, a wrong number of control points or ribbon normals, a ribbon without `N`, a width that is not positive: error; an unknown type: warning, cylinder; `N` on a non-ribbon: warning, ignored. Never an area light (pbrt-v3 cannot sample curves): warning, not emissive",
     build,
 };
 

@@ -29,7 +29,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a cylinder (or a sector of one) about the z axis",
+    doc: "a cylinder (or a sector of one) about the z axis. Open tube; zmin/zmax ordered, phimax clamped as pbrt-v3; radius ≤ 0: error; zmin = zmax or phimax 0: warning, skipped; area lights sampled uniformly in z and φ (pbrt-v3's `Cylinder::Sample`)",
     build,
 };
 

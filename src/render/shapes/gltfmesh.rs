@@ -21,6 +21,6 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a triangle mesh read from a glTF file (alpha/shadowalpha textures)",
+    doc: "a triangle mesh read from a glTF file (alpha/shadowalpha textures) (a pbrs extension). GlTF 2.0 read with `gltf`: every `TRIANGLES` primitive of every mesh reachable from the default scene (else the first scene), each under its node's transform, then the CTM; `POSITION`, `NORMAL`, `TEXCOORD_0`, any index type or none. Buffers from the GLB chunk, files next to the `.gltf` (percent-decoded URIs) or base64 `data:` URIs. The file's coordinates are used as they are (glTF's +y up is not converted). Its materials are not read (the current material applies). Invalid file, a buffer shorter than declared, accessors outside their buffers, or a bad index: error naming the file at the Shape line.",
     build: |p, r| mesh_file(KIND.name, MeshFormat::Gltf, p, r),
 };

@@ -20,7 +20,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a height field over the unit square, refined to a triangle mesh",
+    doc: "a height field over the unit square, refined to a triangle mesh. Refined at load as pbrt-v3 (`src/loader/refine/heightfield.rs`): vertex (i, j) at (i/(nu−1), j/(nv−1), Pz), the same uv, two triangles per cell, no normals. nu or nv < 2, wrong Pz count, non-finite height: error",
     build: |_, r| {
         r.refine(KIND.name)
             .map(|m| Geometry::TriangleMesh(Arc::new(m)))

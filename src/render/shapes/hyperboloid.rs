@@ -38,7 +38,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "the hyperboloid of one sheet swept by the line p1 p2 about z",
+    doc: "the hyperboloid of one sheet swept by the line p1 p2 about z. The surface pbrt-v3 fits to the line p1–p2; p1.z = p2.z, a line that meets the axis (pbrt-v3's defaults: it never finishes) or a fit without points over the z range: error; phimax 0: warning, skipped. Intersected as pbrt-v3. Area lights: a pbrs extension, uniform in z and φ with the exact density",
     build,
 };
 

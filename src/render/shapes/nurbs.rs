@@ -41,7 +41,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a NURBS patch, refined to a triangle mesh",
+    doc: "a NURBS patch, refined to a triangle mesh. Refined at load as pbrt-v3 (`src/loader/refine/nurbs.rs`): a fixed 30×30 grid from (u0, v0) to (u1, v1), normals normalise(∂p/∂u × ∂p/∂v) (zero where that vanishes), uv = (u, v). Missing parameter, order outside 2…32, nu < order, wrong knot count, decreasing or non-finite knots, empty domain, u0…v1 outside it or u0 = u1, wrong point count, a weight ≤ 0: error. u0 > u1: warning, diced backwards as pbrt-v3",
     build: |_, r| {
         r.refine(KIND.name)
             .map(|m| Geometry::TriangleMesh(Arc::new(m)))

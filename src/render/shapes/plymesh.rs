@@ -21,6 +21,6 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a triangle mesh read from a PLY file (alpha/shadowalpha textures)",
+    doc: "a triangle mesh read from a PLY file (alpha/shadowalpha textures). Ascii / binary LE / BE PLY; `x y z`, optional `nx ny nz`, uv from `u v`, `s t`, `texture_u texture_v` or `texture_s texture_t`; faces `vertex_indices` or `vertex_index`, any integer types; quads split (0,1,2),(0,2,3); other polygons skipped with a warning; `face_indices` and other properties read and ignored. Missing, truncated or corrupt file, a face with no indices, a bad index, or a count larger than the file can hold: error naming the PLY file at the Shape line. The same file used twice is loaded once.",
     build: |p, r| mesh_file(KIND.name, MeshFormat::Ply, p, r),
 };

@@ -38,7 +38,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a triangle mesh given in the scene file (alpha/shadowalpha textures)",
+    doc: "a triangle mesh given in the scene file (alpha/shadowalpha textures). Index count not a multiple of 3, an index negative or ≥ vertex count, no P: error. N or uv count mismatch: warning, dropped. S, faceIndices: unused warning",
     build: |p, r| mesh(p, r).map(|m| Geometry::TriangleMesh(Arc::new(m))),
 };
 
