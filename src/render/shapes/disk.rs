@@ -40,7 +40,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a disk or annulus (or a sector of one) in a plane z = height. Phimax clamped to [0, 360] as pbrt-v3; radius ≤ 0 or not a 32-bit float: error; innerradius < 0: warning, 0; innerradius ≥ radius or phimax 0: warning, skipped. As an area light it is sampled as pbrt-v3's `Disk::Sample`: the whole disk of `radius`, density 1/area of the partial disk",
+    doc: "a disk or annulus (or a sector of one) in a plane z = height. `phimax` clamped to [0, 360] as pbrt-v3; radius ≤ 0 or not a 32-bit float: error; innerradius < 0: warning, 0; innerradius ≥ radius or phimax 0: warning, skipped. As an area light it is sampled as pbrt-v3's `Disk::Sample`: the whole disk of `radius`, density 1/area of the partial disk",
     build,
 };
 

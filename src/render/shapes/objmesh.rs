@@ -21,6 +21,6 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a triangle mesh read from a OBJ file (alpha/shadowalpha textures) (a pbrs extension). Wavefront OBJ read with `tobj`: every object/group of the file as one mesh in the file's coordinates (the CTM applies); polygons triangulated as fans (quads as `plymesh`); `vn` normals and `vt` uvs used when every vertex has them; points and lines ignored; `.mtl` materials not read (the current material applies). Unreadable file or a bad index: error naming the file at the Shape line.",
+    doc: "a triangle mesh read from an OBJ file (alpha/shadowalpha textures) (a pbrs extension). Wavefront OBJ read with `tobj`: every object/group of the file as one mesh in the file's coordinates (the CTM applies); polygons triangulated as fans (quads as `plymesh`); `vn` normals and `vt` uvs used when every vertex has them; points and lines ignored; `.mtl` materials not read (the current material applies). Unreadable file or a bad index: error naming the file at the Shape line.",
     build: |p, r| mesh_file(KIND.name, MeshFormat::Obj, p, r),
 };

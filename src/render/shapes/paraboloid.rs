@@ -33,7 +33,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a paraboloid (or a sector of one) opening upwards from z = 0. X² + y² = radius²·z/zmax; zmin/zmax ordered; radius ≤ 0 or zmax ≤ 0: error; zmin < 0: warning, 0; zmin = zmax or phimax 0: warning, skipped. Intersected as pbrt-v3 (f32 with running error bounds). Area lights: a pbrs extension, uniform by area",
+    doc: "a paraboloid (or a sector of one) opening upwards from z = 0: x² + y² = radius²·z/zmax; zmin/zmax ordered; radius ≤ 0 or zmax ≤ 0: error; zmin < 0: warning, 0; zmin = zmax or phimax 0: warning, skipped. Intersected as pbrt-v3 (f32 with running error bounds). Area lights: a pbrs extension, uniform by area",
     build,
 };
 

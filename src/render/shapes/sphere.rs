@@ -29,7 +29,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a sphere (or a zone and sector of one) about the origin. Z range and phimax clamped as pbrt-v3; radius ≤ 0: error; empty: warning, skipped",
+    doc: "a sphere (or a zone and sector of one) about the origin. The z range and phimax clamped as pbrt-v3; radius ≤ 0: error; empty: warning, skipped",
     build,
 };
 
