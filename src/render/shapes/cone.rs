@@ -19,6 +19,7 @@
 //! a cone area light is a pbrs extension: uniform by area (v = 1 − √(1 − ξ)),
 //! with the exact world-area density.
 
+use super::quadric::{Analytic, QuadricHit};
 use super::{check_floats, phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
@@ -208,5 +209,31 @@ impl Cone {
             point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
         }
+    }
+}
+
+impl Analytic for Cone {
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.surface_point(p, err)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
     }
 }

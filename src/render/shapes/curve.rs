@@ -35,6 +35,8 @@
 //! hit (pbrt-v3 divides by its zero width). Curves cannot be area lights
 //! (pbrt-v3's `Curve::Sample` aborts); the loader warns.
 
+use super::quadric::{Analytic, QuadricHit};
+use super::ShapeSample;
 use super::{Geometry, ShapeInput, ShapeKind};
 use crate::scene::{CurveData, CurveSegment, Elem, ParamSpec, ParamValues, Support};
 
@@ -750,4 +752,48 @@ fn bezier_derivative(c: &[Vec3; 4], u: f32) -> Vec3 {
 fn rotate(v: Vec3, axis: Vec3, angle: f32) -> Vec3 {
     let (s, c) = angle.sin_cos();
     v * c + axis.cross(v) * s + axis * axis.dot(v) * (1.0 - c)
+}
+
+impl Analytic for Curve {
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, h)| (t, QuadricHit::Curve(h)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        match h {
+            QuadricHit::Curve(h) => self.surface_point(h),
+            // (Never reached: a curve's hits are curve hits.)
+            _ => {
+                let (p, err) = h.point_and_error();
+                SurfacePoint {
+                    p: p.as_vec3(),
+                    p_error: err.as_vec3(),
+                    n: Vec3::Z,
+                    ns: Vec3::Z,
+                }
+            }
+        }
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        match h {
+            QuadricHit::Curve(h) => self.diff_geom(h),
+            _ => DiffGeom::ZERO,
+        }
+    }
+    /// Never a light (the scene leaves curves' emission out).
+    fn area_sample(&self, _: Vec2) -> Option<ShapeSample> {
+        None
+    }
+    fn sample_toward(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec2) -> Option<ShapeSample> {
+        None
+    }
+    fn pdf_toward(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec3) -> f32 {
+        0.0
+    }
 }

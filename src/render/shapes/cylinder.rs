@@ -14,6 +14,7 @@
 //! sampling is pbrt-v3's `Cylinder::Sample` (uniform in z and φ), density
 //! 1/(world area) (pbrt-v3 uses the object-space area).
 
+use super::quadric::{Analytic, QuadricHit};
 use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
@@ -279,5 +280,30 @@ fn phi_of(p: DVec3) -> f64 {
         phi + TAU
     } else {
         phi
+    }
+}
+
+impl Analytic for Cylinder {
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
     }
 }

@@ -21,6 +21,7 @@
 //! match. Unlike pbrt-v3, the area is the world area (the transform's
 //! Jacobian is constant for a plane), so scaled disk lights are unbiased.
 
+use super::quadric::{Analytic, QuadricHit};
 use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
@@ -296,5 +297,31 @@ fn phi_of(p: DVec3) -> f64 {
         phi + TAU
     } else {
         phi
+    }
+}
+
+impl Analytic for Disk {
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    #[inline]
+    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        self.pdf_from(p, p_error, n, wi)
     }
 }

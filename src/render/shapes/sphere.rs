@@ -8,6 +8,7 @@
 //! | `zmax`    | float | `radius`        |
 //! | `phimax`  | float | 360 (degrees)   |
 
+use super::quadric::{Analytic, QuadricHit};
 use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
@@ -534,5 +535,37 @@ mod tests {
                 );
             }
         }
+    }
+}
+
+impl Analytic for Sphere {
+    fn valid(&self) -> bool {
+        self.radius > 0.0 && self.is_invertible()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    #[inline]
+    fn sample_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
+        self.sample_from(p, p_error, n, u)
+    }
+    #[inline]
+    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        self.pdf_from(p, p_error, n, wi, |o, d| {
+            self.intersect(o, d, f32::INFINITY)
+        })
     }
 }

@@ -125,7 +125,7 @@ fn indices(p: &ParamValues, r: &mut dyn ShapeInput, nv: usize) -> Option<Vec<u32
         return None;
     }
     let v = p.floats("indices");
-    if v.len() % 3 != 0 {
+    if !v.len().is_multiple_of(3) {
         r.error(
             Some("indices"),
             format!(
