@@ -20,7 +20,7 @@
 //! with the exact world-area density.
 
 use super::quadric::{Analytic, QuadricHit};
-use super::{check_floats, phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
+use super::{at_origin, check_floats, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -50,11 +50,8 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
     ) {
         return None;
     }
-    Some(Geometry::Cone {
-        radius,
-        height,
-        phi_max: phi_max("cone", p, r)?,
-    })
+    let phimax = phi_max("cone", p, r)?;
+    at_origin(Cone::new(radius, height, phimax, ORIGIN, false, 0))
 }
 
 use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
@@ -65,6 +62,9 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Cone {
+    /// The arguments of [`Cone::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32),
     pub radius: f64,
     pub height: f64,
     /// Radians.
@@ -90,6 +90,7 @@ impl Cone {
         let place = Placement::new(object_to_world, reverse);
         let obj_area = r * (h * h + r * r).sqrt() * phi_max / 2.0;
         Cone {
+            args: (radius, height, phi_max_deg),
             radius: r,
             height: h,
             phi_max,
@@ -213,6 +214,10 @@ impl Cone {
 }
 
 impl Analytic for Cone {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Cone::new(a.0, a.1, a.2, to_world, reverse, material)
+    }
     fn valid(&self) -> bool {
         self.is_valid()
     }

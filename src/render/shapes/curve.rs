@@ -755,6 +755,11 @@ fn rotate(v: Vec3, axis: Vec3, angle: f32) -> Vec3 {
 }
 
 impl Analytic for Curve {
+    /// (A curve's description is its segments, placed by
+    /// `Curve::pieces`; a piece is already placed.)
+    fn placed(&self, _: DMat4, _: bool, _: u32) -> Self {
+        self.clone()
+    }
     fn valid(&self) -> bool {
         self.is_valid()
     }

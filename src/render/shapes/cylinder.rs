@@ -15,7 +15,7 @@
 //! 1/(world area) (pbrt-v3 uses the object-space area).
 
 use super::quadric::{Analytic, QuadricHit};
-use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -63,12 +63,7 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    Some(Geometry::Cylinder {
-        radius,
-        z_min: z0,
-        z_max: z1,
-        phi_max: phimax,
-    })
+    at_origin(Cylinder::new(radius, z0, z1, phimax, ORIGIN, false, 0))
 }
 
 use super::{DiffGeom, ShapeSample, SurfacePoint};
@@ -78,6 +73,9 @@ use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Cylinder {
+    /// The arguments of [`Cylinder::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
@@ -112,6 +110,7 @@ impl Cylinder {
         // otherwise (only light power reads it then; the density is exact).
         let scale2 = det.abs().powf(2.0 / 3.0);
         Cylinder {
+            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: zmin,
             z_max: zmax,
@@ -284,6 +283,10 @@ fn phi_of(p: DVec3) -> f64 {
 }
 
 impl Analytic for Cylinder {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Cylinder::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
     fn valid(&self) -> bool {
         self.is_valid()
     }

@@ -22,7 +22,7 @@
 //! Jacobian is constant for a plane), so scaled disk lights are unbiased.
 
 use super::quadric::{Analytic, QuadricHit};
-use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -81,12 +81,7 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    Some(Geometry::Disk {
-        height,
-        radius,
-        inner_radius: inner,
-        phi_max: phimax,
-    })
+    at_origin(Disk::new(height, radius, inner, phimax, ORIGIN, false, 0))
 }
 
 use super::{DiffGeom, ShapeSample, SurfacePoint};
@@ -97,6 +92,9 @@ use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Disk {
+    /// The arguments of [`Disk::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub height: f64,
     pub radius: f64,
     pub inner_radius: f64,
@@ -139,6 +137,7 @@ impl Disk {
         let jacobian = det.abs() * (normal_matrix * DVec3::Z).length();
         let obj_area = 0.5 * phi_max * (r * r - ri * ri);
         Disk {
+            args: (height, radius, inner_radius, phi_max_deg),
             height: height as f64,
             radius: r,
             inner_radius: ri,
@@ -301,6 +300,10 @@ fn phi_of(p: DVec3) -> f64 {
 }
 
 impl Analytic for Disk {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Disk::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
     fn valid(&self) -> bool {
         self.is_valid()
     }

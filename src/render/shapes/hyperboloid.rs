@@ -25,7 +25,7 @@
 //! a pbrs extension: uniform in z and φ, with its exact world-area density.
 
 use super::quadric::{Analytic, QuadricHit};
-use super::{phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
+use super::{at_origin, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -80,11 +80,8 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         r.error(at, bad("the implicit surface pbrt-v3 fits to them has no points at some heights between p1 and p2 (not a hyperboloid of one sheet there)"), "not a hyperboloid");
         return None;
     }
-    Some(Geometry::Hyperboloid {
-        p1,
-        p2,
-        phi_max: phi_max("hyperboloid", p, r)?,
-    })
+    let phimax = phi_max("hyperboloid", p, r)?;
+    at_origin(Hyperboloid::new(p1, p2, phimax, ORIGIN, false, 0))
 }
 
 use super::quadric::{pbrt_closest, Placement};
@@ -96,6 +93,9 @@ use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Hyperboloid {
+    /// The arguments of [`Hyperboloid::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (Vec3, Vec3, f32),
     pub p1: DVec3,
     pub p2: DVec3,
     pub z_min: f64,
@@ -155,6 +155,7 @@ impl Hyperboloid {
         reverse: bool,
         material: u32,
     ) -> Hyperboloid {
+        let args = (p1, p2, phi_max_deg);
         let (mut p1, mut p2) = (p1.as_dvec3(), p2.as_dvec3());
         let (a, c) = hyperboloid_coefficients(p1, p2).unwrap_or((f64::NAN, f64::NAN));
         // pbrt-v3 swaps its points for the fit, and keeps them swapped (v
@@ -171,6 +172,7 @@ impl Hyperboloid {
         }
         let place = Placement::new(object_to_world, reverse);
         let mut h = Hyperboloid {
+            args,
             p1,
             p2,
             z_min,
@@ -333,6 +335,10 @@ impl Hyperboloid {
 }
 
 impl Analytic for Hyperboloid {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Hyperboloid::new(a.0, a.1, a.2, to_world, reverse, material)
+    }
     fn valid(&self) -> bool {
         self.is_valid()
     }

@@ -108,14 +108,17 @@ pub static SHAPES: &[ShapeKind] = &[
 pub fn kind_name(g: &Geometry) -> &'static str {
     match g {
         Geometry::TriangleMesh(_) => trianglemesh::KIND.name,
-        Geometry::Sphere { .. } => sphere::KIND.name,
-        Geometry::Disk { .. } => disk::KIND.name,
         Geometry::Curve(_) => curve::KIND.name,
-        Geometry::Cylinder { .. } => cylinder::KIND.name,
-        Geometry::Cone { .. } => cone::KIND.name,
-        Geometry::Paraboloid { .. } => paraboloid::KIND.name,
-        Geometry::Hyperboloid { .. } => hyperboloid::KIND.name,
+        Geometry::Quadric(q) => q.kind_name(),
     }
+}
+
+/// The transform a quadric kind builds its shape with: its object space.
+const ORIGIN: glam::DMat4 = glam::DMat4::IDENTITY;
+
+/// A quadric built at the origin, as the scene description holds it.
+fn at_origin(q: impl Into<Quadric>) -> Option<Geometry> {
+    Some(Geometry::Quadric(q.into()))
 }
 
 /// `phimax`, a line of every quadric's table.

@@ -19,7 +19,7 @@
 //! exact world-area density.
 
 use super::quadric::{Analytic, QuadricHit};
-use super::{check_floats, phi_max, Geometry, ShapeInput, ShapeKind, PHIMAX};
+use super::{at_origin, check_floats, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -80,12 +80,8 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    Some(Geometry::Paraboloid {
-        radius,
-        z_min: z0,
-        z_max: z1,
-        phi_max: phi_max("paraboloid", p, r)?,
-    })
+    let phimax = phi_max("paraboloid", p, r)?;
+    at_origin(Paraboloid::new(radius, z0, z1, phimax, ORIGIN, false, 0))
 }
 
 use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
@@ -96,6 +92,9 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Paraboloid {
+    /// The arguments of [`Paraboloid::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
@@ -133,6 +132,7 @@ impl Paraboloid {
         );
         let obj_area = phi_max / (12.0 * c * c) * (a_max - a_min);
         Paraboloid {
+            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: z0,
             z_max: z1,
@@ -249,6 +249,10 @@ impl Paraboloid {
 }
 
 impl Analytic for Paraboloid {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Paraboloid::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
     fn valid(&self) -> bool {
         self.is_valid()
     }

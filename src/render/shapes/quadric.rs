@@ -32,6 +32,11 @@ impl From<Curve> for Quadric {
 /// only delegates (static dispatch, inlined). The defaults are pbrt-v3's
 /// for shapes sampled by area alone.
 pub trait Analytic {
+    /// The same shape placed by `to_world` (from its object space), with
+    /// the orientation flag and material of its `Shape` statement.
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self
+    where
+        Self: Sized;
     /// False for shapes left out of the scene (singular transforms, no area).
     fn valid(&self) -> bool;
     /// Closest hit with 0 < t < t_max: t and the object-space hit.
@@ -66,7 +71,7 @@ pub trait Analytic {
 }
 
 macro_rules! quadrics {
-    ($($(#[$doc:meta])* $variant:ident($ty:ty),)*) => {
+    ($($(#[$doc:meta])* $variant:ident($ty:ty) = $kind:ident,)*) => {
         /// The quadrics are boxed (each holds its transforms, several
         /// hundred bytes), so that the array of primitives stays small: a
         /// scene of 10,000 curves has 80,000 pieces of a few words each,
@@ -78,6 +83,15 @@ macro_rules! quadrics {
         }
 
         impl Quadric {
+            /// The same shape placed by `to_world`, with the orientation
+            /// flag and material of its `Shape` statement.
+            pub fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Quadric {
+                match self { $(Quadric::$variant(s) => Quadric::from(s.placed(to_world, reverse, material)),)* }
+            }
+            /// The name of its kind in [`SHAPES`](super::SHAPES).
+            pub fn kind_name(&self) -> &'static str {
+                match self { $(Quadric::$variant(_) => super::$kind::KIND.name,)* }
+            }
             #[inline]
             pub fn material(&self) -> u32 {
                 match self { $(Quadric::$variant(s) => s.material,)* }
@@ -135,15 +149,15 @@ macro_rules! quadrics {
 }
 
 quadrics! {
-    Sphere(Box<Sphere>),
-    Disk(Box<Disk>),
-    Cylinder(Box<Cylinder>),
-    Cone(Box<Cone>),
-    Paraboloid(Box<Paraboloid>),
-    Hyperboloid(Box<Hyperboloid>),
+    Sphere(Box<Sphere>) = sphere,
+    Disk(Box<Disk>) = disk,
+    Cylinder(Box<Cylinder>) = cylinder,
+    Cone(Box<Cone>) = cone,
+    Paraboloid(Box<Paraboloid>) = paraboloid,
+    Hyperboloid(Box<Hyperboloid>) = hyperboloid,
     /// A piece of a curve segment (never a light: pbrt-v3 cannot sample
     /// curves, and the scene leaves their emission out).
-    Curve(Curve),
+    Curve(Curve) = curve,
 }
 
 /// A hit on a quadric in its object space: a point computed in f64 (its

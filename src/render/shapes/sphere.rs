@@ -9,7 +9,7 @@
 //! | `phimax`  | float | 360 (degrees)   |
 
 use super::quadric::{Analytic, QuadricHit};
-use super::{Geometry, ShapeInput, ShapeKind, PHIMAX};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
 use crate::scene::{ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -69,12 +69,7 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    Some(Geometry::Sphere {
-        radius,
-        z_min: z0,
-        z_max: z1,
-        phi_max: phimax,
-    })
+    at_origin(Sphere::new(radius, z0, z1, phimax, ORIGIN, false, 0))
 }
 
 use super::{DiffGeom, ShapeSample, SurfacePoint};
@@ -88,6 +83,9 @@ use std::f32::consts::PI;
 /// the world hit point carries an error bound like every other surface.
 #[derive(Clone, Debug)]
 pub struct Sphere {
+    /// The arguments of [`Sphere::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
@@ -153,6 +151,7 @@ impl Sphere {
             det.abs().powf(2.0 / 3.0)
         };
         Sphere {
+            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: zmin,
             z_max: zmax,
@@ -539,6 +538,10 @@ mod tests {
 }
 
 impl Analytic for Sphere {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Sphere::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
     fn valid(&self) -> bool {
         self.radius > 0.0 && self.is_invertible()
     }
