@@ -480,6 +480,42 @@ pub fn area_to_solid_angle(p: Vec3, q: Vec3, nq: Vec3, pdf_area: f32) -> f32 {
     }
 }
 
+impl Analytic for Sphere {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Sphere::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.radius > 0.0 && self.is_invertible()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    #[inline]
+    fn sample_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
+        self.sample_from(p, p_error, n, u)
+    }
+    #[inline]
+    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        self.pdf_from(p, p_error, n, wi, |o, d| {
+            self.intersect(o, d, f32::INFINITY)
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -534,41 +570,5 @@ mod tests {
                 );
             }
         }
-    }
-}
-
-impl Analytic for Sphere {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Sphere::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.radius > 0.0 && self.is_invertible()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p)| (t, QuadricHit::Exact(p)))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        self.surface_point(h.point_and_error().0)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
-    }
-    #[inline]
-    fn sample_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
-        self.sample_from(p, p_error, n, u)
-    }
-    #[inline]
-    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-        self.pdf_from(p, p_error, n, wi, |o, d| {
-            self.intersect(o, d, f32::INFINITY)
-        })
     }
 }
