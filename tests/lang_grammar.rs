@@ -294,6 +294,12 @@ fn reference_family_sections_are_generated_from_the_tables() {
             pbrs::loader::reference::cameras_section,
             rows(pbrs::render::camera::CAMERAS),
         ),
+        (
+            "render::shapes::SHAPES",
+            "shapes",
+            pbrs::loader::reference::shapes_section,
+            rows(pbrs::render::shapes::SHAPES),
+        ),
     ];
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let write = std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1");

@@ -7,6 +7,7 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
 use pbrs::render::camera::Projection;
 use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
+use pbrs::render::shapes::Quadric;
 use pbrs::scene::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -473,16 +474,12 @@ fn triangle_mesh_details() {
 #[test]
 fn sphere_parameters() {
     let s = load("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float zmin\" 5 \"float zmax\" -1 \"float phimax\" 400\nWorldEnd");
-    let Geometry::Sphere {
-        radius,
-        z_min,
-        z_max,
-        phi_max,
-    } = s.scene.shapes[0].geometry
-    else {
+    let Geometry::Quadric(Quadric::Sphere(sp)) = &s.scene.shapes[0].geometry else {
         panic!()
     };
-    assert_eq!((radius, z_min, z_max, phi_max), (2.0, -1.0, 2.0, 360.0));
+    // As the kind built it: zmin and zmax ordered and clamped, phimax clamped.
+    assert_eq!(sp.args, (2.0, -1.0, 2.0, 360.0));
+    assert_eq!((sp.radius, sp.z_min, sp.z_max), (2.0, -1.0, 2.0));
 }
 
 /// `disk` with pbrt-v3's defaults; an empty one is skipped with a warning, a
@@ -491,13 +488,8 @@ fn sphere_parameters() {
 fn disk_parameters_and_bad_disks() {
     let s = load("WorldBegin\nShape \"disk\"\nShape \"disk\" \"float radius\" 2 \"float innerradius\" 3\nShape \"disk\" \"float innerradius\" -1 \"float height\" 0.5 \"float phimax\" 400\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 2);
-    let disk = |i: usize| match s.scene.shapes[i].geometry {
-        Geometry::Disk {
-            height,
-            radius,
-            inner_radius,
-            phi_max,
-        } => (height, radius, inner_radius, phi_max),
+    let disk = |i: usize| match &s.scene.shapes[i].geometry {
+        Geometry::Quadric(Quadric::Disk(d)) => d.args,
         _ => panic!(),
     };
     assert_eq!(disk(0), (0.0, 1.0, 0.0, 360.0));
@@ -608,10 +600,10 @@ fn include_splices_and_resolves_against_the_top_level_directory() {
     )
     .unwrap();
     let s = load_scene(&d.join("main.pbrt")).unwrap_or_else(|f| panic!("{f:?}"));
-    let Geometry::Sphere { radius, .. } = s.scene.shapes[0].geometry else {
+    let Geometry::Quadric(Quadric::Sphere(sp)) = &s.scene.shapes[0].geometry else {
         panic!()
     };
-    assert_eq!(radius, 3.0);
+    assert_eq!(sp.radius, 3.0);
     std::fs::write(
         d.join("sub/b.inc"),
         "Shape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n",

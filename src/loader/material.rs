@@ -13,8 +13,8 @@ use crate::lang::params::{ParamList, ParamType};
 use crate::lang::Loc;
 use crate::render::materials::{self, MaterialKind, Support, MATERIALS};
 use crate::scene::{
-    FloatTex, MaterialDesc, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault,
-    SpectrumTex,
+    Elem, FloatTex, MaterialDesc, ParamKind, ParamSpec, ParamValue, ParamValues, Range,
+    SpectrumDefault, SpectrumTex,
 };
 use glam::Vec3;
 use std::collections::HashMap;
@@ -482,6 +482,17 @@ pub fn read_params_as(
                 .filter(|q| !q.strs()[0].is_empty())
                 .and_then(|q| super::image::load_image(ctx, q.values_loc, &q.strs()[0], decode))
                 .map(ParamValue::Image),
+            ParamKind::List(e) => l
+                .lists()
+                .find_map(|list| {
+                    list.items
+                        .iter()
+                        .find(|q| q.name == s.name && elem_accepts(e, q.ty))
+                })
+                .map(|q| {
+                    q.used.set(true);
+                    ParamValue::Floats(Arc::from(q.nums()))
+                }),
         };
         if let Some(v) = value {
             out.set(s.name, v);
@@ -492,6 +503,17 @@ pub fn read_params_as(
         }
     }
     (out, refs)
+}
+
+/// The parameter types a [`ParamKind::List`] of `e` takes.
+fn elem_accepts(e: Elem, ty: ParamType) -> bool {
+    match e {
+        Elem::Number => matches!(ty, ParamType::Float | ParamType::Integer),
+        Elem::Int => ty == ParamType::Integer,
+        Elem::Point2 => matches!(ty, ParamType::Point2 | ParamType::Float),
+        Elem::Point3 => ty == ParamType::Point3,
+        Elem::Normal => ty == ParamType::Normal,
+    }
 }
 
 fn check_range(ctx: &mut Ctx, s: &ParamSpec, v: f32, loc: Loc) -> f32 {

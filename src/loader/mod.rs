@@ -23,6 +23,7 @@ pub mod meshfile;
 pub mod ply;
 pub mod reference;
 pub mod refine;
+pub mod shapes;
 pub mod spd;
 pub mod state;
 pub mod summary;
@@ -31,7 +32,7 @@ pub mod texture;
 use crate::lang::params::{Param, ParamList};
 use crate::lang::parser::{to_text, DiskLoader, FileLoader, Parser};
 use crate::lang::{Diags, Loc, SourceMap};
-use crate::scene::{FourierTable, ParamKind, ParamSpec, SceneDescription};
+use crate::scene::{Elem, FourierTable, ParamKind, ParamSpec, SceneDescription};
 use glam::Vec3;
 use miette::Severity;
 use std::collections::HashMap;
@@ -190,6 +191,11 @@ fn accepted_types(kind: ParamKind) -> &'static [&'static str] {
         ParamKind::SpectrumOrFloat(_) => &["rgb", "color", "xyz", "blackbody", "spectrum", "float"],
         ParamKind::IntOpt => &["integer"],
         ParamKind::Image(_) => &["string"],
+        ParamKind::List(Elem::Number) => &["float", "integer"],
+        ParamKind::List(Elem::Int) => &["integer"],
+        ParamKind::List(Elem::Point2) => &["point2", "float"],
+        ParamKind::List(Elem::Point3) => &["point3", "point"],
+        ParamKind::List(Elem::Normal) => &["normal"],
     }
 }
 
@@ -253,6 +259,7 @@ fn kind_name(kind: ParamKind) -> &'static str {
         ParamKind::SpectrumOrFloat(_) => "spectrum",
         ParamKind::IntOpt => "integer",
         ParamKind::Image(_) => "file-name",
+        ParamKind::List(e) => e.name(),
     }
 }
 

@@ -152,6 +152,7 @@ pub fn describe(p: &ParamSpec) -> (String, String) {
         ),
         ParamKind::IntOpt => ("integer".to_string(), None),
         ParamKind::Image(_) => ("string: an image file".to_string(), None),
+        ParamKind::List(e) => (format!("{} values", e.name()), None),
     };
     (
         format!("{ty}{nonneg}"),
@@ -357,6 +358,12 @@ pub fn lights_section() -> String {
     out.push_str(LIGHTS_END);
     out.push('\n');
     out
+}
+
+/// The shape section, from [`SHAPES`](crate::render::shapes::SHAPES).
+pub fn shapes_section() -> String {
+    let (b, e) = markers("render::shapes::SHAPES", "shapes");
+    kinds_section((&b, &e), crate::render::shapes::SHAPES)
 }
 
 /// `doc` with the part from the line `begin_marker` to the line

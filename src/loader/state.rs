@@ -785,10 +785,10 @@ impl<'s, 'c> Builder<'s, 'c> {
             params.mark_all_used();
             return None;
         }
-        let geometry = entities::geometry(self.ctx, name, params, &mut self.meshes);
+        let geometry = super::shapes::geometry(self.ctx, name, params, &mut self.meshes);
         let Some(geometry) = geometry else {
             // Otherwise an error or an empty-shape warning was reported.
-            if entities::is_unsupported_shape(&name.value) {
+            if super::shapes::is_unsupported_shape(&name.value) {
                 self.unsupported_shapes += 1;
             }
             params.mark_all_used();

@@ -113,7 +113,7 @@ impl Summary {
         for sh in &scene.shapes {
             s.shapes += 1;
             *s.shapes_by_type
-                .entry(geometry_name(&sh.geometry))
+                .entry(crate::render::shapes::kind_name(&sh.geometry))
                 .or_default() += 1;
             s.triangles += triangles(&sh.geometry);
             s.area_lights += usize::from(sh.area_light.is_some());
@@ -157,19 +157,6 @@ pub enum DeclaredKind {
     Table(&'static str),
     /// A type pbrs does not know (built as a matte).
     Unknown(String),
-}
-
-fn geometry_name(g: &Geometry) -> &'static str {
-    match g {
-        Geometry::TriangleMesh(_) => "trianglemesh",
-        Geometry::Sphere { .. } => "sphere",
-        Geometry::Disk { .. } => "disk",
-        Geometry::Curve(_) => "curve",
-        Geometry::Cylinder { .. } => "cylinder",
-        Geometry::Cone { .. } => "cone",
-        Geometry::Paraboloid { .. } => "paraboloid",
-        Geometry::Hyperboloid { .. } => "hyperboloid",
-    }
 }
 
 fn triangles(g: &Geometry) -> usize {

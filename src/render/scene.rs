@@ -7,10 +7,7 @@ use crate::render::camera::Camera;
 use crate::render::lights::{AreaShape, DiffuseEmission, DiffuseLight, Light};
 use crate::render::materials::{link_materials, Material};
 use crate::render::media::Medium;
-use crate::render::shapes::{
-    AlphaMask, Cone, Curve, CurveCommon, Cylinder, Disk, Hyperboloid, Paraboloid, Quadric, Sphere,
-    TriangleMesh,
-};
+use crate::render::shapes::{AlphaMask, Curve, CurveCommon, Quadric, TriangleMesh};
 use crate::scene::{self, MediumInterfaceDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, Vec3};
 use std::collections::HashMap;
@@ -342,58 +339,10 @@ fn curve_pieces<'a>(
 /// An analytic shape in the space `to_world` maps to (`None` for meshes and
 /// curves).
 fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc, material: u32) -> Option<Quadric> {
-    let reverse = s.reverse_orientation;
-    Some(match *g {
-        scene::Geometry::TriangleMesh(_) | scene::Geometry::Curve(_) => return None,
-        scene::Geometry::Sphere {
-            radius,
-            z_min,
-            z_max,
-            phi_max,
-        } => Quadric::from(Sphere::new(
-            radius, z_min, z_max, phi_max, to_world, reverse, material,
-        )),
-        scene::Geometry::Cylinder {
-            radius,
-            z_min,
-            z_max,
-            phi_max,
-        } => Quadric::from(Cylinder::new(
-            radius, z_min, z_max, phi_max, to_world, reverse, material,
-        )),
-        scene::Geometry::Cone {
-            radius,
-            height,
-            phi_max,
-        } => Quadric::from(Cone::new(
-            radius, height, phi_max, to_world, reverse, material,
-        )),
-        scene::Geometry::Paraboloid {
-            radius,
-            z_min,
-            z_max,
-            phi_max,
-        } => Quadric::from(Paraboloid::new(
-            radius, z_min, z_max, phi_max, to_world, reverse, material,
-        )),
-        scene::Geometry::Hyperboloid { p1, p2, phi_max } => Quadric::from(Hyperboloid::new(
-            p1, p2, phi_max, to_world, reverse, material,
-        )),
-        scene::Geometry::Disk {
-            height,
-            radius,
-            inner_radius,
-            phi_max,
-        } => Quadric::from(Disk::new(
-            height,
-            radius,
-            inner_radius,
-            phi_max,
-            to_world,
-            reverse,
-            material,
-        )),
-    })
+    match g {
+        scene::Geometry::Quadric(q) => Some(q.placed(to_world, s.reverse_orientation, material)),
+        scene::Geometry::TriangleMesh(_) | scene::Geometry::Curve(_) => None,
+    }
 }
 
 /// Transform an object-space mesh to world space (positions in f64 before

@@ -18,7 +18,7 @@ pub use fourier::{FourierTable, FourierTableData, MAX_FOURIER_ORDER};
 pub use image::{srgb_to_linear, Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
 pub use kind::{Collected, Kind, Report, Support};
 pub use motion::AnimatedTransform;
-pub use params::{ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
+pub use params::{Elem, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};
 
 pub use crate::render::lights::{DiffuseEmission, Light};
@@ -233,58 +233,21 @@ pub struct ShapeDesc {
     pub medium_interface: MediumInterfaceDesc,
 }
 
+/// A shape as its kind built it (`render::shapes::SHAPES`), in its object
+/// space; the render core places it (once per instance for shapes inside
+/// `ObjectBegin`).
 #[derive(Clone, Debug)]
 pub enum Geometry {
-    /// Vertices in object space.
+    /// Vertices in object space (`trianglemesh`, the mesh files and the
+    /// refined shapes).
     TriangleMesh(Arc<MeshData>),
-    Sphere {
-        radius: f32,
-        z_min: f32,
-        z_max: f32,
-        /// Degrees, (0, 360].
-        phi_max: f32,
-    },
-    /// pbrt-v3's `cylinder`: z_min < z_max.
-    Cylinder {
-        radius: f32,
-        z_min: f32,
-        z_max: f32,
-        /// Degrees, (0, 360].
-        phi_max: f32,
-    },
-    /// pbrt-v3's `cone`: radius > 0, height > 0.
-    Cone {
-        radius: f32,
-        height: f32,
-        /// Degrees, (0, 360].
-        phi_max: f32,
-    },
-    /// pbrt-v3's `paraboloid`: radius > 0, 0 <= z_min < z_max.
-    Paraboloid {
-        radius: f32,
-        z_min: f32,
-        z_max: f32,
-        /// Degrees, (0, 360].
-        phi_max: f32,
-    },
-    /// pbrt-v3's `hyperboloid` through p1 and p2 (checked to have one).
-    Hyperboloid {
-        p1: glam::Vec3,
-        p2: glam::Vec3,
-        /// Degrees, (0, 360].
-        phi_max: f32,
-    },
     /// pbrt-v3's `curve`, as cubic Bézier segments (bspline and degree-2
-    /// input already converted).
+    /// input already converted); placed as 2^splitdepth pieces per segment.
     Curve(Arc<CurveData>),
-    /// pbrt-v3's `disk`: 0 <= inner_radius < radius.
-    Disk {
-        height: f32,
-        radius: f32,
-        inner_radius: f32,
-        /// Degrees, (0, 360].
-        phi_max: f32,
-    },
+    /// A sphere, disk, cylinder, cone, paraboloid or hyperboloid: the
+    /// render core's own shape, built at the origin (identity transform)
+    /// and placed with `Quadric::placed`.
+    Quadric(crate::render::shapes::Quadric),
 }
 
 /// pbrt-v3's curve types.

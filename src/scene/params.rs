@@ -83,6 +83,34 @@ pub enum ParamKind {
     /// says; absent when not given or empty (a file that cannot be read is
     /// an error).
     Image(super::Decode),
+    /// Values of one element type, any count, as numbers (no default):
+    /// a mesh's `P`, `indices`, `N`, `uv`.
+    List(Elem),
+}
+
+/// The element type of a [`ParamKind::List`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Elem {
+    /// `float` or `integer` values.
+    Number,
+    Int,
+    /// `point2` values (or `float`, as pbrt-v3 takes uv).
+    Point2,
+    Point3,
+    Normal,
+}
+
+impl Elem {
+    /// Its name in messages and `grammar/REFERENCE.md`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Elem::Number => "number",
+            Elem::Int => "integer",
+            Elem::Point2 => "point2",
+            Elem::Point3 => "point3",
+            Elem::Normal => "normal",
+        }
+    }
 }
 
 /// A constraint the loader checks on constant values (with a located
@@ -351,6 +379,14 @@ impl ParamSpec {
             doc,
         }
     }
+    pub const fn list(name: &'static str, elem: Elem, doc: &'static str) -> ParamSpec {
+        ParamSpec {
+            name,
+            kind: ParamKind::List(elem),
+            range: Range::Any,
+            doc,
+        }
+    }
     /// pbrt-v3's `bumpmap`: a float texture of displacements along the
     /// shading normal, applied by `Material::bsdf_into` for every material.
     pub const BUMPMAP: ParamSpec = ParamSpec::float_tex_opt(
@@ -422,6 +458,7 @@ impl ParamValues {
             v => panic!("parameter \"{name}\" is {v:?}, not a float"),
         }
     }
+    /// A [`ParamKind::FloatOpt`]: `None` unless given.
     pub fn float_opt(&self, name: &str) -> Option<f32> {
         match self.get(name) {
             Some(ParamValue::Float(f)) => Some(*f),

@@ -18,8 +18,7 @@ pub mod nurbs;
 use super::Ctx;
 use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::Name;
-use crate::scene::{Geometry, MeshData};
-use std::sync::Arc;
+use crate::scene::MeshData;
 
 /// The most vertices a refinement may produce (the work and memory are
 /// proportional to it; a request above it is refused before allocating).
@@ -58,7 +57,7 @@ pub type Notes = Vec<Problem>;
 pub const REFINED_SHAPES: &[&str] = &["loopsubdiv", "nurbs", "heightfield"];
 
 /// The mesh of a refined shape, or `None` after a located error.
-pub fn shape(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
+pub fn shape(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> {
     let mut notes = Notes::new();
     let result = match name.value.as_str() {
         "loopsubdiv" => loopsubdiv::read(p, &mut notes).and_then(|i| i.refine(&mut notes)),
@@ -78,7 +77,7 @@ pub fn shape(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<Geometry> {
         ctx.warn(loc_of(n), format!("{}: {}", name.value, n.message), "here");
     }
     match result {
-        Ok(mesh) => Some(Geometry::TriangleMesh(Arc::new(mesh))),
+        Ok(mesh) => Some(mesh),
         Err(e) => {
             ctx.error(
                 loc_of(&e),

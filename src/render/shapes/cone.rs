@@ -19,6 +19,41 @@
 //! a cone area light is a pbrs extension: uniform by area (v = 1 − √(1 − ξ)),
 //! with the exact world-area density.
 
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, check_floats, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius of its base (> 0)"),
+    ParamSpec::float("height", 1.0, "height of its apex (> 0)"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "cone",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a cone (or a sector of one) from a base at z = 0 to its apex. Open at the base; radius or height ≤ 0 or not a 32-bit float: error; phimax 0: warning, skipped. Intersected as pbrt-v3 (f32 with running error bounds). Area lights: a pbrs extension (pbrt-v3 cannot sample cones), uniform by area",
+    build,
+};
+
+/// pbrt-v3's checks: radius and height positive 32-bit floats (error),
+/// phimax > 0 (warning, skipped).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let height = p.float("height");
+    if !check_floats(
+        "cone",
+        r,
+        &[("radius", radius, true), ("height", height, true)],
+    ) {
+        return None;
+    }
+    let phimax = phi_max("cone", p, r)?;
+    at_origin(Cone::new(radius, height, phimax, ORIGIN, false, 0))
+}
+
 use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};
@@ -27,6 +62,9 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Cone {
+    /// The arguments of [`Cone::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32),
     pub radius: f64,
     pub height: f64,
     /// Radians.
@@ -52,6 +90,7 @@ impl Cone {
         let place = Placement::new(object_to_world, reverse);
         let obj_area = r * (h * h + r * r).sqrt() * phi_max / 2.0;
         Cone {
+            args: (radius, height, phi_max_deg),
             radius: r,
             height: h,
             phi_max,
@@ -171,5 +210,35 @@ impl Cone {
             point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
         }
+    }
+}
+
+impl Analytic for Cone {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Cone::new(a.0, a.1, a.2, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.surface_point(p, err)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
     }
 }

@@ -35,6 +35,283 @@
 //! hit (pbrt-v3 divides by its zero width). Curves cannot be area lights
 //! (pbrt-v3's `Curve::Sample` aborts); the loader warns.
 
+use super::quadric::{Analytic, QuadricHit};
+use super::ShapeSample;
+use super::{Geometry, ShapeInput, ShapeKind};
+use crate::scene::{CurveData, CurveSegment, Elem, ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::list("P", Elem::Point3, "control points (required)"),
+    ParamSpec::string(
+        "basis",
+        "bezier",
+        "`\"bezier\"` or `\"bspline\"` (else error)",
+    ),
+    ParamSpec::int("degree", 3, "2 or 3 (else error)"),
+    ParamSpec::string(
+        "type",
+        "flat",
+        "`\"flat\"`, `\"ribbon\"` or `\"cylinder\"` (else warning, cylinder)",
+    ),
+    ParamSpec::float("width", 1.0, "width along the whole curve"),
+    ParamSpec::float_opt("width0", "width at its start (default width)"),
+    ParamSpec::float_opt("width1", "width at its end (default width)"),
+    ParamSpec::list("N", Elem::Normal, "ribbons: a normal at every segment end"),
+    ParamSpec::list(
+        "splitdepth",
+        Elem::Number,
+        "each segment is split in 2^splitdepth pieces (default 3; clamped to 0..10)",
+    ),
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "curve",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a cubic (or quadratic) Bézier or b-spline curve of varying width: `flat` (a strip facing the ray), `cylinder` (shaded as a tube) or `ribbon` (oriented by `N`), intersected as pbrt-v3 (recursive subdivision). Degree other than 2 or 3, an unknown basis, a wrong number of control points or ribbon normals, a ribbon without `N`, a width that is not positive: error; an unknown type: warning, cylinder; `N` on a non-ribbon: warning, ignored. Never an area light (pbrt-v3 cannot sample curves): warning, not emissive",
+    build,
+};
+
+/// Most Bézier segments one `curve` may have (each becomes 2^splitdepth BVH
+/// primitives).
+const MAX_CURVE_SEGMENTS: usize = 1 << 22;
+
+/// pbrt-v3's `CreateCurveShape`: the curve as cubic Bézier segments, with
+/// its checks (errors where pbrt-v3 reports an error and makes no shape).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let width = p.float("width");
+    let width0 = p.float_opt("width0").unwrap_or(width);
+    let width1 = p.float_opt("width1").unwrap_or(width);
+    let degree = p.int("degree");
+    if degree != 2 && degree != 3 {
+        r.error(
+            Some("degree"),
+            format!("curve degree {degree}: only degree 2 and 3 curves are supported (as pbrt-v3)"),
+            "degree must be 2 or 3",
+        );
+        return None;
+    }
+    let degree = degree as usize;
+    let bspline = match p.string("basis") {
+        "bezier" => false,
+        "bspline" => true,
+        other => {
+            r.error(
+                Some("basis"),
+                format!("curve basis \"{other}\": only \"bezier\" and \"bspline\" are supported (as pbrt-v3)"),
+                "unknown basis",
+            );
+            return None;
+        }
+    };
+    let (cp, segments) = control_points(p, r, degree, bspline)?;
+    let kind = match p.string("type") {
+        "flat" => CurveKind::Flat,
+        "ribbon" => CurveKind::Ribbon,
+        "cylinder" => CurveKind::Cylinder,
+        other => {
+            r.warn(
+                Some("type"),
+                format!("unknown curve type \"{other}\": \"cylinder\" is used (as pbrt-v3)"),
+                "unknown curve type",
+            );
+            CurveKind::Cylinder
+        }
+    };
+    let normals = normals(p, r, kind, segments)?;
+    let split_depth = match p.has("splitdepth") {
+        true => p.floats("splitdepth").first().map_or(3, |&d| d as i64),
+        false => 3,
+    };
+    // pbrt-v3 takes a negative depth as no split and overflows past 31;
+    // beyond 10 a piece is already far below the subdivision's resolution.
+    let split_depth = split_depth.clamp(0, 10) as u32;
+    let (w0, w1) = (width0, width1);
+    let wat = ["width0", "width1"]
+        .into_iter()
+        .find(|n| p.float_opt(n).is_some())
+        .unwrap_or("width");
+    if !(w0 > 0.0 && w1 > 0.0 && w0.is_finite() && w1.is_finite()) {
+        r.error(
+            Some(wat),
+            format!("curve widths {width0} and {width1}: both must be positive 32-bit floats (pbrt-v3 gives NaN or no curve otherwise)"),
+            "width must be > 0",
+        );
+        return None;
+    }
+    let mut out = Vec::with_capacity(segments);
+    for seg in 0..segments {
+        let bez = if bspline {
+            bspline_to_bezier(&cp[seg..seg + degree + 1])
+        } else {
+            bezier_to_cubic(&cp[seg * degree..seg * degree + degree + 1])
+        };
+        let t0 = seg as f32 / segments as f32;
+        let t1 = (seg + 1) as f32 / segments as f32;
+        out.push(CurveSegment {
+            cp: bez,
+            width: [w0 + (w1 - w0) * t0, w0 + (w1 - w0) * t1],
+            normals: normals.as_ref().map(|n: &Vec<Vec3>| [n[seg], n[seg + 1]]),
+        });
+    }
+    Some(Geometry::Curve(std::sync::Arc::new(CurveData {
+        kind,
+        segments: out,
+        split_depth,
+    })))
+}
+
+/// The control points `P` and the number of segments they make, checked
+/// as pbrt-v3 does.
+fn control_points(
+    p: &ParamValues,
+    r: &mut dyn ShapeInput,
+    degree: usize,
+    bspline: bool,
+) -> Option<(Vec<Vec3>, usize)> {
+    if !p.has("P") {
+        r.error(
+            None,
+            "curve needs control points \"point P\"".into(),
+            "no \"point P\"",
+        );
+        return None;
+    }
+    let cp = to_vec3(&p.floats("P"));
+    let ncp = cp.len();
+    let segments = if bspline {
+        if ncp < degree + 1 {
+            r.error(
+                Some("P"),
+                format!(
+                    "{ncp} control points: a degree {degree} b-spline curve needs at least {}",
+                    degree + 1
+                ),
+                "too few control points",
+            );
+            return None;
+        }
+        ncp - degree
+    } else {
+        if ncp < degree + 1 || !(ncp - 1 - degree).is_multiple_of(degree) {
+            r.error(
+                Some("P"),
+                format!("{ncp} control points: a degree {degree} Bézier curve needs {} + n·{degree} (n ≥ 0)", degree + 1),
+                "wrong number of control points",
+            );
+            return None;
+        }
+        (ncp - 1) / degree
+    };
+    if cp.iter().any(|v| !v.is_finite()) {
+        r.error(
+            Some("P"),
+            "a control point of \"P\" does not fit a 32-bit float".into(),
+            "too large",
+        );
+        return None;
+    }
+    if segments > MAX_CURVE_SEGMENTS {
+        r.error(
+            Some("P"),
+            format!("{segments} curve segments: pbrs takes at most {MAX_CURVE_SEGMENTS} per curve"),
+            "too many segments",
+        );
+        return None;
+    }
+    Some((cp, segments))
+}
+
+/// A ribbon's normals `N` (one per segment end); `Some(None)` for the
+/// other types, which ignore them (with a warning, as pbrt-v3).
+fn normals(
+    p: &ParamValues,
+    r: &mut dyn ShapeInput,
+    kind: CurveKind,
+    segments: usize,
+) -> Option<Option<Vec<Vec3>>> {
+    if !p.has("N") {
+        if kind == CurveKind::Ribbon {
+            r.error(
+                None,
+                "a ribbon curve needs normals \"N\" at its segments' ends (as pbrt-v3)".into(),
+                "no \"normal N\"",
+            );
+            return None;
+        }
+        return Some(None);
+    }
+    if kind != CurveKind::Ribbon {
+        r.warn(
+            Some("N"),
+            "curve normals \"N\" are only used by \"ribbon\" curves: ignored (as pbrt-v3)".into(),
+            "ignored",
+        );
+        return Some(None);
+    }
+    let n = to_vec3(&p.floats("N"));
+    if n.len() != segments + 1 {
+        r.error(
+            Some("N"),
+            format!(
+                "{} normals: a ribbon curve with {segments} segments needs {}",
+                n.len(),
+                segments + 1
+            ),
+            "wrong number of normals",
+        );
+        return None;
+    }
+    if n.iter()
+        .any(|v| !(v.is_finite() && v.length_squared() > 0.0 && v.normalize().is_finite()))
+    {
+        r.error(
+            Some("N"),
+            "a ribbon normal is zero or not a finite 32-bit vector".into(),
+            "bad normal",
+        );
+        return None;
+    }
+    Some(Some(n))
+}
+
+/// A Bézier segment of degree 2 or 3 as a cubic (degree elevation).
+fn bezier_to_cubic(c: &[Vec3]) -> [Vec3; 4] {
+    if c.len() == 3 {
+        [
+            c[0],
+            c[0].lerp(c[1], 2.0 / 3.0),
+            c[1].lerp(c[2], 1.0 / 3.0),
+            c[2],
+        ]
+    } else {
+        [c[0], c[1], c[2], c[3]]
+    }
+}
+
+/// A uniform b-spline segment of degree 2 or 3 as the cubic Bézier of the
+/// same curve (by blossoming, as pbrt-v3).
+fn bspline_to_bezier(c: &[Vec3]) -> [Vec3; 4] {
+    if c.len() == 3 {
+        let (p11, p12, p22) = (c[0].lerp(c[1], 0.5), c[1], c[1].lerp(c[2], 0.5));
+        [p11, p11.lerp(p12, 2.0 / 3.0), p12.lerp(p22, 1.0 / 3.0), p22]
+    } else {
+        let p122 = c[0].lerp(c[1], 2.0 / 3.0);
+        let p223 = c[1].lerp(c[2], 1.0 / 3.0);
+        let p233 = c[1].lerp(c[2], 2.0 / 3.0);
+        let p334 = c[2].lerp(c[3], 1.0 / 3.0);
+        [p122.lerp(p223, 0.5), p223, p233, p233.lerp(p334, 0.5)]
+    }
+}
+
+/// Triples of numbers as f32 vectors.
+pub(super) fn to_vec3(v: &[f64]) -> Vec<Vec3> {
+    v.chunks_exact(3)
+        .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
+        .collect()
+}
+
 use super::{coordinate_system, DiffGeom, Placement, SurfacePoint};
 use crate::render::geometry::Bounds3;
 pub use crate::scene::CurveKind;
@@ -475,4 +752,53 @@ fn bezier_derivative(c: &[Vec3; 4], u: f32) -> Vec3 {
 fn rotate(v: Vec3, axis: Vec3, angle: f32) -> Vec3 {
     let (s, c) = angle.sin_cos();
     v * c + axis.cross(v) * s + axis * axis.dot(v) * (1.0 - c)
+}
+
+impl Analytic for Curve {
+    /// (A curve's description is its segments, placed by
+    /// `Curve::pieces`; a piece is already placed.)
+    fn placed(&self, _: DMat4, _: bool, _: u32) -> Self {
+        self.clone()
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, h)| (t, QuadricHit::Curve(h)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        match h {
+            QuadricHit::Curve(h) => self.surface_point(h),
+            // (Never reached: a curve's hits are curve hits.)
+            _ => {
+                let (p, err) = h.point_and_error();
+                SurfacePoint {
+                    p: p.as_vec3(),
+                    p_error: err.as_vec3(),
+                    n: Vec3::Z,
+                    ns: Vec3::Z,
+                }
+            }
+        }
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        match h {
+            QuadricHit::Curve(h) => self.diff_geom(h),
+            _ => DiffGeom::ZERO,
+        }
+    }
+    /// Never a light (the scene leaves curves' emission out).
+    fn area_sample(&self, _: Vec2) -> Option<ShapeSample> {
+        None
+    }
+    fn sample_toward(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec2) -> Option<ShapeSample> {
+        None
+    }
+    fn pdf_toward(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec3) -> f32 {
+        0.0
+    }
 }

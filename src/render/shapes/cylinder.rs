@@ -14,6 +14,58 @@
 //! sampling is pbrt-v3's `Cylinder::Sample` (uniform in z and φ), density
 //! 1/(world area) (pbrt-v3 uses the object-space area).
 
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius (> 0)"),
+    ParamSpec::float("zmin", -1.0, "lower end (pbrt-v3 orders zmin and zmax)"),
+    ParamSpec::float("zmax", 1.0, "upper end"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "cylinder",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a cylinder (or a sector of one) about the z axis. Open tube; zmin/zmax ordered, phimax clamped as pbrt-v3; radius ≤ 0: error; zmin = zmax or phimax 0: warning, skipped; area lights sampled uniformly in z and φ (pbrt-v3's `Cylinder::Sample`)",
+    build,
+};
+
+/// pbrt-v3's checks: a positive radius and finite ends (error), a
+/// non-empty extent (warning, skipped).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    if radius.is_nan()
+        || radius <= 0.0
+        || !radius.is_finite()
+        || !zmin.is_finite()
+        || !zmax.is_finite()
+    {
+        r.error(
+            Some("radius"),
+            format!("cylinder radius {radius} (zmin {zmin}, zmax {zmax}) is not a positive 32-bit float"),
+            "bad cylinder",
+        );
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax itself.
+    let (z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z0 >= z1 || phimax <= 0.0 {
+        r.warn(
+            None,
+            "cylinder with an empty extent (zmin = zmax or phimax 0): skipped".into(),
+            "empty cylinder",
+        );
+        return None;
+    }
+    at_origin(Cylinder::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+}
+
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
@@ -21,6 +73,9 @@ use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Cylinder {
+    /// The arguments of [`Cylinder::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
@@ -55,6 +110,7 @@ impl Cylinder {
         // otherwise (only light power reads it then; the density is exact).
         let scale2 = det.abs().powf(2.0 / 3.0);
         Cylinder {
+            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: zmin,
             z_max: zmax,
@@ -223,5 +279,34 @@ fn phi_of(p: DVec3) -> f64 {
         phi + TAU
     } else {
         phi
+    }
+}
+
+impl Analytic for Cylinder {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Cylinder::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
     }
 }

@@ -21,6 +21,69 @@
 //! match. Unlike pbrt-v3, the area is the world area (the transform's
 //! Jacobian is constant for a plane), so scaled disk lights are unbiased.
 
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("height", 0.0, "z of its plane"),
+    ParamSpec::float("radius", 1.0, "outer radius (> 0)"),
+    ParamSpec::float(
+        "innerradius",
+        0.0,
+        "inner radius (0 ≤ innerradius < radius)",
+    ),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "disk",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a disk or annulus (or a sector of one) in a plane z = height. `phimax` clamped to [0, 360] as pbrt-v3; radius ≤ 0 or not a 32-bit float: error; innerradius < 0: warning, 0; innerradius ≥ radius or phimax 0: warning, skipped. As an area light it is sampled as pbrt-v3's `Disk::Sample`: the whole disk of `radius`, density 1/area of the partial disk",
+    build,
+};
+
+/// pbrt-v3's checks: a positive radius (error), a negative inner radius is
+/// 0 (warning), an empty annulus or sector is skipped (warning).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let height = p.float("height");
+    let radius = p.float("radius");
+    let mut inner = p.float("innerradius");
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    if radius.is_nan()
+        || radius <= 0.0
+        || !radius.is_finite()
+        || !height.is_finite()
+        || !inner.is_finite()
+    {
+        r.error(
+            Some("radius"),
+            format!("disk radius {radius} (height {height}, innerradius {inner}) is not a positive 32-bit float"),
+            "bad disk",
+        );
+        return None;
+    }
+    if inner < 0.0 {
+        r.warn(
+            Some("innerradius"),
+            format!("disk innerradius {inner} is negative: 0 is used"),
+            "negative innerradius",
+        );
+        inner = 0.0;
+    }
+    if inner >= radius || phimax <= 0.0 {
+        r.warn(
+            None,
+            format!("disk with an empty extent (innerradius {inner} >= radius {radius}, or phimax 0): skipped"),
+            "empty disk",
+        );
+        return None;
+    }
+    at_origin(Disk::new(height, radius, inner, phimax, ORIGIN, false, 0))
+}
+
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
 use crate::render::sampling::concentric_sample_disk;
@@ -29,6 +92,9 @@ use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Disk {
+    /// The arguments of [`Disk::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub height: f64,
     pub radius: f64,
     pub inner_radius: f64,
@@ -71,6 +137,7 @@ impl Disk {
         let jacobian = det.abs() * (normal_matrix * DVec3::Z).length();
         let obj_area = 0.5 * phi_max * (r * r - ri * ri);
         Disk {
+            args: (height, radius, inner_radius, phi_max_deg),
             height: height as f64,
             radius: r,
             inner_radius: ri,
@@ -229,5 +296,35 @@ fn phi_of(p: DVec3) -> f64 {
         phi + TAU
     } else {
         phi
+    }
+}
+
+impl Analytic for Disk {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Disk::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    #[inline]
+    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        self.pdf_from(p, p_error, n, wi)
     }
 }

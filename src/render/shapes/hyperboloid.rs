@@ -24,6 +24,66 @@
 //! `p2` only). pbrt-v3 cannot sample hyperboloids; a hyperboloid area light is
 //! a pbrs extension: uniform in z and φ, with its exact world-area density.
 
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::point3("p1", [0.0, 0.0, 0.0], "a point of the line swept about z"),
+    ParamSpec::point3("p2", [1.0, 1.0, 1.0], "another point of it (p1.z ≠ p2.z)"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "hyperboloid",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "the hyperboloid of one sheet swept by the line p1 p2 about z. The surface pbrt-v3 fits to the line p1–p2; p1.z = p2.z, a line that meets the axis (pbrt-v3's defaults: it never finishes) or a fit without points over the z range: error; phimax 0: warning, skipped. Intersected as pbrt-v3. Area lights: a pbrs extension, uniform in z and φ with the exact density",
+    build,
+};
+
+/// pbrt-v3's fitting, checked: p1 and p2 finite, at different heights, on a
+/// line that misses the z axis, and the fitted surface has points at every
+/// height between them (errors otherwise: pbrt-v3 divides by zero, loops
+/// forever or makes NaNs).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let (p1, p2) = (p.point("p1"), p.point("p2"));
+    let at = Some("p1");
+    if !(p1.as_vec3().is_finite() && p2.as_vec3().is_finite()) {
+        r.error(
+            at,
+            "hyperboloid p1/p2 are not finite 32-bit floats".into(),
+            "bad point",
+        );
+        return None;
+    }
+    let (p1, p2) = (p1.as_vec3(), p2.as_vec3());
+    let bad = |why: &str| {
+        format!(
+            "hyperboloid p1 [{} {} {}], p2 [{} {} {}]: {why}",
+            p1.x, p1.y, p1.z, p2.x, p2.y, p2.z
+        )
+    };
+    if p1.z == p2.z {
+        r.error(at, bad("p1 and p2 are at the same height, so they define no hyperboloid (pbrt-v3 divides by zero); use a disk for an annulus"), "p1.z = p2.z");
+        return None;
+    }
+    let Some((a, c)) = hyperboloid_coefficients(p1.as_dvec3(), p2.as_dvec3()) else {
+        r.error(at, bad("the line through them meets the z axis, which makes a cone, not a hyperboloid (pbrt-v3 never finishes building it); use a cone"), "no hyperboloid");
+        return None;
+    };
+    let (z0, z1) = (p1.z.min(p2.z) as f64, p1.z.max(p2.z) as f64);
+    let rho2 = |z: f64| (1.0 + c * z * z) / a;
+    let inside = z0 < 0.0 && z1 > 0.0;
+    if !(rho2(z0) > 0.0 && rho2(z1) > 0.0 && (!inside || rho2(0.0) > 0.0)) {
+        r.error(at, bad("the implicit surface pbrt-v3 fits to them has no points at some heights between p1 and p2 (not a hyperboloid of one sheet there)"), "not a hyperboloid");
+        return None;
+    }
+    let phimax = phi_max("hyperboloid", p, r)?;
+    at_origin(Hyperboloid::new(p1, p2, phimax, ORIGIN, false, 0))
+}
+
 use super::quadric::{pbrt_closest, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};
@@ -33,6 +93,9 @@ use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Hyperboloid {
+    /// The arguments of [`Hyperboloid::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (Vec3, Vec3, f32),
     pub p1: DVec3,
     pub p2: DVec3,
     pub z_min: f64,
@@ -92,6 +155,7 @@ impl Hyperboloid {
         reverse: bool,
         material: u32,
     ) -> Hyperboloid {
+        let args = (p1, p2, phi_max_deg);
         let (mut p1, mut p2) = (p1.as_dvec3(), p2.as_dvec3());
         let (a, c) = hyperboloid_coefficients(p1, p2).unwrap_or((f64::NAN, f64::NAN));
         // pbrt-v3 swaps its points for the fit, and keeps them swapped (v
@@ -108,6 +172,7 @@ impl Hyperboloid {
         }
         let place = Placement::new(object_to_world, reverse);
         let mut h = Hyperboloid {
+            args,
             p1,
             p2,
             z_min,
@@ -266,5 +331,35 @@ impl Hyperboloid {
             point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
         }
+    }
+}
+
+impl Analytic for Hyperboloid {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Hyperboloid::new(a.0, a.1, a.2, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.surface_point(p, err)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
     }
 }

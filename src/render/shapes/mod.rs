@@ -1,15 +1,31 @@
-//! Shapes in world space: triangle meshes and quadrics (spheres, disks, cylinders, cones, paraboloids, hyperboloids), with intersection,
-//! surface interactions carrying error bounds, and sampling for area lights.
+//! Shapes, as pbrt-v3 has them (src/shapes/*.cpp): one file per kind,
+//! each opening with its parameters and pbrt-v3's checks of them, and one
+//! table, [`SHAPES`], that the loader (parsing, "did you mean"), `--check`,
+//! `grammar/REFERENCE.md` and the tests read. A kind's builder makes the
+//! scene description's [`Geometry`] (object space); the render core places
+//! it in world space: triangle meshes, and the analytic shapes (quadrics and
+//! curve pieces) with intersection, surface interactions carrying error
+//! bounds, and sampling for area lights.
+//!
+//! Files are read by the loader, not here: a builder asks for a mesh file
+//! (or a refined shape's mesh) through [`ShapeInput`].
 
 mod cone;
 mod curve;
 mod cylinder;
 mod disk;
+mod gltfmesh;
+mod heightfield;
 mod hyperboloid;
+mod loopsubdiv;
+mod nurbs;
+mod objmesh;
 mod paraboloid;
+mod plymesh;
 mod quadric;
 mod sphere;
 mod triangle;
+mod trianglemesh;
 
 pub use cone::Cone;
 pub use curve::{Curve, CurveCommon, CurveHit, CurveKind};
@@ -24,6 +40,150 @@ pub use triangle::{
     intersect_triangle, pack_triangles, sample_triangle_point, AlphaMask, TriangleMesh,
     TrianglePack, TriangleRay, TriangleRay4,
 };
+
+pub use crate::scene::{Geometry, MeshData};
+use crate::scene::{Kind, ParamSpec, ParamValues, Report};
+use std::sync::Arc;
+
+/// What a shape's builder needs from the loader besides its parameters:
+/// where to report (file:line:col), and the files it reads.
+pub trait ShapeInput: Report {
+    /// The mesh of the file `filename` (as written; the loader resolves it
+    /// against the scene file), read once however many shapes name it;
+    /// `None` after a located error.
+    fn mesh_file(&mut self, format: MeshFormat, filename: &str) -> Option<Arc<MeshData>>;
+    /// The triangle mesh of a refined shape (`loopsubdiv`, `nurbs`,
+    /// `heightfield`), refined by the loader from the statement; `None`
+    /// after a located error.
+    fn refine(&mut self, kind: &'static str) -> Option<MeshData>;
+}
+
+/// The mesh file formats the loader reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    Ply,
+    Obj,
+    Gltf,
+}
+
+impl MeshFormat {
+    /// Its name in messages.
+    pub fn label(self) -> &'static str {
+        match self {
+            MeshFormat::Ply => "PLY",
+            MeshFormat::Obj => "OBJ",
+            MeshFormat::Gltf => "glTF",
+        }
+    }
+}
+
+/// What a shape kind builds from its parameters (`None`: skipped, after a
+/// warning or an error).
+pub type ShapeBuild = fn(&ParamValues, &mut dyn ShapeInput) -> Option<Geometry>;
+
+/// One shape kind: its pbrt-v3 name, its parameters, its builder.
+pub type ShapeKind = Kind<ShapeBuild>;
+
+/// Every shape pbrt-v3 knows, and the pbrs mesh-file extensions (an
+/// unknown shape is a warning, and the shape is skipped, as pbrt-v3).
+pub static SHAPES: &[ShapeKind] = &[
+    sphere::KIND,
+    disk::KIND,
+    cylinder::KIND,
+    cone::KIND,
+    paraboloid::KIND,
+    hyperboloid::KIND,
+    curve::KIND,
+    trianglemesh::KIND,
+    plymesh::KIND,
+    objmesh::KIND,
+    gltfmesh::KIND,
+    loopsubdiv::KIND,
+    nurbs::KIND,
+    heightfield::KIND,
+];
+
+/// The name of the kind that builds `g` (for `--stats`: the refined and
+/// mesh-file kinds are triangle meshes once built).
+pub fn kind_name(g: &Geometry) -> &'static str {
+    match g {
+        Geometry::TriangleMesh(_) => trianglemesh::KIND.name,
+        Geometry::Curve(_) => curve::KIND.name,
+        Geometry::Quadric(q) => q.kind_name(),
+    }
+}
+
+/// The transform a quadric kind builds its shape with: its object space.
+const ORIGIN: glam::DMat4 = glam::DMat4::IDENTITY;
+
+/// A quadric built at the origin, as the scene description holds it.
+fn at_origin(q: impl Into<Quadric>) -> Option<Geometry> {
+    Some(Geometry::Quadric(q.into()))
+}
+
+/// `phimax`, a line of every quadric's table.
+const PHIMAX: ParamSpec =
+    ParamSpec::float("phimax", 360.0, "degrees of φ swept, clamped to [0, 360]");
+
+/// `phimax` clamped to [0, 360] as pbrt-v3; `None` (with a warning) at 0.
+fn phi_max(kind: &str, p: &ParamValues, r: &mut dyn ShapeInput) -> Option<f32> {
+    let phimax = p.float("phimax");
+    let clamped = if phimax.is_nan() {
+        0.0
+    } else {
+        phimax.clamp(0.0, 360.0)
+    };
+    if clamped <= 0.0 {
+        r.warn(
+            Some("phimax"),
+            format!("{kind} with phimax {phimax}: an empty surface, skipped"),
+            "phimax must be > 0",
+        );
+        return None;
+    }
+    Some(clamped)
+}
+
+/// An error unless every value is a finite 32-bit float and `positive` ones
+/// are > 0.
+fn check_floats(kind: &str, r: &mut dyn ShapeInput, values: &[(&str, f32, bool)]) -> bool {
+    for &(k, v, positive) in values {
+        if !(v.is_finite() && (!positive || v > 0.0)) {
+            let what = if positive {
+                "a positive 32-bit float"
+            } else {
+                "a finite 32-bit float"
+            };
+            r.error(
+                Some(k),
+                format!("{kind} {k} {v} is not {what}"),
+                &format!("bad {k}"),
+            );
+            return false;
+        }
+    }
+    true
+}
+
+/// The mesh-file kinds' builder: the file named by `filename`, read by the
+/// loader.
+fn mesh_file(
+    kind: &str,
+    format: MeshFormat,
+    p: &ParamValues,
+    r: &mut dyn ShapeInput,
+) -> Option<Geometry> {
+    let file = p.string("filename");
+    if file.is_empty() {
+        r.error(
+            None,
+            format!("{kind} needs a \"string filename\" parameter"),
+            "no filename",
+        );
+        return None;
+    }
+    r.mesh_file(format, file).map(Geometry::TriangleMesh)
+}
 
 use crate::render::geometry::RayDiff;
 use glam::{Vec2, Vec3};

@@ -18,6 +18,72 @@
 //! above z grows as (4cz + 1)^{3/2}, inverted in closed form), with the
 //! exact world-area density.
 
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, check_floats, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius at zmax (> 0)"),
+    ParamSpec::float("zmin", 0.0, "lower end (≥ 0; pbrt-v3 orders zmin and zmax)"),
+    ParamSpec::float("zmax", 1.0, "upper end (> 0)"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "paraboloid",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a paraboloid (or a sector of one) opening upwards from z = 0: x² + y² = radius²·z/zmax; zmin/zmax ordered; radius ≤ 0 or zmax ≤ 0: error; zmin < 0: warning, 0; zmin = zmax or phimax 0: warning, skipped. Intersected as pbrt-v3 (f32 with running error bounds). Area lights: a pbrs extension, uniform by area",
+    build,
+};
+
+/// pbrt-v3's checks: finite values, a positive radius and zmax (error); a
+/// zmin below the apex is 0 (warning); an empty extent is skipped.
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
+    let values = [
+        ("radius", radius, true),
+        ("zmin", zmin, false),
+        ("zmax", zmax, false),
+    ];
+    if !check_floats("paraboloid", r, &values) {
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax; its surface x² + y² = r² z / zmax has
+    // points only where z / zmax >= 0.
+    let (mut z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z1 <= 0.0 {
+        r.error(
+            Some("zmax"),
+            format!(
+                "paraboloid zmax {z1} is not positive (the paraboloid opens upwards from z = 0)"
+            ),
+            "zmax must be > 0",
+        );
+        return None;
+    }
+    if z0 < 0.0 {
+        r.warn(
+            Some("zmin"),
+            format!("paraboloid zmin {z0} is below its apex at z = 0: 0 is used (the surface has no points below)"),
+            "negative zmin",
+        );
+        z0 = 0.0;
+    }
+    if z0 >= z1 {
+        r.warn(
+            None,
+            format!("paraboloid with zmin = zmax = {z1}: an empty surface, skipped"),
+            "empty paraboloid",
+        );
+        return None;
+    }
+    let phimax = phi_max("paraboloid", p, r)?;
+    at_origin(Paraboloid::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+}
+
 use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::efloat::{quadratic, transform_ray, EFloat};
@@ -26,6 +92,9 @@ use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Paraboloid {
+    /// The arguments of [`Paraboloid::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
@@ -63,6 +132,7 @@ impl Paraboloid {
         );
         let obj_area = phi_max / (12.0 * c * c) * (a_max - a_min);
         Paraboloid {
+            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: z0,
             z_max: z1,
@@ -175,5 +245,35 @@ impl Paraboloid {
             point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
         }
+    }
+}
+
+impl Analytic for Paraboloid {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Paraboloid::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.surface_point(p, err)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
     }
 }

@@ -11,22 +11,6 @@ use crate::render::geometry::efloat::EFloat;
 use crate::render::geometry::{gamma, offset_ray_origin, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Mat4, Vec2, Vec3};
 
-/// The quadrics are boxed (each holds its transforms, several hundred
-/// bytes), so that the array of primitives stays small: a scene of 10,000
-/// curves has 80,000 pieces of a few words each, which would otherwise each
-/// take a quadric's size (672 bytes) and spread the BVH's leaf tests over
-/// 54 MB.
-#[derive(Clone, Debug)]
-pub enum Quadric {
-    Sphere(Box<Sphere>),
-    Disk(Box<Disk>),
-    Cylinder(Box<Cylinder>),
-    Cone(Box<Cone>),
-    Paraboloid(Box<Paraboloid>),
-    Hyperboloid(Box<Hyperboloid>),
-    Curve(Curve),
-}
-
 macro_rules! from_shape {
     ($($t:ident),*) => {
         $(impl From<$t> for Quadric {
@@ -44,164 +28,136 @@ impl From<Curve> for Quadric {
     }
 }
 
-macro_rules! each {
-    ($self:expr, $s:ident => $e:expr) => {
-        match $self {
-            Quadric::Sphere($s) => $e,
-            Quadric::Disk($s) => $e,
-            Quadric::Cylinder($s) => $e,
-            Quadric::Cone($s) => $e,
-            Quadric::Paraboloid($s) => $e,
-            Quadric::Hyperboloid($s) => $e,
-            Quadric::Curve($s) => $e,
+/// What every analytic shape answers, each in its own file; [`Quadric`]
+/// only delegates (static dispatch, inlined). The defaults are pbrt-v3's
+/// for shapes sampled by area alone.
+pub trait Analytic {
+    /// The same shape placed by `to_world` (from its object space), with
+    /// the orientation flag and material of its `Shape` statement.
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self
+    where
+        Self: Sized;
+    /// False for shapes left out of the scene (singular transforms, no area).
+    fn valid(&self) -> bool;
+    /// Closest hit with 0 < t < t_max: t and the object-space hit.
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)>;
+    fn point(&self, h: QuadricHit) -> SurfacePoint;
+    fn geom(&self, h: QuadricHit) -> DiffGeom;
+    /// Density by world area of the shape's area sampling at an object
+    /// point (NaN for the shapes not sampled by area alone).
+    fn density_at(&self, _p_obj: DVec3) -> f32 {
+        f32::NAN
+    }
+    /// A point sampled by area (`None`: never a light).
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample>;
+    /// A point sampled as seen from a reference point; density by solid angle.
+    #[inline]
+    fn sample_toward(&self, p: Vec3, _p_error: Vec3, _n: Vec3, u: Vec2) -> Option<ShapeSample> {
+        super::to_solid_angle(p, self.area_sample(u)?)
+    }
+    /// pbrt-v3's `Shape::Pdf(ref, wi)`: the area density at the first hit
+    /// of the ray spawned along `wi`, by solid angle.
+    #[inline]
+    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        let o = offset_ray_origin(p, p_error, n, wi);
+        match self.hit(o, wi, f32::INFINITY) {
+            Some((_, h)) => {
+                let density = self.density_at(h.point_and_error().0);
+                solid_angle_pdf(p, &self.point(h), wi, density)
+            }
+            None => 0.0,
+        }
+    }
+}
+
+macro_rules! quadrics {
+    ($($(#[$doc:meta])* $variant:ident($ty:ty) = $kind:ident,)*) => {
+        /// The quadrics are boxed (each holds its transforms, several
+        /// hundred bytes), so that the array of primitives stays small: a
+        /// scene of 10,000 curves has 80,000 pieces of a few words each,
+        /// which would otherwise each take a quadric's size (672 bytes) and
+        /// spread the BVH's leaf tests over 54 MB.
+        #[derive(Clone, Debug)]
+        pub enum Quadric {
+            $($(#[$doc])* $variant($ty),)*
+        }
+
+        impl Quadric {
+            /// The same shape placed by `to_world`, with the orientation
+            /// flag and material of its `Shape` statement.
+            pub fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Quadric {
+                match self { $(Quadric::$variant(s) => Quadric::from(s.placed(to_world, reverse, material)),)* }
+            }
+            /// The name of its kind in [`SHAPES`](super::SHAPES).
+            pub fn kind_name(&self) -> &'static str {
+                match self { $(Quadric::$variant(_) => super::$kind::KIND.name,)* }
+            }
+            #[inline]
+            pub fn material(&self) -> u32 {
+                match self { $(Quadric::$variant(s) => s.material,)* }
+            }
+            #[inline]
+            pub fn light(&self) -> Option<u32> {
+                match self { $(Quadric::$variant(s) => s.light,)* }
+            }
+            pub fn set_light(&mut self, light: Option<u32>) {
+                match self { $(Quadric::$variant(s) => s.light = light,)* }
+            }
+            pub fn area(&self) -> f32 {
+                match self { $(Quadric::$variant(s) => s.area(),)* }
+            }
+            pub fn bounds(&self) -> Bounds3 {
+                match self { $(Quadric::$variant(s) => s.bounds(),)* }
+            }
+            /// False for shapes left out of the scene (singular transforms, no area).
+            pub fn is_valid(&self) -> bool {
+                match self { $(Quadric::$variant(s) => s.valid(),)* }
+            }
+            /// Closest hit with 0 < t < t_max: t and the object-space point.
+            #[inline]
+            pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+                match self { $(Quadric::$variant(s) => s.hit(o, d, t_max),)* }
+            }
+            #[inline]
+            pub fn surface_point(&self, h: QuadricHit) -> SurfacePoint {
+                match self { $(Quadric::$variant(s) => s.point(h),)* }
+            }
+            #[inline]
+            pub fn diff_geom(&self, h: QuadricHit) -> DiffGeom {
+                match self { $(Quadric::$variant(s) => s.geom(h),)* }
+            }
+            /// Density by world area of the shape's area sampling at an
+            /// object point (the shapes sampled by area alone; not spheres
+            /// or disks).
+            pub fn area_density(&self, p_obj: DVec3) -> f32 {
+                match self { $(Quadric::$variant(s) => s.density_at(p_obj),)* }
+            }
+            /// A point sampled as seen from a reference point; density by
+            /// solid angle.
+            #[inline]
+            pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
+                match self { $(Quadric::$variant(s) => s.sample_toward(p, p_error, n, u),)* }
+            }
+            /// Density by solid angle of `sample_from` producing direction
+            /// `wi`: pbrt-v3's `Shape::Pdf(ref, wi)`.
+            #[inline]
+            pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+                match self { $(Quadric::$variant(s) => s.pdf_toward(p, p_error, n, wi),)* }
+            }
         }
     };
 }
 
-impl Quadric {
-    #[inline]
-    pub fn material(&self) -> u32 {
-        each!(self, s => s.material)
-    }
-
-    #[inline]
-    pub fn light(&self) -> Option<u32> {
-        each!(self, s => s.light)
-    }
-
-    pub fn set_light(&mut self, light: Option<u32>) {
-        each!(self, s => s.light = light)
-    }
-
-    pub fn area(&self) -> f32 {
-        each!(self, s => s.area())
-    }
-
-    pub fn bounds(&self) -> Bounds3 {
-        each!(self, s => s.bounds())
-    }
-
-    /// False for shapes left out of the scene (singular transforms, no area).
-    pub fn is_valid(&self) -> bool {
-        match self {
-            Quadric::Sphere(s) => s.radius > 0.0 && s.is_invertible(),
-            Quadric::Disk(d) => d.is_valid(),
-            Quadric::Cylinder(c) => c.is_valid(),
-            Quadric::Cone(c) => c.is_valid(),
-            Quadric::Paraboloid(c) => c.is_valid(),
-            Quadric::Hyperboloid(c) => c.is_valid(),
-            Quadric::Curve(c) => c.is_valid(),
-        }
-    }
-
-    /// Closest hit with 0 < t < t_max: t and the object-space point.
-    #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        let exact = |h: Option<(f32, DVec3)>| h.map(|(t, p)| (t, QuadricHit::Exact(p)));
-        let bounded =
-            |h: Option<(f32, Vec3, Vec3)>| h.map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }));
-        match self {
-            Quadric::Sphere(s) => exact(s.intersect(o, d, t_max)),
-            Quadric::Disk(s) => exact(s.intersect(o, d, t_max)),
-            Quadric::Cylinder(s) => exact(s.intersect(o, d, t_max)),
-            Quadric::Cone(s) => bounded(s.intersect(o, d, t_max)),
-            Quadric::Paraboloid(s) => bounded(s.intersect(o, d, t_max)),
-            Quadric::Hyperboloid(s) => bounded(s.intersect(o, d, t_max)),
-            Quadric::Curve(s) => s
-                .intersect(o, d, t_max)
-                .map(|(t, h)| (t, QuadricHit::Curve(h))),
-        }
-    }
-
-    #[inline]
-    pub fn surface_point(&self, h: QuadricHit) -> SurfacePoint {
-        if let (Quadric::Curve(c), QuadricHit::Curve(h)) = (self, h) {
-            return c.surface_point(h);
-        }
-        let (p, err) = h.point_and_error();
-        match self {
-            Quadric::Sphere(s) => s.surface_point(p),
-            Quadric::Disk(s) => s.surface_point(p),
-            Quadric::Cylinder(s) => s.surface_point(p),
-            Quadric::Cone(s) => s.surface_point(p, err),
-            Quadric::Paraboloid(s) => s.surface_point(p, err),
-            Quadric::Hyperboloid(s) => s.surface_point(p, err),
-            // (Never reached: a curve's hits are curve hits.)
-            Quadric::Curve(_) => SurfacePoint {
-                p: p.as_vec3(),
-                p_error: err.as_vec3(),
-                n: Vec3::Z,
-                ns: Vec3::Z,
-            },
-        }
-    }
-
-    #[inline]
-    pub fn diff_geom(&self, h: QuadricHit) -> DiffGeom {
-        let (p, _) = h.point_and_error();
-        match (self, h) {
-            (Quadric::Curve(c), QuadricHit::Curve(h)) => c.diff_geom(h),
-            (Quadric::Sphere(s), _) => s.diff_geom(p),
-            (Quadric::Disk(s), _) => s.diff_geom(p),
-            (Quadric::Cylinder(s), _) => s.diff_geom(p),
-            (Quadric::Cone(s), _) => s.diff_geom(p),
-            (Quadric::Paraboloid(s), _) => s.diff_geom(p),
-            (Quadric::Hyperboloid(s), _) => s.diff_geom(p),
-            (Quadric::Curve(_), _) => DiffGeom::ZERO,
-        }
-    }
-
-    /// Density by world area of the shape's area sampling at an object point
-    /// (the shapes sampled by area alone; not spheres or disks).
-    pub fn area_density(&self, p_obj: DVec3) -> f32 {
-        match self {
-            Quadric::Cylinder(c) => c.area_density(p_obj),
-            Quadric::Cone(c) => c.area_density(p_obj),
-            Quadric::Paraboloid(c) => c.area_density(p_obj),
-            Quadric::Hyperboloid(c) => c.area_density(p_obj),
-            Quadric::Sphere(_) | Quadric::Disk(_) | Quadric::Curve(_) => f32::NAN,
-        }
-    }
-
-    /// A point sampled as seen from a reference point; density by solid angle.
-    #[inline]
-    pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
-        let by_area = match self {
-            Quadric::Sphere(s) => return s.sample_from(p, p_error, n, u),
-            Quadric::Disk(d) => d.sample_area(u),
-            Quadric::Cylinder(c) => c.sample_area(u),
-            Quadric::Cone(c) => c.sample_area(u),
-            Quadric::Paraboloid(c) => c.sample_area(u),
-            Quadric::Hyperboloid(c) => c.sample_area(u),
-            // Never a light (the scene leaves curves' emission out).
-            Quadric::Curve(_) => return None,
-        };
-        super::to_solid_angle(p, by_area)
-    }
-
-    /// Density by solid angle of `sample_from` producing direction `wi`:
-    /// pbrt-v3's `Shape::Pdf(ref, wi)`, the area density at the first hit of
-    /// the ray spawned along `wi`.
-    #[inline]
-    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-        match self {
-            Quadric::Sphere(s) => {
-                s.pdf_from(p, p_error, n, wi, |o, d| s.intersect(o, d, f32::INFINITY))
-            }
-            Quadric::Disk(d) => d.pdf_from(p, p_error, n, wi),
-            Quadric::Curve(_) => 0.0,
-            _ => {
-                let o = offset_ray_origin(p, p_error, n, wi);
-                match self.intersect(o, wi, f32::INFINITY) {
-                    Some((_, h)) => {
-                        let density = self.area_density(h.point_and_error().0);
-                        solid_angle_pdf(p, &self.surface_point(h), wi, density)
-                    }
-                    None => 0.0,
-                }
-            }
-        }
-    }
+quadrics! {
+    Sphere(Box<Sphere>) = sphere,
+    Disk(Box<Disk>) = disk,
+    Cylinder(Box<Cylinder>) = cylinder,
+    Cone(Box<Cone>) = cone,
+    Paraboloid(Box<Paraboloid>) = paraboloid,
+    Hyperboloid(Box<Hyperboloid>) = hyperboloid,
+    /// A piece of a curve segment (never a light: pbrt-v3 cannot sample
+    /// curves, and the scene leaves their emission out).
+    Curve(Curve) = curve,
 }
 
 /// A hit on a quadric in its object space: a point computed in f64 (its

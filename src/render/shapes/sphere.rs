@@ -1,3 +1,77 @@
+//! pbrt-v3's `sphere`: a sphere of `radius` about its object-space origin,
+//! cut to the zone `zmin`..`zmax` and to φ in [0, `phimax`].
+//!
+//! | parameter | type  | pbrt-v3 default |
+//! |-----------|-------|-----------------|
+//! | `radius`  | float | 1               |
+//! | `zmin`    | float | -`radius`       |
+//! | `zmax`    | float | `radius`        |
+//! | `phimax`  | float | 360 (degrees)   |
+
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius (> 0)"),
+    ParamSpec::float_opt(
+        "zmin",
+        "lower end of the zone (default -radius; clamped to the sphere)",
+    ),
+    ParamSpec::float_opt(
+        "zmax",
+        "upper end of the zone (default radius; clamped to the sphere)",
+    ),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "sphere",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a sphere (or a zone and sector of one) about the origin. The z range and phimax clamped as pbrt-v3; radius ≤ 0: error; empty: warning, skipped",
+    build,
+};
+
+/// pbrt-v3's checks: radius > 0 (error), a non-empty zone and sector
+/// (warning, skipped), a radius that fits a 32-bit float.
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    if radius <= 0.0 {
+        r.error(
+            Some("radius"),
+            format!("sphere radius {radius} is not positive"),
+            "radius must be > 0",
+        );
+        return None;
+    }
+    let zmin = p.float_opt("zmin").unwrap_or(-radius);
+    let zmax = p.float_opt("zmax").unwrap_or(radius);
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    let (z0, z1) = (
+        zmin.min(zmax).clamp(-radius, radius),
+        zmin.max(zmax).clamp(-radius, radius),
+    );
+    if phimax <= 0.0 || z0 >= z1 {
+        r.warn(
+            None,
+            "sphere with an empty extent (phimax 0 or zmin = zmax): skipped".into(),
+            "empty sphere",
+        );
+        return None;
+    }
+    if radius == f32::INFINITY {
+        r.error(
+            None,
+            "sphere radius does not fit a 32-bit float".into(),
+            "radius too large",
+        );
+        return None;
+    }
+    at_origin(Sphere::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+}
+
 use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::render::geometry::{gamma, offset_ray_origin, Bounds3, Frame};
 use crate::render::sampling::uniform_cone_pdf;
@@ -9,6 +83,9 @@ use std::f32::consts::PI;
 /// the world hit point carries an error bound like every other surface.
 #[derive(Clone, Debug)]
 pub struct Sphere {
+    /// The arguments of [`Sphere::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
@@ -74,6 +151,7 @@ impl Sphere {
             det.abs().powf(2.0 / 3.0)
         };
         Sphere {
+            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: zmin,
             z_max: zmax,
@@ -399,6 +477,42 @@ pub fn area_to_solid_angle(p: Vec3, q: Vec3, nq: Vec3, pdf_area: f32) -> f32 {
         pdf
     } else {
         0.0
+    }
+}
+
+impl Analytic for Sphere {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Sphere::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.radius > 0.0 && self.is_invertible()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    #[inline]
+    fn sample_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
+        self.sample_from(p, p_error, n, u)
+    }
+    #[inline]
+    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        self.pdf_from(p, p_error, n, wi, |o, d| {
+            self.intersect(o, d, f32::INFINITY)
+        })
     }
 }
 
