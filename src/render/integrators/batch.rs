@@ -133,11 +133,7 @@ impl Integrator {
     pub fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
         let n = b.len;
         match self {
-            Integrator::Path {
-                max_depth,
-                rr_threshold,
-                lights,
-            } => {
+            Integrator::Path { settings, lights } => {
                 b.active.clear();
                 for j in 0..n {
                     b.l[j] = Vec3::ZERO;
@@ -162,8 +158,8 @@ impl Integrator {
                         let p = PathParams {
                             scene,
                             time: b.times[j],
-                            max_depth: *max_depth,
-                            rr_threshold: *rr_threshold,
+                            max_depth: settings.max_depth,
+                            rr_threshold: settings.rr_threshold,
                             lights,
                         };
                         if path_step(
@@ -238,7 +234,7 @@ impl Integrator {
         uniform: &[TriangleLightPack],
     ) {
         let Integrator::Direct {
-            max_depth, packs, ..
+            settings, packs, ..
         } = self
         else {
             unreachable!("direct_batch is directlighting's");
@@ -295,7 +291,7 @@ impl Integrator {
             for pack in packs {
                 direct_lanes::draw_samples(sampler, pack.count, &mut d.u);
             }
-            if 1 < *max_depth {
+            if 1 < settings.max_depth {
                 sampler.skip_2d();
                 sampler.skip_2d();
             }

@@ -3,10 +3,16 @@
 //! `all` (every light, its sample counts in sampler arrays; four lights at
 //! a time at Lambertian vertices when they are triangles, see
 //! [`super::direct_lanes`]) or `one` (one light chosen uniformly).
+//!
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `maxdepth` | integer | 5 | maximum depth of the specular tree (≥ 0) |
+//! | `strategy` | string | `all` | `all` lights at every vertex, or `one` chosen uniformly |
+//! | `pixelbounds` | | | ignored, with a warning |
 
 use super::common::light_strategy;
 use super::direct_lanes;
-use super::Scratch;
+use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
 use crate::render::accel::SurfaceHit;
 use crate::render::geometry::spawn_ray;
 use crate::render::lights::{LightSampler, TriangleLightPack};
@@ -14,8 +20,81 @@ use crate::render::materials::{Bsdf, BxdfFlags};
 use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
-use crate::scene::DirectStrategy;
+use crate::scene::kind::{Report, Support};
+use crate::scene::{DirectStrategy, ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
+
+pub const PARAMS: &[ParamSpec] = &[
+    MAX_DEPTH,
+    ParamSpec::string(
+        "strategy",
+        "all",
+        "`all`: every light at every vertex (its sample count from the light's `nsamples`); `one`: one light chosen uniformly",
+    ),
+    PIXEL_BOUNDS,
+];
+
+pub const KIND: IntegratorKind = IntegratorKind {
+    name: "directlighting",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "direct lighting with MIS at every vertex, specular reflection and transmission followed recursively",
+    build: |p, r| IntegratorSettings::DirectLighting(DirectLightingSettings::read(p, r)),
+};
+
+/// directlighting ignores participating media and subsurface scattering
+/// (as pbrt-v3's).
+pub const RENDERS_MEDIA: bool = false;
+pub const SAMPLES_SUBSURFACE: bool = false;
+
+/// `directlighting`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectLightingSettings {
+    pub max_depth: u32,
+    pub strategy: DirectStrategy,
+}
+
+impl Default for DirectLightingSettings {
+    fn default() -> DirectLightingSettings {
+        DirectLightingSettings {
+            max_depth: 5,
+            strategy: DirectStrategy::All,
+        }
+    }
+}
+
+impl DirectLightingSettings {
+    /// The settings of a statement's parameters, checked as pbrt-v3 does:
+    /// an unknown strategy is a warning, and `all` is used.
+    pub fn read(p: &ParamValues, r: &mut dyn Report) -> DirectLightingSettings {
+        let max_depth = super::max_depth(p, r);
+        let strategy = match p.string("strategy") {
+            "all" => DirectStrategy::All,
+            "one" => DirectStrategy::One,
+            other => {
+                r.warn(
+                    Some("strategy"),
+                    format!("unknown strategy \"{other}\": \"all\" is used (as pbrt-v3)"),
+                    "expected all or one",
+                );
+                DirectStrategy::All
+            }
+        };
+        DirectLightingSettings {
+            max_depth,
+            strategy,
+        }
+    }
+
+    pub fn summary(&self) -> String {
+        let DirectLightingSettings {
+            max_depth,
+            strategy,
+        } = self;
+        format!("{}, maxdepth {max_depth}, strategy {strategy:?}", KIND.name).to_lowercase()
+    }
+}
 
 /// How directlighting lights a vertex: its strategy, the light choice of
 /// strategy `one`, the sample counts of strategy `all` and its four-lane

@@ -10,6 +10,12 @@
 //! ([`direct_lanes`]); and what several of them share, written once
 //! ([`common`]: shading, emission, light choice and sampling, MIS weights,
 //! Russian roulette; [`subsurface`]: the BSSRDF exit of path and volpath).
+//!
+//! [`INTEGRATORS`] is the table of kinds the loader, `--check`,
+//! `grammar/REFERENCE.md` and the tests read; a kind's builder gives its
+//! settings (one struct per kind, [`IntegratorSettings`] the enum that only
+//! delegates), which the scene description holds; [`Integrator::new`] makes
+//! the runtime integrator from them.
 
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::lights::{
@@ -18,7 +24,8 @@ use crate::render::lights::{
 use crate::render::materials::Bsdf;
 use crate::render::samplers::Sampler;
 use crate::render::scene::RenderScene;
-use crate::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
+use crate::scene::kind::{Kind, Report, Support};
+use crate::scene::{DirectStrategy, LightSampleStrategy, ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
 
 mod batch;
@@ -32,7 +39,11 @@ mod volpath;
 mod whitted;
 
 pub use batch::Batch;
+pub use directlighting::DirectLightingSettings;
+pub use path::PathSettings;
 use specular::{First, Work};
+pub use volpath::VolPathSettings;
+pub use whitted::WhittedSettings;
 
 /// Rays traced, counted per tile and summed at the end (no shared counters).
 #[derive(Clone, Copy, Debug, Default)]
@@ -71,15 +82,158 @@ impl Scratch {
 /// Rays crossing more than this many `Material "none"` surfaces in a row stop.
 const MAX_PASS_THROUGH: u32 = 256;
 
+/// What an integrator kind builds from its parameters: its settings (the
+/// builder reports pbrt-v3's checks of them).
+pub type IntegratorBuild = fn(&ParamValues, &mut dyn Report) -> IntegratorSettings;
+
+/// One integrator kind: its pbrt-v3 name, its parameters, its builder.
+pub type IntegratorKind = Kind<IntegratorBuild>;
+
+/// Every integrator pbrt-v3 knows: the four pbrs renders, then those it
+/// substitutes by `path` (with the statement's `maxdepth`, and a warning).
+pub static INTEGRATORS: &[IntegratorKind] = &[
+    path::KIND,
+    volpath::KIND,
+    directlighting::KIND,
+    whitted::KIND,
+    unsupported("bdpt", "bidirectional path tracing is not implemented"),
+    unsupported("mlt", "Metropolis light transport is not implemented"),
+    unsupported(
+        "sppm",
+        "stochastic progressive photon mapping is not implemented",
+    ),
+    unsupported("ambientocclusion", "ambient occlusion is not implemented"),
+];
+
+/// `maxdepth`, which every integrator reads.
+const MAX_DEPTH: ParamSpec = ParamSpec::int("maxdepth", 5, "maximum number of bounces (≥ 0)");
+
+/// `pixelbounds`, which every integrator of pbrt-v3 reads and pbrs ignores.
+const PIXEL_BOUNDS: ParamSpec = ParamSpec::unsupported(
+    "pixelbounds",
+    "\"pixelbounds\" is not supported by pbrs: the whole film is rendered (use --cropwindow)",
+);
+
+/// The parameters of the kinds pbrs substitutes by `path`.
+const UNSUPPORTED_PARAMS: &[ParamSpec] = &[MAX_DEPTH, PIXEL_BOUNDS];
+
+/// A kind pbrs does not render: `path` with the statement's `maxdepth`
+/// (the loader says so).
+const fn unsupported(name: &'static str, why: &'static str) -> IntegratorKind {
+    IntegratorKind {
+        name,
+        aliases: &[],
+        support: Support::Unsupported(why),
+        params: UNSUPPORTED_PARAMS,
+        doc: "substituted by `path` with the same `maxdepth`, with a warning",
+        build: |p, r| {
+            IntegratorSettings::Path(PathSettings {
+                max_depth: max_depth(p, r),
+                ..PathSettings::default()
+            })
+        },
+    }
+}
+
+/// pbrt-v3's `maxdepth`, checked: a negative one is an error (and 5 is used).
+fn max_depth(p: &ParamValues, r: &mut dyn Report) -> u32 {
+    let md = p.int("maxdepth");
+    if md < 0 {
+        r.error(
+            Some("maxdepth"),
+            format!("\"maxdepth\" is {md}: it must be ≥ 0"),
+            "negative depth",
+        );
+        5
+    } else {
+        md as u32
+    }
+}
+
+/// The integrator's settings, one variant per kind pbrs renders: made by
+/// the kind's builder, held by the scene description and by the runtime
+/// [`Integrator`]. Its methods only delegate to the kinds' files.
+macro_rules! integrators {
+    ($($variant:ident($settings:ident) in $module:ident),* $(,)?) => {
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum IntegratorSettings {
+            $($variant($settings),)*
+        }
+
+        impl IntegratorSettings {
+            /// The kind's row of [`INTEGRATORS`].
+            pub fn kind(&self) -> &'static IntegratorKind {
+                match self {
+                    $(IntegratorSettings::$variant(_) => &$module::KIND,)*
+                }
+            }
+
+            /// pbrt-v3's name of the kind.
+            pub fn name(&self) -> &'static str {
+                self.kind().name
+            }
+
+            pub fn max_depth(&self) -> u32 {
+                match self {
+                    $(IntegratorSettings::$variant(s) => s.max_depth,)*
+                }
+            }
+
+            /// Sets `maxdepth` (the command line's and the tests' override).
+            pub fn set_max_depth(&mut self, d: u32) {
+                match self {
+                    $(IntegratorSettings::$variant(s) => s.max_depth = d,)*
+                }
+            }
+
+            /// The settings in a line, for `--check` and `--stats`.
+            pub fn summary(&self) -> String {
+                match self {
+                    $(IntegratorSettings::$variant(s) => s.summary(),)*
+                }
+            }
+
+            /// True if it renders participating media.
+            pub fn renders_media(&self) -> bool {
+                match self {
+                    $(IntegratorSettings::$variant(_) => $module::RENDERS_MEDIA,)*
+                }
+            }
+
+            /// True if it samples subsurface scattering.
+            pub fn samples_subsurface(&self) -> bool {
+                match self {
+                    $(IntegratorSettings::$variant(_) => $module::SAMPLES_SUBSURFACE,)*
+                }
+            }
+        }
+    };
+}
+
+integrators! {
+    Path(PathSettings) in path,
+    VolPath(VolPathSettings) in volpath,
+    DirectLighting(DirectLightingSettings) in directlighting,
+    Whitted(WhittedSettings) in whitted,
+}
+
+/// Without an `Integrator` statement: `path` with pbrt-v3's defaults.
+impl Default for IntegratorSettings {
+    fn default() -> IntegratorSettings {
+        IntegratorSettings::Path(PathSettings::default())
+    }
+}
+
+/// The runtime integrator: a kind's settings and what it builds from the
+/// scene (its light distribution, directlighting's sample counts and
+/// four-lane light packs).
 pub enum Integrator {
     Path {
-        max_depth: u32,
-        rr_threshold: f32,
+        settings: PathSettings,
         lights: LightSampler,
     },
     Direct {
-        max_depth: u32,
-        strategy: DirectStrategy,
+        settings: DirectLightingSettings,
         lights: LightSampler,
         n_light_samples: Vec<u32>,
         /// The lights four to a pack, for strategy "all" when every light is
@@ -90,11 +244,10 @@ pub enum Integrator {
         uniform: Vec<TriangleLightPack>,
     },
     Whitted {
-        max_depth: u32,
+        settings: WhittedSettings,
     },
     VolPath {
-        max_depth: u32,
-        rr_threshold: f32,
+        settings: VolPathSettings,
         lights: LightSampler,
     },
 }
@@ -112,34 +265,22 @@ fn light_sampler_kind(s: LightSampleStrategy) -> LightSamplerKind {
 impl Integrator {
     /// Builds the integrator and only the light distribution it uses;
     /// `simd` allows the four-lane paths (which give the same image).
-    pub fn new(desc: &IntegratorDesc, scene: &RenderScene, simd: bool) -> Integrator {
-        match *desc {
-            IntegratorDesc::Path {
-                max_depth,
-                rr_threshold,
-                light_sample_strategy,
-            } => {
-                let kind = light_sampler_kind(light_sample_strategy);
-                Integrator::Path {
-                    max_depth,
-                    rr_threshold,
-                    lights: LightSampler::new(kind, &scene.lights, &scene.geometry),
-                }
-            }
-            IntegratorDesc::DirectLighting {
-                max_depth,
-                strategy,
-            } => Integrator::Direct {
-                max_depth,
-                strategy,
+    pub fn new(settings: &IntegratorSettings, scene: &RenderScene, simd: bool) -> Integrator {
+        let lights = |strategy: LightSampleStrategy| {
+            let kind = light_sampler_kind(strategy);
+            LightSampler::new(kind, &scene.lights, &scene.geometry)
+        };
+        match *settings {
+            IntegratorSettings::Path(settings) => Integrator::Path {
+                settings,
+                lights: lights(settings.light_sample_strategy),
+            },
+            IntegratorSettings::DirectLighting(settings) => Integrator::Direct {
+                settings,
                 // pbrt-v3's directlighting chooses uniformly for strategy "one".
-                lights: LightSampler::new(
-                    LightSamplerKind::Uniform,
-                    &scene.lights,
-                    &scene.geometry,
-                ),
+                lights: lights(LightSampleStrategy::Uniform),
                 n_light_samples: Vec::new(),
-                packs: match strategy {
+                packs: match settings.strategy {
                     DirectStrategy::All if simd => {
                         pack_triangle_lights(&scene.lights).unwrap_or_default()
                     }
@@ -147,27 +288,22 @@ impl Integrator {
                 },
                 uniform: Vec::new(),
             },
-            IntegratorDesc::Whitted { max_depth } => Integrator::Whitted { max_depth },
-            IntegratorDesc::VolPath {
-                max_depth,
-                rr_threshold,
-                light_sample_strategy,
-            } => {
-                let kind = light_sampler_kind(light_sample_strategy);
-                Integrator::VolPath {
-                    max_depth,
-                    rr_threshold,
-                    lights: LightSampler::new(kind, &scene.lights, &scene.geometry),
-                }
-            }
+            IntegratorSettings::Whitted(settings) => Integrator::Whitted { settings },
+            IntegratorSettings::VolPath(settings) => Integrator::VolPath {
+                settings,
+                lights: lights(settings.light_sample_strategy),
+            },
         }
     }
 
     /// Requests the sampler arrays the integrator uses (pbrt-v3's Preprocess).
     pub fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
         if let Integrator::Direct {
-            max_depth,
-            strategy: DirectStrategy::All,
+            settings:
+                DirectLightingSettings {
+                    max_depth,
+                    strategy: DirectStrategy::All,
+                },
             n_light_samples,
             packs,
             uniform,
@@ -231,34 +367,26 @@ impl Integrator {
         scratch: &mut Scratch,
     ) -> Vec3 {
         match self {
-            Integrator::Path {
-                max_depth,
-                rr_threshold,
-                lights,
-            } => path::path_li(
+            Integrator::Path { settings, lights } => path::path_li(
                 ray,
                 time,
                 diff,
                 scene,
                 sampler,
                 scratch,
-                *max_depth,
-                *rr_threshold,
+                settings.max_depth,
+                settings.rr_threshold,
                 lights,
             ),
-            Integrator::VolPath {
-                max_depth,
-                rr_threshold,
-                lights,
-            } => volpath::volpath_li(
+            Integrator::VolPath { settings, lights } => volpath::volpath_li(
                 ray,
                 time,
                 diff,
                 scene,
                 sampler,
                 scratch,
-                *max_depth,
-                *rr_threshold,
+                settings.max_depth,
+                settings.rr_threshold,
                 lights,
             ),
             Integrator::Direct { .. } | Integrator::Whitted { .. } => {

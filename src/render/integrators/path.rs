@@ -1,10 +1,18 @@
 //! `path`: pbrt-v3's PathIntegrator (see [`path_li`]).
+//!
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `maxdepth` | integer | 5 | maximum number of bounces (≥ 0) |
+//! | `rrthreshold` | float | 1 | Russian roulette once max(β·etaScale) is below it (after bounce 3) |
+//! | `lightsamplestrategy` | string | `spatial` | light choice: `uniform`, `power`, `spatial` or `bvh` |
+//! | `pixelbounds` | | | ignored, with a warning |
 
 use super::common::{
     add_escaped_mis, emitted_mis, eta_scale_change, roulette, sample_light_mis, shade,
 };
 use super::subsurface::{sample_exit, subsurface_exit};
-use super::{Scratch, MAX_PASS_THROUGH};
+use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
+use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::render::accel::Hit;
 use crate::render::geometry::{spawn_ray, Ray, RayDiff};
 use crate::render::lights::LightSampler;
@@ -12,7 +20,100 @@ use crate::render::materials::{Bsdf, BxdfFlags};
 use crate::render::samplers::Sampler;
 use crate::render::scene::RenderScene;
 use crate::render::shapes::SurfacePoint;
+use crate::scene::kind::{Report, Support};
+use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
 use glam::Vec3;
+
+pub const PARAMS: &[ParamSpec] = &[
+    MAX_DEPTH,
+    ParamSpec::float(
+        "rrthreshold",
+        1.0,
+        "Russian roulette once max(β·etaScale) is below it (after bounce 3)",
+    ),
+    LIGHT_SAMPLE_STRATEGY,
+    PIXEL_BOUNDS,
+];
+
+pub const KIND: IntegratorKind = IntegratorKind {
+    name: "path",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "unidirectional path tracing: next-event estimation with power-heuristic MIS, Russian roulette; no participating media",
+    build: |p, r| IntegratorSettings::Path(PathSettings::read(p, r)),
+};
+
+/// `path` ignores participating media (as pbrt-v3's) and samples
+/// subsurface scattering.
+pub const RENDERS_MEDIA: bool = false;
+pub const SAMPLES_SUBSURFACE: bool = true;
+
+/// `lightsamplestrategy`, read by `path` and `volpath`.
+pub(super) const LIGHT_SAMPLE_STRATEGY: ParamSpec = ParamSpec::string(
+    "lightsamplestrategy",
+    "spatial",
+    "how a vertex chooses the light to sample: `uniform`, `power`, `spatial` (pbrt-v3's voxel distribution) or `bvh` (a pbrs extension: pbrt-v4's light BVH)",
+);
+
+/// `path`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathSettings {
+    pub max_depth: u32,
+    pub rr_threshold: f32,
+    pub light_sample_strategy: LightSampleStrategy,
+}
+
+impl Default for PathSettings {
+    fn default() -> PathSettings {
+        PathSettings {
+            max_depth: 5,
+            rr_threshold: 1.0,
+            light_sample_strategy: LightSampleStrategy::Spatial,
+        }
+    }
+}
+
+impl PathSettings {
+    /// The settings of a statement's parameters, checked as pbrt-v3 does.
+    pub fn read(p: &ParamValues, r: &mut dyn Report) -> PathSettings {
+        PathSettings {
+            max_depth: super::max_depth(p, r),
+            rr_threshold: p.float("rrthreshold"),
+            light_sample_strategy: light_sample_strategy(p, r),
+        }
+    }
+
+    pub fn summary(&self) -> String {
+        let PathSettings {
+            max_depth,
+            rr_threshold,
+            light_sample_strategy,
+        } = self;
+        format!("{}, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}", KIND.name).to_lowercase()
+    }
+}
+
+/// `lightsamplestrategy`: an unknown one is a warning, and `spatial` is
+/// used (as pbrt-v3).
+pub(super) fn light_sample_strategy(p: &ParamValues, r: &mut dyn Report) -> LightSampleStrategy {
+    match p.string("lightsamplestrategy") {
+        "spatial" => LightSampleStrategy::Spatial,
+        "uniform" => LightSampleStrategy::Uniform,
+        "power" => LightSampleStrategy::Power,
+        "bvh" => LightSampleStrategy::Bvh,
+        other => {
+            r.warn(
+                Some("lightsamplestrategy"),
+                format!(
+                    "unknown light sample strategy \"{other}\": \"spatial\" is used (as pbrt-v3)"
+                ),
+                "expected uniform, power, spatial or bvh",
+            );
+            LightSampleStrategy::Spatial
+        }
+    }
+}
 
 /// The path tracer: pbrt-v3's PathIntegrator (next-event estimation,
 /// power-heuristic MIS, `maxdepth`, pbrt-v3's Russian roulette with

@@ -6,6 +6,7 @@
 
 use super::common::{emitted, escaped, shade_geom, with_diff};
 use super::{directlighting, whitted, Integrator, Scratch, MAX_PASS_THROUGH};
+use super::{DirectLightingSettings, WhittedSettings};
 use crate::render::accel::{Hit, SurfaceHit};
 use crate::render::geometry::{spawn_ray, Ray, RayDiff};
 use crate::render::materials::{Bsdf, BxdfFlags};
@@ -109,8 +110,11 @@ impl Integrator {
             let mut local = emitted(scene, &s, wo);
             let max_depth = match *self {
                 Integrator::Direct {
-                    max_depth,
-                    strategy,
+                    settings:
+                        DirectLightingSettings {
+                            max_depth,
+                            strategy,
+                        },
                     ref lights,
                     ref n_light_samples,
                     ref packs,
@@ -127,7 +131,9 @@ impl Integrator {
                     );
                     max_depth
                 }
-                Integrator::Whitted { max_depth } => {
+                Integrator::Whitted {
+                    settings: WhittedSettings { max_depth },
+                } => {
                     whitted::add_direct(&mut local, scene, &s, bsdf, wo, sampler, scratch);
                     max_depth
                 }

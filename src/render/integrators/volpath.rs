@@ -1,8 +1,12 @@
 //! The volumetric path tracer: pbrt-v3's `VolPathIntegrator`
 //! (src/integrators/volpath.cpp) with the MIS structure of pbrs's `path`.
 //!
-//! Parameters (pbrt-v3's): `integer maxdepth` (5), `float rrthreshold`
-//! (1), `string lightsamplestrategy` (`spatial`).
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `maxdepth` | integer | 5 | maximum number of bounces (≥ 0) |
+//! | `rrthreshold` | float | 1 | Russian roulette once max(β·etaScale) is below it (after bounce 3) |
+//! | `lightsamplestrategy` | string | `spatial` | light choice: `uniform`, `power`, `spatial` or `bvh` |
+//! | `pixelbounds` | | | ignored, with a warning |
 //!
 //! Along each segment the ray's medium (the camera's to start with; after a
 //! surface, the side of the surface's `MediumInterface` the new direction
@@ -24,8 +28,10 @@
 //! specular bounces; both are unbiased estimators of the same integral.
 
 use super::common::{add_escaped_mis, emitted_mis, eta_scale_change, roulette, shade};
+use super::path::{light_sample_strategy, LIGHT_SAMPLE_STRATEGY};
 use super::subsurface::{sample_exit, subsurface_exit};
-use super::{Scratch, MAX_PASS_THROUGH};
+use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
+use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::render::accel::{Hit, SurfaceHit};
 use crate::render::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
 use crate::render::lights::LightSampler;
@@ -35,7 +41,71 @@ use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
 use crate::render::shapes::SurfacePoint;
+use crate::scene::kind::{Report, Support};
+use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
 use glam::Vec3;
+
+pub const PARAMS: &[ParamSpec] = &[
+    MAX_DEPTH,
+    ParamSpec::float(
+        "rrthreshold",
+        1.0,
+        "Russian roulette once max(β·etaScale) is below it (after bounce 3)",
+    ),
+    LIGHT_SAMPLE_STRATEGY,
+    PIXEL_BOUNDS,
+];
+
+pub const KIND: IntegratorKind = IntegratorKind {
+    name: "volpath",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "path tracing with participating media (see Media)",
+    build: |p, r| IntegratorSettings::VolPath(VolPathSettings::read(p, r)),
+};
+
+/// `volpath` renders participating media and samples subsurface scattering.
+pub const RENDERS_MEDIA: bool = true;
+pub const SAMPLES_SUBSURFACE: bool = true;
+
+/// `volpath`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolPathSettings {
+    pub max_depth: u32,
+    pub rr_threshold: f32,
+    pub light_sample_strategy: LightSampleStrategy,
+}
+
+impl Default for VolPathSettings {
+    fn default() -> VolPathSettings {
+        VolPathSettings {
+            max_depth: 5,
+            rr_threshold: 1.0,
+            light_sample_strategy: LightSampleStrategy::Spatial,
+        }
+    }
+}
+
+impl VolPathSettings {
+    /// The settings of a statement's parameters, checked as pbrt-v3 does.
+    pub fn read(p: &ParamValues, r: &mut dyn Report) -> VolPathSettings {
+        VolPathSettings {
+            max_depth: super::max_depth(p, r),
+            rr_threshold: p.float("rrthreshold"),
+            light_sample_strategy: light_sample_strategy(p, r),
+        }
+    }
+
+    pub fn summary(&self) -> String {
+        let VolPathSettings {
+            max_depth,
+            rr_threshold,
+            light_sample_strategy,
+        } = self;
+        format!("{}, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}", KIND.name).to_lowercase()
+    }
+}
 
 /// What scatters at a path vertex.
 #[derive(Clone, Copy)]
