@@ -219,6 +219,41 @@ pub(super) fn bsdf_mis_weight(
     power_heuristic(1, bsdf_pdf, 1, light_pdf)
 }
 
+/// Whether [`choose_light`] draws the light's 2D sample before choosing
+/// the light (`path`, `volpath`: drawn even when no light is chosen) or
+/// after (pbrt-v3's UniformSampleOneLight).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum LightSampleFirst {
+    Yes,
+    No,
+}
+
+/// The light choice of next-event estimation at `point`: none without
+/// lights; else one 1D sample chooses a light by `lights`, and the light's
+/// 2D sample is drawn before or after the choice as `first` says. The
+/// light, its probability and its 2D sample; `None` when no light is
+/// chosen.
+#[inline(always)]
+pub(super) fn choose_light(
+    scene: &RenderScene,
+    point: &SurfacePoint,
+    sampler: &mut Sampler,
+    lights: &LightSampler,
+    first: LightSampleFirst,
+) -> Option<(u32, f32, Vec2)> {
+    if scene.lights.is_empty() {
+        return None;
+    }
+    let u = sampler.get_1d();
+    let early = (first == LightSampleFirst::Yes).then(|| sampler.get_2d());
+    let (light, pmf) = lights.sample(point.p, point.n, u, &scene.lights, &scene.geometry)?;
+    let u_light = match early {
+        Some(u_light) => u_light,
+        None => sampler.get_2d(),
+    };
+    Some((light, pmf, u_light))
+}
+
 /// Next-event estimation of the path tracer: choose a light, sample it,
 /// trace the shadow ray, weight against the BSDF strategy (whose sample is
 /// the path's continuation, see `path_li`).
@@ -232,13 +267,8 @@ pub(super) fn sample_light_mis(
     scratch: &mut Scratch,
     lights: &LightSampler,
 ) -> Vec3 {
-    if scene.lights.is_empty() {
-        return Vec3::ZERO;
-    }
-    let u = sampler.get_1d();
-    let u_light = sampler.get_2d();
-    let Some((light_index, pmf)) =
-        lights.sample(s.point.p, s.point.n, u, &scene.lights, &scene.geometry)
+    let Some((light_index, pmf, u_light)) =
+        choose_light(scene, &s.point, sampler, lights, LightSampleFirst::Yes)
     else {
         return Vec3::ZERO;
     };

@@ -10,7 +10,7 @@
 //! | `strategy` | string | `all` | `all` lights at every vertex, or `one` chosen uniformly |
 //! | `pixelbounds` | | | ignored, with a warning |
 
-use super::common::light_strategy;
+use super::common::{choose_light, light_strategy, LightSampleFirst};
 use super::direct_lanes;
 use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
 use crate::render::accel::SurfaceHit;
@@ -147,15 +147,11 @@ pub(super) fn sample_one_light(
     scratch: &mut Scratch,
     lights: &LightSampler,
 ) -> Vec3 {
-    if scene.lights.is_empty() {
-        return Vec3::ZERO;
-    }
-    let u = sampler.get_1d();
-    let Some((light, pmf)) = lights.sample(s.point.p, s.point.n, u, &scene.lights, &scene.geometry)
+    let Some((light, pmf, u_light)) =
+        choose_light(scene, &s.point, sampler, lights, LightSampleFirst::No)
     else {
         return Vec3::ZERO;
     };
-    let u_light = sampler.get_2d();
     let u_scatter = sampler.get_2d();
     estimate_direct(scene, s, bsdf, wo, light, u_light, u_scatter, scratch) / pmf
 }

@@ -27,7 +27,9 @@
 //! more ray per vertex for its BSDF strategy and adds emission only after
 //! specular bounces; both are unbiased estimators of the same integral.
 
-use super::common::{add_escaped_mis, emitted_mis, eta_scale_change, roulette, shade};
+use super::common::{
+    add_escaped_mis, choose_light, emitted_mis, eta_scale_change, roulette, shade, LightSampleFirst,
+};
 use super::path::{light_sample_strategy, LIGHT_SAMPLE_STRATEGY};
 use super::subsurface::{sample_exit, subsurface_exit};
 use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
@@ -223,13 +225,8 @@ fn sample_light(
     scratch: &mut Scratch,
     lights: &LightSampler,
 ) -> Vec3 {
-    if scene.lights.is_empty() {
-        return Vec3::ZERO;
-    }
-    let u = sampler.get_1d();
-    let u_light = sampler.get_2d();
-    let Some((light_index, pmf)) =
-        lights.sample(point.p, point.n, u, &scene.lights, &scene.geometry)
+    let Some((light_index, pmf, u_light)) =
+        choose_light(scene, point, sampler, lights, LightSampleFirst::Yes)
     else {
         return Vec3::ZERO;
     };
