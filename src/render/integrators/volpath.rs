@@ -387,17 +387,10 @@ pub(super) fn volpath_li(
         }
         let material = &scene.materials[s.material as usize];
         if material.is_none() {
-            // A medium boundary only: cross it without a bounce.
-            st.pass += 1;
-            if st.pass > MAX_PASS_THROUGH {
-                break;
+            if cross_boundary(&mut st, &s, &p) {
+                continue;
             }
-            if media_on {
-                st.medium = medium_after(scene, &s, st.ray.d, st.medium);
-            }
-            st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, st.ray.d);
-            st.diff = None;
-            continue;
+            break;
         }
         shade(
             scene,
@@ -464,6 +457,23 @@ pub(super) fn volpath_li(
         st.bounces += 1;
     }
     st.l
+}
+
+/// A surface without a material is a medium boundary only: the path
+/// crosses it without a bounce, into the medium on the other side. False
+/// past `MAX_PASS_THROUGH` such surfaces in a row (the path ends).
+#[inline(always)]
+fn cross_boundary(st: &mut VolState, s: &SurfaceHit, p: &VolParams) -> bool {
+    st.pass += 1;
+    if st.pass > MAX_PASS_THROUGH {
+        return false;
+    }
+    if p.media_on {
+        st.medium = medium_after(p.scene, s, st.ray.d, st.medium);
+    }
+    st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, st.ray.d);
+    st.diff = None;
+    true
 }
 
 /// The path scatters in its medium at distance `t` along `st.ray`: a
