@@ -27,24 +27,24 @@
 mod common;
 use common::*;
 use pbrs::render::film::Image;
-use pbrs::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy, SceneDescription};
+use pbrs::scene::{DirectStrategy, IntegratorSettings, LightSampleStrategy, SceneDescription};
 
-fn direct(strategy: DirectStrategy) -> IntegratorDesc {
-    IntegratorDesc::DirectLighting {
+fn direct(strategy: DirectStrategy) -> IntegratorSettings {
+    IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
         max_depth: 5,
         strategy,
-    }
+    })
 }
 
-fn path(max_depth: u32) -> IntegratorDesc {
-    IntegratorDesc::Path {
+fn path(max_depth: u32) -> IntegratorSettings {
+    IntegratorSettings::Path(pbrs::scene::PathSettings {
         max_depth,
         rr_threshold: 1.0,
         light_sample_strategy: LightSampleStrategy::Spatial,
-    }
+    })
 }
 
-fn check(name: &str, scene: &str, integrator: IntegratorDesc, spp: u32, expected: f64) -> f64 {
+fn check(name: &str, scene: &str, integrator: IntegratorSettings, spp: u32, expected: f64) -> f64 {
     let mut d: SceneDescription = load(scene);
     d.integrator = integrator;
     let (img, stats) = render_at(d, 32, spp, None);
@@ -86,7 +86,10 @@ fn point_light_at_the_centre_gives_one_half() {
     for (name, i) in [
         ("point/all", direct(DirectStrategy::All)),
         ("point/one", direct(DirectStrategy::One)),
-        ("point/whitted", IntegratorDesc::Whitted { max_depth: 5 }),
+        (
+            "point/whitted",
+            IntegratorSettings::Whitted(pbrs::scene::WhittedSettings { max_depth: 5 }),
+        ),
         ("point/path-1", path(1)),
     ] {
         let sigma = check(name, POINT, i, 16, 0.5);
@@ -100,7 +103,10 @@ fn emitting_sphere_with_one_bounce_gives_three_quarters() {
     for (name, i) in [
         ("emitting/all", direct(DirectStrategy::All)),
         ("emitting/one", direct(DirectStrategy::One)),
-        ("emitting/whitted", IntegratorDesc::Whitted { max_depth: 5 }),
+        (
+            "emitting/whitted",
+            IntegratorSettings::Whitted(pbrs::scene::WhittedSettings { max_depth: 5 }),
+        ),
         ("emitting/path-1", path(1)),
     ] {
         check(name, EMITTING, i, 64, 0.75);
@@ -131,19 +137,22 @@ fn specular_recursion_stops_at_maxdepth() {
             for (kind, i) in [
                 (
                     "all",
-                    IntegratorDesc::DirectLighting {
+                    IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
                         max_depth,
                         strategy: DirectStrategy::All,
-                    },
+                    }),
                 ),
                 (
                     "one",
-                    IntegratorDesc::DirectLighting {
+                    IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
                         max_depth,
                         strategy: DirectStrategy::One,
-                    },
+                    }),
                 ),
-                ("whitted", IntegratorDesc::Whitted { max_depth }),
+                (
+                    "whitted",
+                    IntegratorSettings::Whitted(pbrs::scene::WhittedSettings { max_depth }),
+                ),
             ] {
                 let name = format!("{scene} {kind} maxdepth {max_depth}");
                 let sigma = check(&name, scene, i, 4, want);

@@ -5,12 +5,12 @@
 mod common;
 use common::*;
 use pbrs::render::film::compare::block_error;
-use pbrs::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy};
+use pbrs::scene::{DirectStrategy, IntegratorSettings, LightSampleStrategy};
 
 const STEM: &str = "cornell-direct";
 const SCENE: &str = "scenes/cornell-direct.pbrt";
 
-fn with_integrator(i: IntegratorDesc) -> pbrs::scene::SceneDescription {
+fn with_integrator(i: IntegratorSettings) -> pbrs::scene::SceneDescription {
     let mut d = load(SCENE);
     d.integrator = i;
     d
@@ -21,10 +21,10 @@ fn strategy_all_matches_pbrt() {
     let d = load(SCENE);
     assert!(matches!(
         d.integrator,
-        IntegratorDesc::DirectLighting {
+        IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
             strategy: DirectStrategy::All,
             max_depth: 5
-        }
+        })
     ));
     let (img, stats) = render_at(d, 128, 64, None);
     assert_eq!(stats.dropped_samples(), 0, "NaN/Inf/negative samples");
@@ -63,10 +63,12 @@ fn check_unbiased(name: &str, desc: pbrs::scene::SceneDescription, spp: u32, k: 
 
 #[test]
 fn strategy_one_is_unbiased() {
-    let d = with_integrator(IntegratorDesc::DirectLighting {
-        max_depth: 5,
-        strategy: DirectStrategy::One,
-    });
+    let d = with_integrator(IntegratorSettings::DirectLighting(
+        pbrs::scene::DirectLightingSettings {
+            max_depth: 5,
+            strategy: DirectStrategy::One,
+        },
+    ));
     check_unbiased("cornell-direct-one", d, 64, 2);
 }
 
@@ -77,11 +79,11 @@ fn path_maxdepth_1_equals_directlighting() {
         LightSampleStrategy::Power,
         LightSampleStrategy::Spatial,
     ] {
-        let d = with_integrator(IntegratorDesc::Path {
+        let d = with_integrator(IntegratorSettings::Path(pbrs::scene::PathSettings {
             max_depth: 1,
             rr_threshold: 1.0,
             light_sample_strategy: strategy,
-        });
+        }));
         check_unbiased(&format!("cornell-path-maxdepth1-{strategy:?}"), d, 64, 2);
     }
 }
@@ -90,7 +92,9 @@ fn path_maxdepth_1_equals_directlighting() {
 fn whitted_matches_directlighting() {
     // All surfaces are matte and the lights are area lights, so Whitted's
     // light sampling (no MIS) has the same expectation as directlighting.
-    let d = with_integrator(IntegratorDesc::Whitted { max_depth: 5 });
+    let d = with_integrator(IntegratorSettings::Whitted(pbrs::scene::WhittedSettings {
+        max_depth: 5,
+    }));
     check_unbiased("cornell-whitted", d, 64, 2);
 }
 

@@ -12,9 +12,9 @@
 mod common;
 use common::*;
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::scene::{DirectStrategy, IntegratorDesc, LightSampleStrategy, SamplerKind};
+use pbrs::scene::{DirectStrategy, IntegratorSettings, LightSampleStrategy, SamplerKind};
 
-fn check(scene: &str, integrator: IntegratorDesc, sampler: SamplerKind, expect: f64) {
+fn check(scene: &str, integrator: IntegratorSettings, sampler: SamplerKind, expect: f64) {
     let mut desc = load(scene);
     desc.integrator = integrator;
     desc.sampler.kind = sampler;
@@ -33,12 +33,12 @@ fn check(scene: &str, integrator: IntegratorDesc, sampler: SamplerKind, expect: 
     );
 }
 
-fn path(d: u32) -> IntegratorDesc {
-    IntegratorDesc::Path {
+fn path(d: u32) -> IntegratorSettings {
+    IntegratorSettings::Path(pbrs::scene::PathSettings {
         max_depth: d,
         rr_threshold: 1.0,
         light_sample_strategy: LightSampleStrategy::Spatial,
-    }
+    })
 }
 
 const SAMPLERS: [SamplerKind; 2] = [SamplerKind::Halton, SamplerKind::Random];
@@ -56,10 +56,10 @@ fn point_light_at_the_centre_gives_one_minus_half_to_the_depth() {
             for strategy in [DirectStrategy::All, DirectStrategy::One] {
                 check(
                     scene,
-                    IntegratorDesc::DirectLighting {
+                    IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
                         max_depth: 5,
                         strategy,
-                    },
+                    }),
                     s,
                     0.5,
                 );
@@ -78,10 +78,10 @@ fn emitting_sphere_gives_one_minus_half_to_the_depth_plus_one() {
         for strategy in [DirectStrategy::All, DirectStrategy::One] {
             check(
                 scene,
-                IntegratorDesc::DirectLighting {
+                IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
                     max_depth: 5,
                     strategy,
-                },
+                }),
                 s,
                 0.75,
             );

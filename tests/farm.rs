@@ -31,7 +31,9 @@ fn scene(w: u32, h: u32, spp: u32, filter: Filter) -> SceneDescription {
     d.filter = filter;
     // Short paths keep the renders fast; the image is still noisy and
     // filter-dependent everywhere.
-    if let pbrs::scene::IntegratorDesc::Path { max_depth, .. } = &mut d.integrator {
+    if let pbrs::scene::IntegratorSettings::Path(pbrs::scene::PathSettings { max_depth, .. }) =
+        &mut d.integrator
+    {
         *max_depth = 3;
     }
     d

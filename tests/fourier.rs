@@ -781,7 +781,7 @@ fn spheres() -> pbrs::scene::SceneDescription {
 
 #[test]
 fn renders_without_nan_or_negative_samples() {
-    use pbrs::scene::IntegratorDesc;
+    use pbrs::scene::IntegratorSettings;
     let desc = spheres();
     let mut black = desc.clone();
     for m in &mut black.materials {
@@ -791,10 +791,10 @@ fn renders_without_nan_or_negative_samples() {
     }
     let direct = {
         let mut d = desc.clone();
-        d.integrator = IntegratorDesc::DirectLighting {
+        d.integrator = IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
             max_depth: 5,
             strategy: pbrs::scene::DirectStrategy::All,
-        };
+        });
         d
     };
     let mean = |img: &pbrs::render::film::Image| {

@@ -223,6 +223,41 @@ fn reference_material_section_is_generated_from_the_table() {
     }
 }
 
+/// The integrators section of REFERENCE.md is what the generator writes
+/// from `render::integrators::INTEGRATORS` (`PBRS_WRITE_REFERENCE=1`
+/// rewrites it).
+#[test]
+fn reference_integrators_section_is_generated_from_the_table() {
+    use pbrs::loader::reference::{
+        integrators_section, splice_between, INTEGRATORS_BEGIN, INTEGRATORS_END,
+    };
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
+    let doc = std::fs::read_to_string(&path).unwrap();
+    let section = integrators_section();
+    let Some(expected) = splice_between(&doc, &section, INTEGRATORS_BEGIN, INTEGRATORS_END) else {
+        panic!(
+            "REFERENCE.md lacks the lines {INTEGRATORS_BEGIN:?} and, after it, {INTEGRATORS_END:?}"
+        );
+    };
+    if std::env::var_os("PBRS_WRITE_REFERENCE").is_some_and(|v| v == "1") {
+        if expected != doc {
+            std::fs::write(&path, &expected).unwrap();
+        }
+        return;
+    }
+    assert!(
+        expected == doc,
+        "grammar/REFERENCE.md's integrators section differs from the integrator table; regenerate it with \
+         `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` and commit the diff"
+    );
+    for k in pbrs::render::integrators::INTEGRATORS {
+        assert!(section.contains(&format!("`{}`", k.name)), "{}", k.name);
+        for p in k.params.iter().filter(|_| k.is_supported()) {
+            assert!(section.contains(&format!("| `{}` |", p.name)), "{}", p.name);
+        }
+    }
+}
+
 /// The media section of REFERENCE.md is what the generator writes from
 /// `render::media::MEDIA` (`PBRS_WRITE_REFERENCE=1` rewrites it).
 #[test]

@@ -72,11 +72,11 @@ fn defaults_without_options() {
     );
     assert_eq!(
         s.integrator,
-        IntegratorDesc::Path {
+        IntegratorSettings::Path(pbrs::scene::PathSettings {
             max_depth: 5,
             rr_threshold: 1.0,
             light_sample_strategy: LightSampleStrategy::Spatial
-        }
+        })
     );
     let Projection::Perspective(c) = &s.camera.projection else {
         panic!("not perspective")
@@ -145,21 +145,21 @@ fn integrators() {
     let i = |t: &str| load(&format!("Integrator {t}\nWorldBegin\nWorldEnd"));
     assert_eq!(
         i("\"whitted\" \"integer maxdepth\" 3").scene.integrator,
-        IntegratorDesc::Whitted { max_depth: 3 }
+        IntegratorSettings::Whitted(pbrs::scene::WhittedSettings { max_depth: 3 })
     );
     assert_eq!(
         i("\"directlighting\" \"string strategy\" \"one\"")
             .scene
             .integrator,
-        IntegratorDesc::DirectLighting {
+        IntegratorSettings::DirectLighting(pbrs::scene::DirectLightingSettings {
             max_depth: 5,
             strategy: DirectStrategy::One
-        }
+        })
     );
     let b = i("\"bdpt\" \"integer maxdepth\" 7");
     assert!(matches!(
         b.scene.integrator,
-        IntegratorDesc::Path { max_depth: 7, .. }
+        IntegratorSettings::Path(pbrs::scene::PathSettings { max_depth: 7, .. })
     ));
     assert!(warnings(&b).contains("substituted by \"path\""));
 }

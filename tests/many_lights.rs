@@ -9,7 +9,7 @@ use pbrs::render::film::compare::compare;
 use pbrs::render::lights::{LightSampler, LightSamplerKind};
 use pbrs::render::sampling::Pcg32;
 use pbrs::render::scene::RenderScene;
-use pbrs::scene::{IntegratorDesc, LightSampleStrategy};
+use pbrs::scene::{IntegratorSettings, LightSampleStrategy};
 
 /// `n` small downward-facing emissive triangles scattered over a floor
 /// (deterministic), plus optional extra light lines, at `res` pixels.
@@ -142,10 +142,10 @@ LightSource "infinite" "rgb L" [0.1 0.1 0.1]"#;
 }
 
 fn with_strategy(desc: &mut pbrs::scene::SceneDescription, s: LightSampleStrategy) {
-    if let IntegratorDesc::Path {
+    if let IntegratorSettings::Path(pbrs::scene::PathSettings {
         light_sample_strategy,
         ..
-    } = &mut desc.integrator
+    }) = &mut desc.integrator
     {
         *light_sample_strategy = s;
     } else {

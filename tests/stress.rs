@@ -183,7 +183,10 @@ fn a_hall_of_mirrors_100000_deep_does_not_exhaust_the_stack() {
     for integrator in ["directlighting", "whitted"] {
         let mut desc = load("scenes/stress/mirrors-deep.pbrt");
         if integrator == "whitted" {
-            desc.integrator = pbrs::scene::IntegratorDesc::Whitted { max_depth: 100_000 };
+            desc.integrator =
+                pbrs::scene::IntegratorSettings::Whitted(pbrs::scene::WhittedSettings {
+                    max_depth: 100_000,
+                });
         }
         let (img, stats) =
             pbrs::render::driver::render(&desc, &Default::default(), &|_, _| {}).unwrap();

@@ -394,86 +394,34 @@ pub fn sampler(ctx: &mut Ctx, s: Ent) -> SamplerDesc {
         })
 }
 
-pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorDesc {
-    let path = |d| IntegratorDesc::Path {
-        max_depth: d,
-        rr_threshold: 1.0,
-        light_sample_strategy: LightSampleStrategy::Spatial,
+/// The integrator of an `Integrator` statement, read through
+/// [`INTEGRATORS`](crate::render::integrators::INTEGRATORS): the kind's
+/// builder checks its settings; a kind pbrs does not render is `path` with
+/// the statement's `maxdepth`, with a warning.
+pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorSettings {
+    use super::kinds::{self, Family, StatementReport, Unknown};
+    let family = Family {
+        directive: "Integrator",
+        noun: "integrator",
+        table: crate::render::integrators::INTEGRATORS,
+        unknown: Unknown::Error,
     };
-    let Some((name, p)) = s else { return path(5) };
-    let (md, loc) = int(p, "maxdepth", 5);
-    let max_depth = if md < 0 {
-        ctx.error(
-            loc.unwrap_or(name.loc),
-            format!("\"maxdepth\" is {md}: it must be ≥ 0"),
-            "negative depth",
-            None,
-        );
-        5
-    } else {
-        md as u32
+    let Some((name, p)) = s else {
+        return IntegratorSettings::default();
     };
-    if let Some(q) = p.items.iter().find(|q| q.name == "pixelbounds") {
-        q.used.set(true);
-        ctx.warn(q.loc, "\"pixelbounds\" is not supported by pbrs: the whole film is rendered (use --cropwindow)", "ignored");
+    let Some(read) = kinds::read(ctx, &family, name, p) else {
+        return IntegratorSettings::default();
+    };
+    let mut report = StatementReport {
+        ctx,
+        at: name.loc,
+        params: p,
+    };
+    let settings = (read.kind.build)(&read.params, &mut report);
+    if read.kind.unsupported().is_some() {
+        p.mark_all_used();
+        ctx.warn(name.loc, format!("integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth {}", name.value, settings.max_depth()), "substituted by path");
     }
-    let d = match name.value.as_str() {
-        "path" | "volpath" => {
-            let rr = float(p, "rrthreshold", 1.0) as f32;
-            let strategy = match string(p, "lightsamplestrategy") {
-                None | Some(("spatial", _)) => LightSampleStrategy::Spatial,
-                Some(("uniform", _)) => LightSampleStrategy::Uniform,
-                Some(("power", _)) => LightSampleStrategy::Power,
-                Some(("bvh", _)) => LightSampleStrategy::Bvh,
-                Some((other, loc)) => {
-                    ctx.warn(loc, format!("unknown light sample strategy \"{other}\": \"spatial\" is used (as pbrt-v3)"), "expected uniform, power, spatial or bvh");
-                    LightSampleStrategy::Spatial
-                }
-            };
-            if name.value == "volpath" {
-                IntegratorDesc::VolPath {
-                    max_depth,
-                    rr_threshold: rr,
-                    light_sample_strategy: strategy,
-                }
-            } else {
-                IntegratorDesc::Path {
-                    max_depth,
-                    rr_threshold: rr,
-                    light_sample_strategy: strategy,
-                }
-            }
-        }
-        "directlighting" => {
-            let strategy = match string(p, "strategy") {
-                None | Some(("all", _)) => DirectStrategy::All,
-                Some(("one", _)) => DirectStrategy::One,
-                Some((other, loc)) => {
-                    ctx.warn(
-                        loc,
-                        format!("unknown strategy \"{other}\": \"all\" is used (as pbrt-v3)"),
-                        "expected all or one",
-                    );
-                    DirectStrategy::All
-                }
-            };
-            IntegratorDesc::DirectLighting {
-                max_depth,
-                strategy,
-            }
-        }
-        "whitted" => IntegratorDesc::Whitted { max_depth },
-        "bdpt" | "mlt" | "sppm" | "ambientocclusion" => {
-            p.mark_all_used();
-            ctx.warn(name.loc, format!("integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth {max_depth}", name.value), "substituted by path");
-            path(max_depth)
-        }
-        other => {
-            p.mark_all_used();
-            ctx.error(name.loc, format!("unknown integrator \"{other}\" (pbrt-v3 has whitted, directlighting, path, volpath, bdpt, mlt, ambientocclusion, sppm)"), "unknown integrator", None);
-            path(max_depth)
-        }
-    };
-    ctx.report_unused(p, &format!("Integrator \"{}\"", name.value));
-    d
+    kinds::report_unused(ctx, &family, &read, name, p);
+    settings
 }

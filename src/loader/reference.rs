@@ -366,6 +366,41 @@ pub fn shapes_section() -> String {
     kinds_section((&b, &e), crate::render::shapes::SHAPES)
 }
 
+/// The line that opens the generated integrators section.
+pub const INTEGRATORS_BEGIN: &str = "<!-- BEGIN generated from render::integrators::INTEGRATORS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+/// The line that closes it.
+pub const INTEGRATORS_END: &str = "<!-- END generated integrators -->";
+
+/// The integrators section, between its markers (both included), from
+/// [`INTEGRATORS`](crate::render::integrators::INTEGRATORS).
+pub fn integrators_section() -> String {
+    use crate::render::integrators::INTEGRATORS;
+    let mut out = String::new();
+    out.push_str(INTEGRATORS_BEGIN);
+    out.push('\n');
+    for k in INTEGRATORS.iter().filter(|k| k.is_supported()) {
+        let _ = write!(out, "\n### `{}`\n\n{}\n", k.name, sentence(k.doc));
+        out.push_str("\n| parameter | type | default | meaning |\n|---|---|---|---|\n");
+        for p in k.params {
+            let (ty, default) = describe(p);
+            let _ = writeln!(out, "| `{}` | {ty} | {default} | {} |", p.name, cell(p.doc));
+        }
+    }
+    out.push_str("\n### Known to pbrt-v3, not rendered by pbrs\n\n");
+    out.push_str("A warning says so; `path` renders the scene instead, with the statement's `maxdepth` (its other parameters are not reported as unused).\n\n");
+    out.push_str("| type | why |\n|---|---|\n");
+    for k in INTEGRATORS {
+        if let Some(why) = k.unsupported() {
+            let _ = writeln!(out, "| `{}` | {} |", k.name, cell(why));
+        }
+    }
+    out.push_str("\n### Other types\n\nAn unknown type is an error (with a \"did you mean\" when a known type is close), as in pbrt-v3. A negative `maxdepth` is an error.\n");
+    out.push('\n');
+    out.push_str(INTEGRATORS_END);
+    out.push('\n');
+    out
+}
+
 /// `doc` with the part from the line `begin_marker` to the line
 /// `end_marker` (both included) replaced by `section`.
 pub fn splice_between(

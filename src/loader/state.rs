@@ -1015,7 +1015,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         FilmDesc,
         crate::render::filters::Filter,
         SamplerDesc,
-        IntegratorDesc,
+        IntegratorSettings,
     ) {
         let stmts = self.stmts;
         let ent = |i: Option<usize>| {
@@ -1049,22 +1049,13 @@ impl<'s, 'c> Builder<'s, 'c> {
         let integrator = entities::integrator(self.ctx, ent(self.integrator));
         if let Some(loc) = self.first_medium_interface {
             // pbrt-v3's warning for integrators without volume scattering.
-            let name = match integrator {
-                IntegratorDesc::VolPath { .. } => None,
-                IntegratorDesc::Path { .. } => Some("path"),
-                IntegratorDesc::DirectLighting { .. } => Some("directlighting"),
-                IntegratorDesc::Whitted { .. } => Some("whitted"),
-            };
+            let name = (!integrator.renders_media()).then(|| integrator.name());
             if let Some(name) = name {
                 self.ctx.warn(loc, format!("the scene has participating media but the \"{name}\" integrator ignores them (as pbrt-v3's): use \"volpath\" to render them"), "media ignored by this integrator");
             }
         }
         if let Some(loc) = self.first_subsurface {
-            let name = match integrator {
-                IntegratorDesc::VolPath { .. } | IntegratorDesc::Path { .. } => None,
-                IntegratorDesc::DirectLighting { .. } => Some("directlighting"),
-                IntegratorDesc::Whitted { .. } => Some("whitted"),
-            };
+            let name = (!integrator.samples_subsurface()).then(|| integrator.name());
             if let Some(name) = name {
                 self.ctx.warn(loc, format!("the \"{name}\" integrator does not sample subsurface scattering (as pbrt-v3's): this material renders as its dielectric boundary only; use \"path\" or \"volpath\""), "subsurface ignored by this integrator");
             }

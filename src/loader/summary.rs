@@ -90,16 +90,7 @@ impl Summary {
             SamplerKind::MaxMinDist => "maxmindist".into(),
         };
         s.sampler = format!("{kind}, {} samples per pixel", scene.sampler.pixel_samples);
-        s.integrator = match scene.integrator {
-            IntegratorDesc::Path { max_depth, rr_threshold, light_sample_strategy } => {
-                format!("path, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}").to_lowercase()
-            }
-            IntegratorDesc::DirectLighting { max_depth, strategy } => format!("directlighting, maxdepth {max_depth}, strategy {strategy:?}").to_lowercase(),
-            IntegratorDesc::Whitted { max_depth } => format!("whitted, maxdepth {max_depth}"),
-            IntegratorDesc::VolPath { max_depth, rr_threshold, light_sample_strategy } => {
-                format!("volpath, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}").to_lowercase()
-            }
-        };
+        s.integrator = scene.integrator.summary();
         s.media = scene.media.iter().map(|m| m.describe()).collect();
         s.camera_medium = scene
             .camera_medium

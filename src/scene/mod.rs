@@ -33,7 +33,7 @@ pub struct SceneDescription {
     pub film: FilmDesc,
     pub filter: crate::render::filters::Filter,
     pub sampler: SamplerDesc,
-    pub integrator: IntegratorDesc,
+    pub integrator: IntegratorSettings,
     /// Materials referenced by shapes (by index). Only referenced ones are built.
     pub materials: Vec<MaterialDesc>,
     /// Shapes in world space (their `object_to_world` maps to world).
@@ -165,27 +165,11 @@ pub enum DirectStrategy {
     One,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum IntegratorDesc {
-    Path {
-        max_depth: u32,
-        rr_threshold: f32,
-        light_sample_strategy: LightSampleStrategy,
-    },
-    DirectLighting {
-        max_depth: u32,
-        strategy: DirectStrategy,
-    },
-    Whitted {
-        max_depth: u32,
-    },
-    /// pbrt-v3's `volpath`: the path tracer with participating media.
-    VolPath {
-        max_depth: u32,
-        rr_threshold: f32,
-        light_sample_strategy: LightSampleStrategy,
-    },
-}
+/// The integrator: a kind's settings, built by its row of
+/// `render::integrators::INTEGRATORS`.
+pub use crate::render::integrators::{
+    DirectLightingSettings, IntegratorSettings, PathSettings, VolPathSettings, WhittedSettings,
+};
 
 /// A material: its kind (a name in `render::materials::MATERIALS`) and the
 /// values of the parameters that kind declares, defaults applied.

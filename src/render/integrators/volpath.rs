@@ -1,8 +1,12 @@
 //! The volumetric path tracer: pbrt-v3's `VolPathIntegrator`
 //! (src/integrators/volpath.cpp) with the MIS structure of pbrs's `path`.
 //!
-//! Parameters (pbrt-v3's): `integer maxdepth` (5), `float rrthreshold`
-//! (1), `string lightsamplestrategy` (`spatial`).
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `maxdepth` | integer | 5 | maximum number of bounces (≥ 0) |
+//! | `rrthreshold` | float | 1 | Russian roulette once max(β·etaScale) is below it (after bounce 3) |
+//! | `lightsamplestrategy` | string | `spatial` | light choice: `uniform`, `power`, `spatial` or `bvh` |
+//! | `pixelbounds` | | | ignored, with a warning |
 //!
 //! Along each segment the ray's medium (the camera's to start with; after a
 //! surface, the side of the surface's `MediumInterface` the new direction
@@ -23,20 +27,87 @@
 //! more ray per vertex for its BSDF strategy and adds emission only after
 //! specular bounces; both are unbiased estimators of the same integral.
 
-use super::{
-    add_escaped_mis, emitted_mis, eta_scale_change, roulette, sample_exit, shade, subsurface_exit,
-    Scratch, MAX_PASS_THROUGH,
+use super::common::{
+    add_escaped_mis, choose_light, emitted_mis, eta_scale_change, roulette, shade, LightSampleFirst,
 };
-use crate::render::accel::SurfaceHit;
+use super::path::{light_sample_strategy, LIGHT_SAMPLE_STRATEGY};
+use super::subsurface::{sample_exit, subsurface_exit};
+use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
+use super::{MAX_DEPTH, PIXEL_BOUNDS};
+use crate::render::accel::{Hit, SurfaceHit};
 use crate::render::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
 use crate::render::lights::LightSampler;
-use crate::render::materials::{Bsdf, BxdfFlags};
+use crate::render::materials::{Bsdf, BxdfFlags, Material};
 use crate::render::media::HenyeyGreenstein;
 use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
 use crate::render::shapes::SurfacePoint;
+use crate::scene::kind::{Report, Support};
+use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
 use glam::Vec3;
+
+pub const PARAMS: &[ParamSpec] = &[
+    MAX_DEPTH,
+    ParamSpec::float(
+        "rrthreshold",
+        1.0,
+        "Russian roulette once max(β·etaScale) is below it (after bounce 3)",
+    ),
+    LIGHT_SAMPLE_STRATEGY,
+    PIXEL_BOUNDS,
+];
+
+pub const KIND: IntegratorKind = IntegratorKind {
+    name: "volpath",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "path tracing with participating media (see Media)",
+    build: |p, r| IntegratorSettings::VolPath(VolPathSettings::read(p, r)),
+};
+
+/// `volpath` renders participating media and samples subsurface scattering.
+pub const RENDERS_MEDIA: bool = true;
+pub const SAMPLES_SUBSURFACE: bool = true;
+
+/// `volpath`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolPathSettings {
+    pub max_depth: u32,
+    pub rr_threshold: f32,
+    pub light_sample_strategy: LightSampleStrategy,
+}
+
+impl Default for VolPathSettings {
+    fn default() -> VolPathSettings {
+        VolPathSettings {
+            max_depth: 5,
+            rr_threshold: 1.0,
+            light_sample_strategy: LightSampleStrategy::Spatial,
+        }
+    }
+}
+
+impl VolPathSettings {
+    /// The settings of a statement's parameters, checked as pbrt-v3 does.
+    pub fn read(p: &ParamValues, r: &mut dyn Report) -> VolPathSettings {
+        VolPathSettings {
+            max_depth: super::max_depth(p, r),
+            rr_threshold: p.float("rrthreshold"),
+            light_sample_strategy: light_sample_strategy(p, r),
+        }
+    }
+
+    pub fn summary(&self) -> String {
+        let VolPathSettings {
+            max_depth,
+            rr_threshold,
+            light_sample_strategy,
+        } = self;
+        format!("{}, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}", KIND.name).to_lowercase()
+    }
+}
 
 /// What scatters at a path vertex.
 #[derive(Clone, Copy)]
@@ -154,13 +225,8 @@ fn sample_light(
     scratch: &mut Scratch,
     lights: &LightSampler,
 ) -> Vec3 {
-    if scene.lights.is_empty() {
-        return Vec3::ZERO;
-    }
-    let u = sampler.get_1d();
-    let u_light = sampler.get_2d();
-    let Some((light_index, pmf)) =
-        lights.sample(point.p, point.n, u, &scene.lights, &scene.geometry)
+    let Some((light_index, pmf, u_light)) =
+        choose_light(scene, point, sampler, lights, LightSampleFirst::Yes)
     else {
         return Vec3::ZERO;
     };
@@ -195,10 +261,60 @@ fn sample_light(
     f * tr * ls.li * power_heuristic(1, light_pdf, 1, scatter_pdf) / light_pdf
 }
 
+/// A volpath path between two vertices: what one step of the loop of
+/// [`volpath_li`] carries to the next.
+struct VolState {
+    /// The ray to trace next, and its differentials (the camera ray's).
+    ray: Ray,
+    diff: Option<RayDiff>,
+    /// The medium the ray is in.
+    medium: Option<u32>,
+    /// Radiance gathered so far.
+    l: Vec3,
+    beta: Vec3,
+    specular_bounce: bool,
+    eta_scale: f32,
+    bounces: u32,
+    pass: u32,
+    /// The last scattering vertex (a medium point has no normal and no
+    /// error bound) and the density of the direction sampled there.
+    prev: Option<SurfacePoint>,
+    scatter_pdf: f32,
+}
+
+impl VolState {
+    fn new(ray: Ray, diff: Option<RayDiff>, medium: Option<u32>) -> VolState {
+        VolState {
+            ray,
+            diff,
+            medium,
+            l: Vec3::ZERO,
+            beta: Vec3::ONE,
+            specular_bounce: false,
+            eta_scale: 1.0,
+            bounces: 0,
+            pass: 0,
+            prev: None,
+            scatter_pdf: 0.0,
+        }
+    }
+}
+
+/// What every step of a `volpath` render shares.
+struct VolParams<'a> {
+    scene: &'a RenderScene,
+    time: f32,
+    max_depth: u32,
+    rr_threshold: f32,
+    lights: &'a LightSampler,
+    /// The scene has media (else every ray's medium stays none).
+    media_on: bool,
+}
+
 /// The volumetric path tracer's radiance along a camera ray.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn volpath_li(
-    mut ray: Ray,
+    ray: Ray,
     time: f32,
     diff: Option<RayDiff>,
     scene: &RenderScene,
@@ -209,103 +325,72 @@ pub(super) fn volpath_li(
     lights: &LightSampler,
 ) -> Vec3 {
     let media_on = !scene.media.is_empty();
-    let mut medium = if media_on { scene.camera_medium } else { None };
-    let mut l = Vec3::ZERO;
+    let p = VolParams {
+        scene,
+        time,
+        max_depth,
+        rr_threshold,
+        lights,
+        media_on,
+    };
+    let medium = if media_on { scene.camera_medium } else { None };
+    let mut st = VolState::new(ray, diff, medium);
     let mut bsdf = Bsdf::empty();
-    let mut beta = Vec3::ONE;
-    let mut diff = diff;
-    let mut specular_bounce = false;
-    let mut eta_scale = 1.0f32;
-    let mut bounces = 0u32;
-    let mut pass = 0u32;
-    // The last scattering vertex (a medium point has no normal and no
-    // error bound) and the density of the direction sampled there.
-    let mut prev: Option<SurfacePoint> = None;
-    let mut scatter_pdf = 0.0f32;
     loop {
         scratch.counts.closest += 1;
-        let hit = scene.geometry.intersect_at(&ray, time);
-        if let Some(m) = medium {
+        let hit = scene.geometry.intersect_at(&st.ray, time);
+        if let Some(m) = st.medium {
             let med = &scene.media[m as usize];
             let segment = Ray {
                 t_max: hit.map_or(f32::INFINITY, |h| h.t),
-                ..ray
+                ..st.ray
             };
             let (w, scattered) = med.sample(&segment, sampler);
-            beta *= w;
-            if beta == Vec3::ZERO {
+            st.beta *= w;
+            if st.beta == Vec3::ZERO {
                 break;
             }
             if let Some(t) = scattered {
-                if bounces >= max_depth {
-                    break;
-                }
-                let point = SurfacePoint {
-                    p: ray.at(t),
-                    p_error: Vec3::ZERO,
-                    n: Vec3::ZERO,
-                    ns: Vec3::ZERO,
-                };
-                let wo = (-ray.d).normalize();
                 let phase = med.phase;
-                l += beta
-                    * sample_light(
-                        scene,
-                        &point,
-                        time,
-                        Scatter::Medium(phase),
-                        wo,
-                        |_| medium,
-                        sampler,
-                        scratch,
-                        lights,
-                    );
-                let (wi, pdf) = phase.sample(wo, sampler.get_2d());
-                // The phase function's value equals its density: β stays.
-                specular_bounce = false;
-                scatter_pdf = pdf;
-                prev = Some(point);
-                ray = Ray::new(point.p, wi);
-                diff = None;
-                if roulette(&mut beta, eta_scale, rr_threshold, bounces, sampler) {
-                    break;
+                if scatter_in_medium(&mut st, t, phase, &p, sampler, scratch) {
+                    continue;
                 }
-                bounces += 1;
-                continue;
+                break;
             }
         }
-        let from = prev.filter(|_| !specular_bounce);
+        let from = st.prev.filter(|_| !st.specular_bounce);
         let Some(hit) = hit else {
             add_escaped_mis(
-                &mut l,
+                &mut st.l,
                 scene,
                 lights,
-                beta,
+                st.beta,
                 from.as_ref(),
-                ray.d,
-                scatter_pdf,
+                st.ray.d,
+                st.scatter_pdf,
             );
             break;
         };
         let mut s = scene.geometry.surface_at(&hit, time);
-        let wo = -ray.d;
-        l += emitted_mis(scene, lights, beta, &s, from.as_ref(), ray.d, scatter_pdf);
-        if bounces >= max_depth {
+        let wo = -st.ray.d;
+        st.l += emitted_mis(
+            scene,
+            lights,
+            st.beta,
+            &s,
+            from.as_ref(),
+            st.ray.d,
+            st.scatter_pdf,
+        );
+        if st.bounces >= max_depth {
             break;
         }
         let material = &scene.materials[s.material as usize];
         if material.is_none() {
-            // A medium boundary only: cross it without a bounce.
-            pass += 1;
-            if pass > MAX_PASS_THROUGH {
-                break;
+            if cross_boundary(&mut st, &s, &p) {
+                continue;
             }
-            if media_on {
-                medium = medium_after(scene, &s, ray.d, medium);
-            }
-            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
-            diff = None;
-            continue;
+            break;
         }
         shade(
             scene,
@@ -313,13 +398,13 @@ pub(super) fn volpath_li(
             &mut s,
             material,
             true,
-            diff.as_ref(),
+            st.diff.as_ref(),
             &mut bsdf,
         );
-        diff = None;
+        st.diff = None;
         if bsdf.has_non_specular() {
-            let current = medium;
-            l += beta
+            let current = st.medium;
+            st.l += st.beta
                 * sample_light(
                     scene,
                     &s.point,
@@ -345,65 +430,172 @@ pub(super) fn volpath_li(
         if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
             break;
         }
-        beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
-        specular_bounce = bs.is_specular();
-        scatter_pdf = bs.pdf;
-        prev = Some(s.point);
-        eta_scale *= eta_scale_change(&bsdf, &bs, wo, s.point.n);
+        st.beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
+        st.specular_bounce = bs.is_specular();
+        st.scatter_pdf = bs.pdf;
+        st.prev = Some(s.point);
+        st.eta_scale *= eta_scale_change(&bsdf, &bs, wo, s.point.n);
         if media_on {
-            medium = medium_after(scene, &s, bs.wi, medium);
+            st.medium = medium_after(scene, &s, bs.wi, st.medium);
         }
-        ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-        if bs.is_transmission() && material.has_bssrdf() {
-            // pbrt-v3's subsurface step (as in `path`): continue from a
-            // sampled exit point, with light sampled there (through media),
-            // not counted as a bounce. As in pbrt-v3, the exit point is
-            // found by probe rays that carry no medium, so unless its shape
-            // has a medium transition the rays leaving it start in vacuum
-            // (pbrt-v3's `GeometricPrimitive::Intersect` gives a hit of a
-            // non-transition shape the probe ray's medium, none).
-            let frame = bsdf.frame;
-            let Some((pi, w, exit)) =
-                subsurface_exit(scene, &hit, &s, material, &frame, time, sampler, scratch)
-            else {
-                break;
-            };
-            beta *= w;
-            let wo = pi.point.ns;
-            l += beta
-                * sample_light(
-                    scene,
-                    &pi.point,
-                    time,
-                    Scatter::Surface(&exit, pi.point.ns),
-                    wo,
-                    |wi| {
-                        if media_on {
-                            medium_after(scene, &pi, wi, None)
-                        } else {
-                            None
-                        }
-                    },
-                    sampler,
-                    scratch,
-                    lights,
-                );
-            let Some(bs) = sample_exit(&pi, &exit, sampler) else {
-                break;
-            };
-            beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
-            specular_bounce = false;
-            scatter_pdf = bs.pdf;
-            prev = Some(pi.point);
-            if media_on {
-                medium = medium_after(scene, &pi, bs.wi, None);
-            }
-            ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
-        }
-        if roulette(&mut beta, eta_scale, rr_threshold, bounces, sampler) {
+        st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+        if bs.is_transmission()
+            && material.has_bssrdf()
+            && !subsurface_step(&mut st, &hit, &s, material, &bsdf, &p, sampler, scratch)
+        {
             break;
         }
-        bounces += 1;
+        if roulette(
+            &mut st.beta,
+            st.eta_scale,
+            rr_threshold,
+            st.bounces,
+            sampler,
+        ) {
+            break;
+        }
+        st.bounces += 1;
     }
-    l
+    st.l
+}
+
+/// A surface without a material is a medium boundary only: the path
+/// crosses it without a bounce, into the medium on the other side. False
+/// past `MAX_PASS_THROUGH` such surfaces in a row (the path ends).
+#[inline(always)]
+fn cross_boundary(st: &mut VolState, s: &SurfaceHit, p: &VolParams) -> bool {
+    st.pass += 1;
+    if st.pass > MAX_PASS_THROUGH {
+        return false;
+    }
+    if p.media_on {
+        st.medium = medium_after(p.scene, s, st.ray.d, st.medium);
+    }
+    st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, st.ray.d);
+    st.diff = None;
+    true
+}
+
+/// The path scatters in its medium at distance `t` along `st.ray`: a
+/// medium vertex whose phase function plays the BSDF's part (next-event
+/// estimation, then a phase-function sample to continue). False when the
+/// path ends.
+#[inline(always)]
+fn scatter_in_medium(
+    st: &mut VolState,
+    t: f32,
+    phase: HenyeyGreenstein,
+    p: &VolParams,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> bool {
+    let (scene, time, lights) = (p.scene, p.time, p.lights);
+    if st.bounces >= p.max_depth {
+        return false;
+    }
+    let point = SurfacePoint {
+        p: st.ray.at(t),
+        p_error: Vec3::ZERO,
+        n: Vec3::ZERO,
+        ns: Vec3::ZERO,
+    };
+    let wo = (-st.ray.d).normalize();
+    st.l += st.beta
+        * sample_light(
+            scene,
+            &point,
+            time,
+            Scatter::Medium(phase),
+            wo,
+            |_| st.medium,
+            sampler,
+            scratch,
+            lights,
+        );
+    let (wi, pdf) = phase.sample(wo, sampler.get_2d());
+    // The phase function's value equals its density: β stays.
+    st.specular_bounce = false;
+    st.scatter_pdf = pdf;
+    st.prev = Some(point);
+    st.ray = Ray::new(point.p, wi);
+    st.diff = None;
+    if roulette(
+        &mut st.beta,
+        st.eta_scale,
+        p.rr_threshold,
+        st.bounces,
+        sampler,
+    ) {
+        return false;
+    }
+    st.bounces += 1;
+    true
+}
+
+/// pbrt-v3's subsurface step (as in `path`) after a BSDF sample that
+/// transmits into `material` at `s` (`bsdf`'s frame): continue from a
+/// sampled exit point, with light sampled there (through media), not
+/// counted as a bounce. As in pbrt-v3, the exit point is found by probe
+/// rays that carry no medium, so unless its shape has a medium transition
+/// the rays leaving it start in vacuum (pbrt-v3's
+/// `GeometricPrimitive::Intersect` gives a hit of a non-transition shape
+/// the probe ray's medium, none). False when the path ends.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn subsurface_step(
+    st: &mut VolState,
+    hit: &Hit,
+    s: &SurfaceHit,
+    material: &Material,
+    bsdf: &Bsdf,
+    p: &VolParams,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> bool {
+    let (scene, time, lights, media_on) = (p.scene, p.time, p.lights, p.media_on);
+    // pbrt-v3's subsurface step (as in `path`): continue from a
+    // sampled exit point, with light sampled there (through media),
+    // not counted as a bounce. As in pbrt-v3, the exit point is
+    // found by probe rays that carry no medium, so unless its shape
+    // has a medium transition the rays leaving it start in vacuum
+    // (pbrt-v3's `GeometricPrimitive::Intersect` gives a hit of a
+    // non-transition shape the probe ray's medium, none).
+    let frame = bsdf.frame;
+    let Some((pi, w, exit)) =
+        subsurface_exit(scene, hit, s, material, &frame, time, sampler, scratch)
+    else {
+        return false;
+    };
+    st.beta *= w;
+    let wo = pi.point.ns;
+    st.l += st.beta
+        * sample_light(
+            scene,
+            &pi.point,
+            time,
+            Scatter::Surface(&exit, pi.point.ns),
+            wo,
+            |wi| {
+                if media_on {
+                    medium_after(scene, &pi, wi, None)
+                } else {
+                    None
+                }
+            },
+            sampler,
+            scratch,
+            lights,
+        );
+    let Some(bs) = sample_exit(&pi, &exit, sampler) else {
+        return false;
+    };
+    st.beta *= bs.f * bs.wi.dot(pi.point.ns).abs() / bs.pdf;
+    st.specular_bounce = false;
+    st.scatter_pdf = bs.pdf;
+    st.prev = Some(pi.point);
+    if media_on {
+        st.medium = medium_after(scene, &pi, bs.wi, None);
+    }
+    st.ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
+    true
 }

@@ -1,6 +1,6 @@
 //! Triangle area lights four to a pack, in structure-of-arrays form, so
 //! that directlighting's strategy "all" samples four lights in one pass of
-//! four-lane arithmetic (`integrators::all_lights`). Lane `i` of pack `k` is
+//! four-lane arithmetic (`integrators::direct_lanes`). Lane `i` of pack `k` is
 //! light `4k + i`; a pack's unused lanes repeat its first light and are
 //! masked off by `count`.
 

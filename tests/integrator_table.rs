@@ -1,0 +1,129 @@
+//! The integrator table's completeness test: every kind that
+//! `INTEGRATORS` marks as supported has a case here (a kind without one
+//! fails), loaded through the real scene loader from an `Integrator`
+//! statement and rendered; the image must be finite and lit, and the
+//! description must hold that kind's settings. Kinds pbrs does not render
+//! must be substituted by `path` with the statement's `maxdepth`, with
+//! pbrt-v3's warning.
+
+mod common;
+
+use common::{load_text, render_at, warning_text};
+use pbrs::render::integrators::INTEGRATORS;
+
+/// A kind and the parameters of its `Integrator` statement.
+struct Case {
+    kind: &'static str,
+    params: &'static str,
+    /// The settings' line in `--check`.
+    summary: &'static str,
+}
+
+const CASES: &[Case] = &[
+    Case {
+        kind: "path",
+        params: "\"integer maxdepth\" 3 \"string lightsamplestrategy\" \"power\"",
+        summary: "path, maxdepth 3, rrthreshold 1, light samples power",
+    },
+    Case {
+        kind: "volpath",
+        params: "\"integer maxdepth\" 4",
+        summary: "volpath, maxdepth 4, rrthreshold 1, light samples spatial",
+    },
+    Case {
+        kind: "directlighting",
+        params: "\"string strategy\" \"one\"",
+        summary: "directlighting, maxdepth 5, strategy one",
+    },
+    Case {
+        kind: "whitted",
+        params: "\"integer maxdepth\" 2",
+        summary: "whitted, maxdepth 2",
+    },
+];
+
+/// A small scene lit by a point light and an area light: a matte floor, a
+/// glass sphere and a mirror sphere (so the specular trees have children).
+fn scene(integrator: &str) -> String {
+    format!(
+        r#"LookAt 0 1 -4  0 0.5 0  0 1 0
+Camera "perspective" "float fov" 45
+Film "image" "integer xresolution" 16 "integer yresolution" 16
+Sampler "halton" "integer pixelsamples" 4
+Integrator {integrator}
+WorldBegin
+LightSource "point" "point from" [0 3 -1] "rgb I" [6 6 6]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [2 2 2]
+  Translate 0 3 1
+  Shape "sphere" "float radius" 0.3
+AttributeEnd
+Material "matte" "rgb Kd" [0.5 0.5 0.5]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point P" [-5 0 -5  5 0 -5  5 0 5  -5 0 5]
+AttributeBegin
+  Material "glass"
+  Translate -0.6 0.5 0
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+AttributeBegin
+  Material "mirror"
+  Translate 0.6 0.5 0
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+WorldEnd
+"#
+    )
+}
+
+#[test]
+fn every_supported_kind_has_a_case_that_renders() {
+    for k in INTEGRATORS.iter().filter(|k| k.is_supported()) {
+        let case = CASES.iter().find(|c| c.kind == k.name);
+        let Some(case) = case else {
+            panic!(
+                "integrator \"{}\" has no case in tests/integrator_table.rs",
+                k.name
+            );
+        };
+        let loaded = load_text(&scene(&format!("\"{}\" {}", case.kind, case.params)));
+        assert_eq!(warning_text(&loaded), "", "{}", k.name);
+        let settings = loaded.scene.integrator;
+        assert_eq!(settings.name(), k.name);
+        assert_eq!(settings.summary(), case.summary);
+        let (img, stats) = render_at(loaded.scene, 16, 4, Some(1));
+        let sum: f64 = img.data.iter().map(|&v| v as f64).sum();
+        assert!(sum.is_finite() && sum > 0.0, "{}: {sum}", k.name);
+        assert!(stats.rays.shadow > 0, "{}: no light sampled", k.name);
+    }
+    for c in CASES {
+        assert!(
+            INTEGRATORS
+                .iter()
+                .any(|k| k.name == c.kind && k.is_supported()),
+            "case for unknown kind {}",
+            c.kind
+        );
+    }
+}
+
+#[test]
+fn unsupported_kinds_are_path_with_their_maxdepth() {
+    for k in INTEGRATORS.iter().filter(|k| !k.is_supported()) {
+        let loaded = load_text(&scene(&format!(
+            "\"{}\" \"integer maxdepth\" 2 \"bool visualizestrategies\" \"true\"",
+            k.name
+        )));
+        let w = warning_text(&loaded);
+        assert!(
+            w.contains(&format!(
+                "integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth 2",
+                k.name
+            )),
+            "{w}"
+        );
+        assert!(!w.contains("visualizestrategies"), "{w}");
+        assert_eq!(loaded.scene.integrator.name(), "path");
+        assert_eq!(loaded.scene.integrator.max_depth(), 2);
+    }
+}
