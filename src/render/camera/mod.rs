@@ -38,7 +38,9 @@ pub use realistic::RealisticCamera;
 
 use crate::render::geometry::{Ray, RayDiff};
 use crate::render::samplers::CameraSample;
-use crate::scene::{AnimatedTransform, CameraDesc, FilmDesc, Kind, ParamSpec, ParamValues, Report};
+use crate::scene::{
+    AnimatedTransform, CameraDesc, FilmDesc, Kind, ParamKind, ParamSpec, ParamValues, Range, Report,
+};
 use glam::{Affine3A, DMat4, Vec2, Vec3};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -99,10 +101,12 @@ pub const THIN_LENS: [ParamSpec; 4] = [
         "frameaspectratio",
         "x/y of the screen window (default: the film's; > 0)",
     ),
-    ParamSpec::floats(
-        "screenwindow",
-        "xmin xmax ymin ymax of the screen window (default: the shorter axis spans [-1, 1])",
-    ),
+    ParamSpec {
+        name: "screenwindow",
+        kind: ParamKind::Floats,
+        range: Range::Any,
+        doc: "xmin xmax ymin ymax of the screen window (default: the shorter axis spans [-1, 1])",
+    },
 ];
 
 /// `lensradius` and `focaldistance`. A negative radius is a pinhole (pbrt-v3
