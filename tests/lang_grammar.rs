@@ -164,6 +164,7 @@ fn operands_match() {
 
 #[test]
 fn reference_documents_every_directive_and_type() {
+    let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     let reference =
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md"))
             .unwrap();
@@ -186,6 +187,7 @@ fn reference_documents_every_directive_and_type() {
 /// rewrites it instead (then review and commit the diff).
 #[test]
 fn reference_material_section_is_generated_from_the_table() {
+    let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use pbrs::loader::reference::{materials_section, splice, MATERIALS_BEGIN, MATERIALS_END};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let doc = std::fs::read_to_string(&path).unwrap();
@@ -228,6 +230,7 @@ fn reference_material_section_is_generated_from_the_table() {
 /// rewrites it).
 #[test]
 fn reference_integrators_section_is_generated_from_the_table() {
+    let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use pbrs::loader::reference::{
         integrators_section, splice_between, INTEGRATORS_BEGIN, INTEGRATORS_END,
     };
@@ -262,6 +265,7 @@ fn reference_integrators_section_is_generated_from_the_table() {
 /// `render::media::MEDIA` (`PBRS_WRITE_REFERENCE=1` rewrites it).
 #[test]
 fn reference_media_section_is_generated_from_the_table() {
+    let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use pbrs::loader::reference::{media_section, splice_between, MEDIA_BEGIN, MEDIA_END};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let doc = std::fs::read_to_string(&path).unwrap();
@@ -298,6 +302,7 @@ fn reference_media_section_is_generated_from_the_table() {
 /// lists every kind and parameter of the table.
 #[test]
 fn reference_family_sections_are_generated_from_the_tables() {
+    let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use pbrs::loader::reference::{markers, splice_between};
     type Section = (
         &'static str,
@@ -373,6 +378,7 @@ fn reference_family_sections_are_generated_from_the_tables() {
 /// rewrites it).
 #[test]
 fn reference_lights_section_is_generated_from_the_tables() {
+    let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use pbrs::loader::reference::{lights_section, splice_between, LIGHTS_BEGIN, LIGHTS_END};
     use pbrs::render::lights::{AREA_LIGHTS, LIGHTS};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
@@ -413,3 +419,7 @@ fn reference_lights_section_is_generated_from_the_tables() {
         }
     }
 }
+
+/// The reference tests read, and with `PBRS_WRITE_REFERENCE=1` rewrite,
+/// one file: one at a time.
+static REFERENCE_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());

@@ -71,7 +71,10 @@ pub static MATERIALS: &[MaterialKind] = &[
     NONE_KIND,
     subsurface::KIND,
     kdsubsurface::KIND,
-    unsupported("hair", "the hair BSDF comes after curves"),
+    unsupported(
+        "hair",
+        "pbrt-v3's HairBSDF is not implemented yet (curves are): a matte with the material's Kd stands in",
+    ),
 ];
 
 const NONE_KIND: MaterialKind = MaterialKind {
