@@ -69,31 +69,7 @@ impl Slots {
 
 impl RenderScene {
     pub fn new(desc: &SceneDescription) -> RenderScene {
-        let mut materials: Vec<Material> = desc.materials.iter().map(Material::new).collect();
-        link_materials(&mut materials);
-        let mut surface_media: Vec<Option<SurfaceMedia>> = vec![None; materials.len()];
-        let mut slots = Slots {
-            map: HashMap::new(),
-        };
-        let all_shapes = desc
-            .shapes
-            .iter()
-            .chain(desc.objects.iter().flat_map(|o| o.shapes.iter()));
-        for s in all_shapes {
-            let mi = s.medium_interface;
-            if !mi.is_transition() {
-                continue;
-            }
-            slots.map.entry((s.material.0, mi)).or_insert_with(|| {
-                materials.push(materials[s.material.0 as usize].clone());
-                surface_media.push(Some(SurfaceMedia {
-                    inside: mi.inside.map(|m| m.0),
-                    outside: mi.outside.map(|m| m.0),
-                }));
-                (materials.len() - 1) as u32
-            });
-        }
-        let slots = slots;
+        let (materials, surface_media, slots) = material_slots(desc);
         let mut meshes = Vec::new();
         let mut quadrics = Vec::new();
         let mut area: Vec<(AreaShape, DiffuseEmission)> = Vec::new();
@@ -154,37 +130,8 @@ impl RenderScene {
                 }
             }
         }
-        // Each instanced object is built once, in its own space, with its own
-        // BVH; instances refer to it (two-level BVH, no copies of geometry).
-        let objects: Vec<Option<Arc<Object>>> = desc
-            .objects
-            .iter()
-            .enumerate()
-            .map(|(i, obj)| {
-                if !desc.instances.iter().any(|inst| inst.object == i) {
-                    return None;
-                }
-                Some(Arc::new(object(&obj.shapes, |s| s.object_to_world, &slots)))
-            })
-            .collect();
-        let mut instances = Vec::with_capacity(desc.instances.len());
-        let mut singular = 0usize;
-        for inst in &desc.instances {
-            let Some(Some(obj)) = objects.get(inst.object) else {
-                continue;
-            };
-            if let Some(m) = &inst.motion {
-                match MovingInstance::new(obj.clone(), m.clone()) {
-                    Some(i) => moving.push(i),
-                    None => singular_moving += 1,
-                }
-                continue;
-            }
-            match Instance::new(obj.clone(), inst.instance_to_world) {
-                Some(i) => instances.push(i),
-                None => singular += 1,
-            }
-        }
+        let (objects, instances, singular) =
+            place_instances(desc, &slots, &mut moving, &mut singular_moving);
         if singular > 0 {
             notes.push(format!(
                 "{singular} instances with a singular transform left out"
@@ -294,6 +241,79 @@ impl RenderScene {
             has_pass_through,
         }
     }
+}
+
+/// The materials, one per description material plus one per (material,
+/// medium interface) pair that crosses media, with each slot's media.
+fn material_slots(desc: &SceneDescription) -> (Vec<Material>, Vec<Option<SurfaceMedia>>, Slots) {
+    let mut materials: Vec<Material> = desc.materials.iter().map(Material::new).collect();
+    link_materials(&mut materials);
+    let mut surface_media: Vec<Option<SurfaceMedia>> = vec![None; materials.len()];
+    let mut slots = Slots {
+        map: HashMap::new(),
+    };
+    let all_shapes = desc
+        .shapes
+        .iter()
+        .chain(desc.objects.iter().flat_map(|o| o.shapes.iter()));
+    for s in all_shapes {
+        let mi = s.medium_interface;
+        if !mi.is_transition() {
+            continue;
+        }
+        slots.map.entry((s.material.0, mi)).or_insert_with(|| {
+            materials.push(materials[s.material.0 as usize].clone());
+            surface_media.push(Some(SurfaceMedia {
+                inside: mi.inside.map(|m| m.0),
+                outside: mi.outside.map(|m| m.0),
+            }));
+            (materials.len() - 1) as u32
+        });
+    }
+    (materials, surface_media, slots)
+}
+
+/// Each instanced object built once, in its own space, and the instances
+/// that place it (moving ones go to `moving`); the count of instances left
+/// out for a singular transform.
+fn place_instances(
+    desc: &SceneDescription,
+    slots: &Slots,
+    moving: &mut Vec<MovingInstance>,
+    singular_moving: &mut usize,
+) -> (Vec<Option<Arc<Object>>>, Vec<Instance>, usize) {
+    // Each instanced object is built once, in its own space, with its own
+    // BVH; instances refer to it (two-level BVH, no copies of geometry).
+    let objects: Vec<Option<Arc<Object>>> = desc
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, obj)| {
+            if !desc.instances.iter().any(|inst| inst.object == i) {
+                return None;
+            }
+            Some(Arc::new(object(&obj.shapes, |s| s.object_to_world, slots)))
+        })
+        .collect();
+    let mut instances = Vec::with_capacity(desc.instances.len());
+    let mut singular = 0usize;
+    for inst in &desc.instances {
+        let Some(Some(obj)) = objects.get(inst.object) else {
+            continue;
+        };
+        if let Some(m) = &inst.motion {
+            match MovingInstance::new(obj.clone(), m.clone()) {
+                Some(i) => moving.push(i),
+                None => *singular_moving += 1,
+            }
+            continue;
+        }
+        match Instance::new(obj.clone(), inst.instance_to_world) {
+            Some(i) => instances.push(i),
+            None => singular += 1,
+        }
+    }
+    (objects, instances, singular)
 }
 
 /// Builds an object's shapes in object space (each placed there by
