@@ -185,7 +185,7 @@ const CASES: &[Case] = &[
     // Tabulated (pbrt-v3's .bsdf files in tests/inputs/fourier): leather
     // (an opaque layered fit: reflection only, albedo below 1) and rough
     // gold (3 channels, Y R B), fits of reciprocal models to a few percent.
-    // Rough glass is in tests/fourier.rs: its file's CDF and coefficients
+    // Rough glass is in tests/materials_fourier.rs: its file's CDF and coefficients
     // disagree near the normal, which the chi-square here cannot allow for.
     fitted(
         "fourier",
@@ -242,7 +242,7 @@ fn every_supported_material_has_a_case() {
         }
         assert!(
             CASES.iter().any(|c| c.kind == k.name),
-            "material \"{}\" is supported but has no case in tests/bsdf_table.rs",
+            "material \"{}\" is supported but has no case in tests/materials_table.rs",
             k.name
         );
     }

@@ -350,7 +350,7 @@ fn every_light_type_has_a_case() {
     for n in names {
         assert!(
             CASES.iter().any(|c| c.ty == n),
-            "light type \"{n}\" is in the tables but has no case in tests/light_table.rs"
+            "light type \"{n}\" is in the tables but has no case in tests/lights_table.rs"
         );
     }
     for c in CASES {

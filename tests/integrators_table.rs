@@ -82,7 +82,7 @@ fn every_supported_kind_has_a_case_that_renders() {
         let case = CASES.iter().find(|c| c.kind == k.name);
         let Some(case) = case else {
             panic!(
-                "integrator \"{}\" has no case in tests/integrator_table.rs",
+                "integrator \"{}\" has no case in tests/integrators_table.rs",
                 k.name
             );
         };
