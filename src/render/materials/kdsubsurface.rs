@@ -18,29 +18,27 @@
 //!
 //! The boundary is `glass`'s BSDF with `eta`, as for `subsurface`.
 
-use super::subsurface::Boundary;
+use super::subsurface::{Boundary, BOUNDARY_PARAMS};
 use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::render::bssrdf::subsurface_from_diffuse;
 use crate::scene::{ParamSpec, ParamValues, SpectrumTex};
 use glam::Vec3;
 use std::sync::Arc;
 
+const B: [ParamSpec; 7] = BOUNDARY_PARAMS;
+
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::spectrum("Kd", 0.5, "effective diffuse albedo"),
     ParamSpec::spectrum("mfp", 1.0, "mean free path (times scale)"),
     ParamSpec::float("scale", 1.0, "multiplies mfp"),
     ParamSpec::float("g", 0.0, "Henyey–Greenstein asymmetry"),
-    ParamSpec::float("eta", 1.33, "index of refraction"),
-    ParamSpec::spectrum("Kr", 1.0, "reflection scale"),
-    ParamSpec::spectrum("Kt", 1.0, "transmission scale"),
-    ParamSpec::nonneg_tex("uroughness", 0.0, "roughness along dp/du (0: smooth)"),
-    ParamSpec::nonneg_tex("vroughness", 0.0, "roughness along dp/dv (0: smooth)"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
-    ParamSpec::BUMPMAP,
+    B[0],
+    B[1],
+    B[2],
+    B[3],
+    B[4],
+    B[5],
+    B[6],
 ];
 
 /// The entry of [`super::MATERIALS`].

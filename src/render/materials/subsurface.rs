@@ -38,6 +38,8 @@ use std::sync::Arc;
 pub const DEFAULT_SIGMA_A: [f32; 3] = [0.0011, 0.0024, 0.014];
 pub const DEFAULT_SIGMA_S: [f32; 3] = [2.55, 3.21, 3.77];
 
+const B: [ParamSpec; 7] = BOUNDARY_PARAMS;
+
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::string(
         "name",
@@ -54,6 +56,18 @@ pub const PARAMS: &[ParamSpec] = &[
     ),
     ParamSpec::float("scale", 1.0, "multiplies sigma_a and sigma_s"),
     ParamSpec::float("g", 0.0, "Henyey–Greenstein asymmetry (0 with a name)"),
+    B[0],
+    B[1],
+    B[2],
+    B[3],
+    B[4],
+    B[5],
+    B[6],
+];
+
+/// The parameters of the dielectric boundary both subsurface materials
+/// read ([`Boundary`]), after their own.
+pub const BOUNDARY_PARAMS: [ParamSpec; 7] = [
     ParamSpec::float("eta", 1.33, "index of refraction"),
     ParamSpec::spectrum("Kr", 1.0, "reflection scale"),
     ParamSpec::spectrum("Kt", 1.0, "transmission scale"),
