@@ -140,11 +140,12 @@ impl LightModel for DiffuseLight {
         }
     }
 
+    #[inline]
     fn contribution(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
         let AreaShape::Triangle { mesh, tri: t } = self.shape else {
             return contribution_by_sampling(self, p, u, geom);
         };
-        let tri = self.tri;
+        let tri = &self.tri;
         let (b, q, _) = sample_triangle_point(tri.p, u);
         let d = q - p;
         let dist2 = d.length_squared();
