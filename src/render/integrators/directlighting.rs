@@ -92,7 +92,7 @@ impl DirectLightingSettings {
             max_depth,
             strategy,
         } = self;
-        format!("{}, maxdepth {max_depth}, strategy {strategy:?}", KIND.name).to_lowercase()
+        format!("maxdepth {max_depth}, strategy {strategy:?}").to_lowercase()
     }
 }
 

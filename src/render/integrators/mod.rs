@@ -186,11 +186,12 @@ macro_rules! integrators {
                 }
             }
 
-            /// The settings in a line, for `--check` and `--stats`.
+            /// The kind and its settings in a line, for `--check` and `--stats`.
             pub fn summary(&self) -> String {
-                match self {
+                let settings = match self {
                     $(IntegratorSettings::$variant(s) => s.summary(),)*
-                }
+                };
+                format!("{}, {settings}", self.name())
             }
 
             /// True if it renders participating media.

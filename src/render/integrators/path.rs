@@ -49,14 +49,14 @@ pub const KIND: IntegratorKind = IntegratorKind {
 pub const RENDERS_MEDIA: bool = false;
 pub const SAMPLES_SUBSURFACE: bool = true;
 
-/// `lightsamplestrategy`, read by `path` and `volpath`.
-pub(super) const LIGHT_SAMPLE_STRATEGY: ParamSpec = ParamSpec::string(
+/// `lightsamplestrategy`.
+const LIGHT_SAMPLE_STRATEGY: ParamSpec = ParamSpec::string(
     "lightsamplestrategy",
     "spatial",
     "how a vertex chooses the light to sample: `uniform`, `power`, `spatial` (pbrt-v3's voxel distribution) or `bvh` (a pbrs extension: pbrt-v4's light BVH)",
 );
 
-/// `path`'s settings.
+/// `path`'s settings (and `volpath`'s).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathSettings {
     pub max_depth: u32,
@@ -90,13 +90,13 @@ impl PathSettings {
             rr_threshold,
             light_sample_strategy,
         } = self;
-        format!("{}, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}", KIND.name).to_lowercase()
+        format!("maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}").to_lowercase()
     }
 }
 
 /// `lightsamplestrategy`: an unknown one is a warning, and `spatial` is
 /// used (as pbrt-v3).
-pub(super) fn light_sample_strategy(p: &ParamValues, r: &mut dyn Report) -> LightSampleStrategy {
+fn light_sample_strategy(p: &ParamValues, r: &mut dyn Report) -> LightSampleStrategy {
     match p.string("lightsamplestrategy") {
         "spatial" => LightSampleStrategy::Spatial,
         "uniform" => LightSampleStrategy::Uniform,

@@ -30,10 +30,8 @@
 use super::common::{
     add_escaped_mis, choose_light, emitted_mis, eta_scale_change, roulette, shade, LightSampleFirst,
 };
-use super::path::{light_sample_strategy, LIGHT_SAMPLE_STRATEGY};
 use super::subsurface::{sample_exit, subsurface_exit};
 use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
-use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::render::accel::{Hit, SurfaceHit};
 use crate::render::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
 use crate::render::lights::LightSampler;
@@ -43,20 +41,12 @@ use crate::render::samplers::Sampler;
 use crate::render::sampling::power_heuristic;
 use crate::render::scene::RenderScene;
 use crate::render::shapes::SurfacePoint;
-use crate::scene::kind::{Report, Support};
-use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
+use crate::scene::kind::Support;
+use crate::scene::ParamSpec;
 use glam::Vec3;
 
-pub const PARAMS: &[ParamSpec] = &[
-    MAX_DEPTH,
-    ParamSpec::float(
-        "rrthreshold",
-        1.0,
-        "Russian roulette once max(β·etaScale) is below it (after bounce 3)",
-    ),
-    LIGHT_SAMPLE_STRATEGY,
-    PIXEL_BOUNDS,
-];
+/// The same parameters as `path`.
+pub const PARAMS: &[ParamSpec] = super::path::PARAMS;
 
 pub const KIND: IntegratorKind = IntegratorKind {
     name: "volpath",
@@ -71,43 +61,8 @@ pub const KIND: IntegratorKind = IntegratorKind {
 pub const RENDERS_MEDIA: bool = true;
 pub const SAMPLES_SUBSURFACE: bool = true;
 
-/// `volpath`'s settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct VolPathSettings {
-    pub max_depth: u32,
-    pub rr_threshold: f32,
-    pub light_sample_strategy: LightSampleStrategy,
-}
-
-impl Default for VolPathSettings {
-    fn default() -> VolPathSettings {
-        VolPathSettings {
-            max_depth: 5,
-            rr_threshold: 1.0,
-            light_sample_strategy: LightSampleStrategy::Spatial,
-        }
-    }
-}
-
-impl VolPathSettings {
-    /// The settings of a statement's parameters, checked as pbrt-v3 does.
-    pub fn read(p: &ParamValues, r: &mut dyn Report) -> VolPathSettings {
-        VolPathSettings {
-            max_depth: super::max_depth(p, r),
-            rr_threshold: p.float("rrthreshold"),
-            light_sample_strategy: light_sample_strategy(p, r),
-        }
-    }
-
-    pub fn summary(&self) -> String {
-        let VolPathSettings {
-            max_depth,
-            rr_threshold,
-            light_sample_strategy,
-        } = self;
-        format!("{}, maxdepth {max_depth}, rrthreshold {rr_threshold}, light samples {light_sample_strategy:?}", KIND.name).to_lowercase()
-    }
-}
+/// `volpath`'s settings: `path`'s.
+pub type VolPathSettings = super::path::PathSettings;
 
 /// What scatters at a path vertex.
 #[derive(Clone, Copy)]

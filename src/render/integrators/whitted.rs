@@ -52,7 +52,7 @@ impl WhittedSettings {
     }
 
     pub fn summary(&self) -> String {
-        format!("{}, maxdepth {}", KIND.name, self.max_depth)
+        format!("maxdepth {}", self.max_depth)
     }
 }
 
