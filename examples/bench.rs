@@ -30,9 +30,9 @@
 
 use pbrs::loader::load_scene;
 use pbrs::render::driver::{peak_memory_bytes, render, RenderOptions};
-use pbrs::render::film::compare::compare;
-use pbrs::render::film::io::read_image;
-use pbrs::render::film::Image;
+use pbrs::image::compare::compare;
+use pbrs::image::io::read_image;
+use pbrs::image::Image;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;

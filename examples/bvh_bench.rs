@@ -8,10 +8,10 @@
 //! memory (VmHWM) is per case.
 
 use glam::{DMat4, DVec3, Vec3};
-use pbrs::render::accel::{Geometry, Instance, Object};
+use pbrs::accel::{Geometry, Instance, Object};
 use pbrs::render::driver::peak_memory_bytes;
-use pbrs::render::geometry::Ray;
-use pbrs::render::shapes::TriangleMesh;
+use pbrs::geometry::Ray;
+use pbrs::shapes::TriangleMesh;
 use std::process::Command;
 use std::sync::Arc;
 use std::time::Instant;

@@ -5,8 +5,8 @@
 //! cargo run --release --example bvh_build [-- N...]
 
 use glam::Vec3;
-use pbrs::render::accel::Geometry;
-use pbrs::render::shapes::TriangleMesh;
+use pbrs::accel::Geometry;
+use pbrs::shapes::TriangleMesh;
 use std::time::Instant;
 
 fn mesh(p: Vec<Vec3>, indices: Vec<u32>) -> TriangleMesh {

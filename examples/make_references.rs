@@ -11,7 +11,7 @@ mod golden;
 use golden::{manifest, Check, PBRS_REFERENCE_RES, PBRS_REFERENCE_SPP};
 use pbrs::loader::load_scene;
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::render::film::io::write_image;
+use pbrs::image::io::write_image;
 use std::path::Path;
 
 fn main() {

@@ -13,8 +13,8 @@
 
 use pbrs::loader::load_scene_str;
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::render::film::compare::compare;
-use pbrs::render::film::Image;
+use pbrs::image::compare::compare;
+use pbrs::image::Image;
 use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;

@@ -9,10 +9,10 @@
 
 use glam::Vec3;
 use pbrs::loader::load_scene;
-use pbrs::render::accel::{Geometry, Hit};
-use pbrs::render::geometry::{spawn_ray, spawn_ray_to_point, Ray};
-use pbrs::render::sampling::rng::Pcg32;
-use pbrs::render::scene::RenderScene;
+use pbrs::accel::{Geometry, Hit};
+use pbrs::geometry::{spawn_ray, spawn_ray_to_point, Ray};
+use pbrs::sampling::rng::Pcg32;
+use pbrs::integrators::RenderScene;
 use std::path::Path;
 use std::time::Instant;
 

@@ -11,3 +11,21 @@ pub mod lang;
 pub mod loader;
 pub mod render;
 pub mod scene;
+
+// The render core's primitives and pluggable families: the scene description
+// holds what their kinds build, and `render` drives them.
+pub mod accel;
+pub mod bssrdf;
+pub mod bxdf;
+pub mod cameras;
+pub mod filters;
+pub mod geometry;
+pub mod image;
+pub mod integrators;
+pub mod lights;
+pub mod materials;
+pub mod media;
+pub mod samplers;
+pub mod sampling;
+pub mod shapes;
+pub mod textures;

@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use pbrs::render::scene::RenderScene;
+use pbrs::integrators::RenderScene;
 
 fn coincident_scene(n: usize, extra: &str) -> String {
     let idx = "0 1 2 ".repeat(n);

@@ -5,12 +5,12 @@
 //! 1, that it does so as much as its formulas say.
 
 use glam::{DVec3, Vec2, Vec3};
-use pbrs::render::bxdf::{
+use pbrs::bxdf::{
     gtr1, Bxdf, BxdfFlags, BxdfModel, DisneyClearcoat, DisneyDiffuse, DisneyFakeSS, DisneyRetro,
     DisneySheen,
 };
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Polar angles of wo (degrees); 135 is below the surface (the lobes are

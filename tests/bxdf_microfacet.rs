@@ -7,12 +7,12 @@
 //! white furnace of the rough conductor.
 
 use glam::{DVec3, Vec2, Vec3};
-use pbrs::render::bxdf::{
+use pbrs::bxdf::{
     Beckmann, Bxdf, BxdfModel, Fresnel, FresnelBlend, MicrofacetDistribution, MicrofacetModel,
     MicrofacetReflection, MicrofacetTransmission, TrowbridgeReitz,
 };
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
 use std::f64::consts::{PI, TAU};
 
 /// Distribution settings: kind, αx, αy, visible-normal sampling.
@@ -480,11 +480,11 @@ fn reflection_lobes_are_reciprocal() {
         for b in &lobes {
             let mut nonzero = 0;
             for _ in 0..5000 {
-                let wo = pbrs::render::sampling::uniform_sample_hemisphere(Vec2::new(
+                let wo = pbrs::sampling::uniform_sample_hemisphere(Vec2::new(
                     rng.uniform_f32(),
                     rng.uniform_f32(),
                 ));
-                let wi = pbrs::render::sampling::uniform_sample_hemisphere(Vec2::new(
+                let wi = pbrs::sampling::uniform_sample_hemisphere(Vec2::new(
                     rng.uniform_f32(),
                     rng.uniform_f32(),
                 ));
@@ -514,7 +514,7 @@ fn transmission_is_reciprocal_up_to_the_radiance_factor() {
         let b = transmission(d);
         let mut checked = 0;
         for _ in 0..5000 {
-            let wo = pbrs::render::sampling::uniform_sample_sphere(Vec2::new(
+            let wo = pbrs::sampling::uniform_sample_sphere(Vec2::new(
                 rng.uniform_f32(),
                 rng.uniform_f32(),
             ));

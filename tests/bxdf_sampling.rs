@@ -6,14 +6,14 @@
 //! equations written out independently here (in f64).
 
 use glam::{Vec2, Vec3};
-use pbrs::render::geometry::Frame;
+use pbrs::geometry::Frame;
 mod common;
 
 use common::material_bsdf;
-use pbrs::render::bxdf::{Bxdf, FresnelSpecular};
-use pbrs::render::materials::{Bsdf, BxdfFlags};
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
+use pbrs::bxdf::{Bxdf, FresnelSpecular};
+use pbrs::materials::{Bsdf, BxdfFlags};
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
 
 /// Incident directions: polar angles (degrees) of wo, above the surface,
 /// plus one from below (both-sided matte surfaces shade either side).

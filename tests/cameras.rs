@@ -10,10 +10,10 @@ use common::repo;
 use glam::{Vec2, Vec3};
 use pbrs::lang::parser::FileLoader;
 use pbrs::loader::{load_scene_str, load_scene_with, LoadFailure, LoadedScene};
-use pbrs::render::camera::realistic::LensRay;
-use pbrs::render::camera::{Camera, Projection, RealisticCamera};
-use pbrs::render::geometry::Ray;
-use pbrs::render::samplers::CameraSample;
+use pbrs::cameras::realistic::LensRay;
+use pbrs::cameras::{Camera, Projection, RealisticCamera};
+use pbrs::geometry::Ray;
+use pbrs::samplers::CameraSample;
 use pbrs::scene::SceneDescription;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -589,14 +589,14 @@ fn bad_thin_lens_parameters() {
     );
 }
 
-/// Every kind of `render::camera::CAMERAS`, loaded from a statement: the
+/// Every kind of `cameras::CAMERAS`, loaded from a statement: the
 /// centre of the film looks where pbrt-v3's camera of that kind looks (the
 /// projective and realistic cameras along +z, the environment camera along
 /// −x), with a positive weight, and `--check` names the kind. A kind of the
 /// table without a case here fails.
 #[test]
 fn every_camera_kind_loads_and_looks_where_pbrt_v3s_does() {
-    use pbrs::render::camera::CAMERAS;
+    use pbrs::cameras::CAMERAS;
     let cases: &[(&str, &str, Vec3)] = &[
         ("perspective", "\"float fov\" 30", Vec3::Z),
         ("orthographic", "", Vec3::Z),

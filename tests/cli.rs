@@ -3,8 +3,8 @@
 //! the tev live view, partial images and exit codes. Every test runs the
 //! built binary at a tiny resolution.
 
-use pbrs::render::film::io::read_pfm;
-use pbrs::render::film::Image;
+use pbrs::image::io::read_pfm;
+use pbrs::image::Image;
 use std::io::{Read, Write};
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
@@ -935,7 +935,7 @@ fn partial_images_are_written_whole_while_rendering() {
     let mut seen = 0;
     let final_status = loop {
         if let Ok(b) = std::fs::read(&o) {
-            let img = pbrs::render::film::io::parse_pfm(&b).expect("a half-written image");
+            let img = pbrs::image::io::parse_pfm(&b).expect("a half-written image");
             assert_eq!((img.width, img.height), (256, 192));
             seen += 1;
         }

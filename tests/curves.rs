@@ -8,10 +8,10 @@ mod common;
 use common::*;
 use glam::Vec3;
 use pbrs::loader::load_scene_str;
-use pbrs::render::geometry::Ray;
-use pbrs::render::sampling::Pcg32;
-use pbrs::render::scene::RenderScene;
-use pbrs::render::shapes::{DiffGeom, SurfacePoint};
+use pbrs::geometry::Ray;
+use pbrs::sampling::Pcg32;
+use pbrs::integrators::RenderScene;
+use pbrs::shapes::{DiffGeom, SurfacePoint};
 
 fn load_text(text: &str) -> Result<pbrs::loader::LoadedScene, pbrs::loader::LoadFailure> {
     load_scene_str(text, &repo().join("scenes/curve-test.pbrt"))

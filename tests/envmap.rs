@@ -9,7 +9,7 @@ use glam::Vec3;
 use pbrs::lang::FileLoader;
 use pbrs::loader::{load_scene_with, LoadFailure, LoadedScene};
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::render::film::Image;
+use pbrs::image::Image;
 use pbrs::scene::{Light, SceneDescription};
 use std::collections::HashMap;
 use std::io::Cursor;

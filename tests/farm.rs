@@ -7,10 +7,10 @@ mod common;
 
 use glam::Vec2;
 use pbrs::render::driver::{render, render_part, RenderOptions};
-use pbrs::render::film::io::write_image;
+use pbrs::image::io::write_image;
 use pbrs::render::film::part::{merge, read_part, tile_rect, Part, PartKind};
-use pbrs::render::film::Image;
-use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
+use pbrs::image::Image;
+use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
 use pbrs::scene::SceneDescription;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -136,7 +136,7 @@ fn tiles_merge_to_the_full_render_byte_for_byte_for_every_filter() {
             assert!(got == want, "{name}, {n} tiles: merged EXR differs");
             // The parts really are the rows of the split.
             let frame =
-                pbrs::render::geometry::Bounds2i::new(glam::IVec2::ZERO, glam::IVec2::new(40, 30));
+                pbrs::geometry::Bounds2i::new(glam::IVec2::ZERO, glam::IVec2::new(40, 30));
             for (k, p) in parts.iter().enumerate() {
                 assert_eq!(p.window, tile_rect(frame, k as u32, n));
             }
@@ -183,7 +183,7 @@ fn a_tile_takes_fewer_samples_than_the_full_render() {
     // Box filter, radius 0.5: the tile's rows plus the margin (one pixel
     // each way), not the whole frame.
     let rows = tile_rect(
-        pbrs::render::geometry::Bounds2i::new(glam::IVec2::ZERO, glam::IVec2::new(40, 30)),
+        pbrs::geometry::Bounds2i::new(glam::IVec2::ZERO, glam::IVec2::new(40, 30)),
         3,
         8,
     )

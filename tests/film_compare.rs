@@ -1,10 +1,10 @@
 //! The comparison metrics against the figures of scenes/references/README.md.
 
-use pbrs::render::film::compare::{
+use pbrs::image::compare::{
     block_error, compare, false_colour_difference, mean_rgb, relative_mse, rmse,
 };
-use pbrs::render::film::io::read_pfm;
-use pbrs::render::film::Image;
+use pbrs::image::io::read_pfm;
+use pbrs::image::Image;
 use std::path::PathBuf;
 
 fn reference(name: &str) -> PathBuf {

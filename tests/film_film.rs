@@ -2,9 +2,9 @@
 
 use glam::{IVec2, Vec2, Vec3};
 use pbrs::render::film::{luminance, Film, FILTER_TABLE_WIDTH};
-use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
-use pbrs::render::geometry::Bounds2i;
-use pbrs::render::sampling::Pcg32;
+use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
+use pbrs::geometry::Bounds2i;
+use pbrs::sampling::Pcg32;
 use pbrs::scene::FilmDesc;
 use rayon::prelude::*;
 

@@ -1,9 +1,9 @@
 //! Image files: round trips, PFM layout, atomic writes.
 
-use pbrs::render::film::io::{
+use pbrs::image::io::{
     check_output_path, parse_pfm, read_exr, read_image, read_pfm, read_png, to_8bit, write_image,
 };
-use pbrs::render::film::Image;
+use pbrs::image::Image;
 use std::fs;
 use std::path::{Path, PathBuf};
 

@@ -2,9 +2,10 @@
 //! parallel with one sampler clone each, merged in order.
 
 use glam::{Vec2, Vec3};
-use pbrs::render::film::{Film, Image};
-use pbrs::render::filters::{BoxFilter, Filter, Gaussian};
-use pbrs::render::samplers::Sampler;
+use pbrs::image::Image;
+use pbrs::render::film::Film;
+use pbrs::filters::{BoxFilter, Filter, Gaussian};
+use pbrs::samplers::Sampler;
 use pbrs::scene::{FilmDesc, SamplerDesc, SamplerKind};
 use rayon::prelude::*;
 

@@ -1,11 +1,11 @@
-//! Every kind of `render::filters::FILTERS`, loaded from a scene statement
+//! Every kind of `filters::FILTERS`, loaded from a scene statement
 //! with its default widths and with given ones, evaluated against pbrt-v3's
 //! formula written out here independently (src/filters/*.cpp). A kind of the
 //! table without a case here fails.
 
 use glam::Vec2;
 use pbrs::loader::load_scene_str;
-use pbrs::render::filters::{Filter, FILTERS};
+use pbrs::filters::{Filter, FILTERS};
 use std::path::Path;
 
 /// pbrt-v3's filter formulas in f64: the value at `p` for radius `r`.

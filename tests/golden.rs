@@ -13,8 +13,8 @@ mod golden;
 
 use common::*;
 use golden::{manifest, Check, PBRS_REFERENCE_SPP};
-use pbrs::render::film::compare::compare;
-use pbrs::render::film::io::read_image;
+use pbrs::image::compare::compare;
+use pbrs::image::io::read_image;
 
 fn walk(dir: &std::path::Path, out: &mut Vec<String>) {
     for e in std::fs::read_dir(dir).unwrap() {
@@ -71,9 +71,9 @@ fn every_scene_has_a_golden_entry() {
 /// reference (128×128 for most scenes).
 fn render_golden(
     scene: &str,
-    reference: &pbrs::render::film::Image,
+    reference: &pbrs::image::Image,
     seed: u64,
-) -> (pbrs::render::film::Image, pbrs::render::driver::RenderStats) {
+) -> (pbrs::image::Image, pbrs::render::driver::RenderStats) {
     render_seeded_wh(load(scene), reference.width, reference.height, 64, seed)
 }
 

@@ -26,7 +26,7 @@
 
 mod common;
 use common::*;
-use pbrs::render::film::Image;
+use pbrs::image::Image;
 use pbrs::scene::{DirectStrategy, IntegratorSettings, LightSampleStrategy, SceneDescription};
 
 fn direct(strategy: DirectStrategy) -> IntegratorSettings {
@@ -171,8 +171,8 @@ fn rays_with_negative_zero_direction_components_hit() {
     // reflections -0.0: these missed the sphere in the BVH (obvhs picks slab
     // planes by `d < 0.0`, false for -0.0, while the reciprocal was -1e30).
     use glam::Vec3;
-    use pbrs::render::geometry::Ray;
-    let sc = pbrs::render::scene::RenderScene::new(&load(MIRROR));
+    use pbrs::geometry::Ray;
+    let sc = pbrs::integrators::RenderScene::new(&load(MIRROR));
     for d in [
         Vec3::new(-0.0, 0.590_631, -0.806_942),
         Vec3::new(0.0, 0.590_631, -0.806_942),

@@ -4,7 +4,7 @@
 
 mod common;
 use common::*;
-use pbrs::render::film::compare::block_error;
+use pbrs::image::compare::block_error;
 use pbrs::scene::{DirectStrategy, IntegratorSettings, LightSampleStrategy};
 
 const STEM: &str = "cornell-direct";

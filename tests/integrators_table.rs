@@ -9,7 +9,7 @@
 mod common;
 
 use common::{load_text, render_at, warning_text};
-use pbrs::render::integrators::INTEGRATORS;
+use pbrs::integrators::INTEGRATORS;
 
 /// A kind and the parameters of its `Integrator` statement.
 struct Case {

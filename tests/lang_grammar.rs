@@ -183,7 +183,7 @@ fn reference_documents_every_directive_and_type() {
 }
 
 /// The material section of REFERENCE.md is what the generator writes from
-/// `render::materials::MATERIALS`; with `PBRS_WRITE_REFERENCE=1` the test
+/// `materials::MATERIALS`; with `PBRS_WRITE_REFERENCE=1` the test
 /// rewrites it instead (then review and commit the diff).
 #[test]
 fn reference_material_section_is_generated_from_the_table() {
@@ -215,7 +215,7 @@ fn reference_material_section_is_generated_from_the_table() {
     }
     // What the section must say, read from the table itself (so that a
     // generator that dropped rows would fail here too).
-    for k in pbrs::render::materials::MATERIALS {
+    for k in pbrs::materials::MATERIALS {
         assert!(section.contains(&format!("`{}`", k.name)), "{}", k.name);
         for p in k.params {
             let (ty, default) = pbrs::loader::reference::describe(p);
@@ -226,7 +226,7 @@ fn reference_material_section_is_generated_from_the_table() {
 }
 
 /// The integrators section of REFERENCE.md is what the generator writes
-/// from `render::integrators::INTEGRATORS` (`PBRS_WRITE_REFERENCE=1`
+/// from `integrators::INTEGRATORS` (`PBRS_WRITE_REFERENCE=1`
 /// rewrites it).
 #[test]
 fn reference_integrators_section_is_generated_from_the_table() {
@@ -253,7 +253,7 @@ fn reference_integrators_section_is_generated_from_the_table() {
         "grammar/REFERENCE.md's integrators section differs from the integrator table; regenerate it with \
          `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` and commit the diff"
     );
-    for k in pbrs::render::integrators::INTEGRATORS {
+    for k in pbrs::integrators::INTEGRATORS {
         assert!(section.contains(&format!("`{}`", k.name)), "{}", k.name);
         for p in k.params.iter().filter(|_| k.is_supported()) {
             assert!(section.contains(&format!("| `{}` |", p.name)), "{}", p.name);
@@ -262,7 +262,7 @@ fn reference_integrators_section_is_generated_from_the_table() {
 }
 
 /// The media section of REFERENCE.md is what the generator writes from
-/// `render::media::MEDIA` (`PBRS_WRITE_REFERENCE=1` rewrites it).
+/// `media::MEDIA` (`PBRS_WRITE_REFERENCE=1` rewrites it).
 #[test]
 fn reference_media_section_is_generated_from_the_table() {
     let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
@@ -284,7 +284,7 @@ fn reference_media_section_is_generated_from_the_table() {
         "grammar/REFERENCE.md's media section differs from the media table; regenerate it with \
          `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` and commit the diff"
     );
-    for k in pbrs::render::media::MEDIA {
+    for k in pbrs::media::MEDIA {
         assert!(section.contains(&format!("### `{}`", k.name)), "{}", k.name);
         for p in k.params {
             assert!(
@@ -317,28 +317,28 @@ fn reference_family_sections_are_generated_from_the_tables() {
     }
     let sections: Vec<Section> = vec![
         (
-            "render::filters::FILTERS",
+            "filters::FILTERS",
             "filters",
             pbrs::loader::reference::filters_section,
-            rows(pbrs::render::filters::FILTERS),
+            rows(pbrs::filters::FILTERS),
         ),
         (
-            "render::samplers::SAMPLERS",
+            "samplers::SAMPLERS",
             "samplers",
             pbrs::loader::reference::samplers_section,
-            rows(pbrs::render::samplers::SAMPLERS),
+            rows(pbrs::samplers::SAMPLERS),
         ),
         (
-            "render::camera::CAMERAS",
+            "cameras::CAMERAS",
             "cameras",
             pbrs::loader::reference::cameras_section,
-            rows(pbrs::render::camera::CAMERAS),
+            rows(pbrs::cameras::CAMERAS),
         ),
         (
-            "render::shapes::SHAPES",
+            "shapes::SHAPES",
             "shapes",
             pbrs::loader::reference::shapes_section,
-            rows(pbrs::render::shapes::SHAPES),
+            rows(pbrs::shapes::SHAPES),
         ),
     ];
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
@@ -374,13 +374,13 @@ fn reference_family_sections_are_generated_from_the_tables() {
 }
 
 /// The lights section of REFERENCE.md is what the generator writes from
-/// `render::lights::LIGHTS` and `AREA_LIGHTS` (`PBRS_WRITE_REFERENCE=1`
+/// `lights::LIGHTS` and `AREA_LIGHTS` (`PBRS_WRITE_REFERENCE=1`
 /// rewrites it).
 #[test]
 fn reference_lights_section_is_generated_from_the_tables() {
     let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use pbrs::loader::reference::{lights_section, splice_between, LIGHTS_BEGIN, LIGHTS_END};
-    use pbrs::render::lights::{AREA_LIGHTS, LIGHTS};
+    use pbrs::lights::{AREA_LIGHTS, LIGHTS};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let doc = std::fs::read_to_string(&path).unwrap();
     let section = lights_section();

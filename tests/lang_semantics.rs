@@ -5,9 +5,9 @@ mod common;
 use common::{error_text as errors, load_text as load, warning_text as warnings};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
-use pbrs::render::camera::Projection;
-use pbrs::render::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
-use pbrs::render::shapes::Quadric;
+use pbrs::cameras::Projection;
+use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
+use pbrs::shapes::Quadric;
 use pbrs::scene::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -756,7 +756,7 @@ fn unused_material_parameters_say_what_was_meant() {
 
 #[test]
 fn summary_counts_declared_material_kinds() {
-    use pbrs::render::materials::{kind, Support};
+    use pbrs::materials::{kind, Support};
     // The hair's substitute has matte's default Kd, so it equals the
     // matte; it is still counted under its own kind.
     let s = load("WorldBegin\nMaterial \"matte\"\nShape \"sphere\"\nMaterial \"glass\"\nShape \"sphere\"\nMaterial \"hair\"\nShape \"sphere\"\nMaterial \"BUSH1\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\nWorldEnd");

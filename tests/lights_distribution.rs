@@ -15,10 +15,10 @@
 mod common;
 use common::*;
 use glam::{Vec2, Vec3};
-use pbrs::render::lights::{AreaShape, DiffuseLight, Light, LightSampler, LightSamplerKind};
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::scene::RenderScene;
-use pbrs::render::shapes::SurfacePoint;
+use pbrs::lights::{AreaShape, DiffuseLight, Light, LightSampler, LightSamplerKind};
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::integrators::RenderScene;
+use pbrs::shapes::SurfacePoint;
 use std::f64::consts::PI;
 
 fn scene(rel: &str) -> RenderScene {

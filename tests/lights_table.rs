@@ -17,11 +17,11 @@ mod common;
 use common::{load_text, warning_text};
 use glam::{Vec2, Vec3};
 use pbrs::loader::LoadedScene;
-use pbrs::render::geometry::luminance;
-use pbrs::render::lights::{Light, AREA_LIGHTS, LIGHTS};
-use pbrs::render::sampling::Pcg32;
-use pbrs::render::scene::RenderScene;
-use pbrs::render::shapes::SurfacePoint;
+use pbrs::geometry::luminance;
+use pbrs::lights::{Light, AREA_LIGHTS, LIGHTS};
+use pbrs::sampling::Pcg32;
+use pbrs::integrators::RenderScene;
+use pbrs::shapes::SurfacePoint;
 use pbrs::scene::kind;
 use std::f32::consts::PI;
 
@@ -269,7 +269,7 @@ fn at(p: Vec3) -> SurfacePoint {
     }
 }
 
-fn sample(sc: &RenderScene, p: Vec3) -> pbrs::render::lights::LightSample {
+fn sample(sc: &RenderScene, p: Vec3) -> pbrs::lights::LightSample {
     sc.lights[0]
         .sample_li(&at(p), Vec2::new(0.3, 0.6), &sc.geometry)
         .expect("a sample")

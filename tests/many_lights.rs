@@ -5,10 +5,10 @@
 mod common;
 
 use common::*;
-use pbrs::render::film::compare::compare;
-use pbrs::render::lights::{LightSampler, LightSamplerKind};
-use pbrs::render::sampling::Pcg32;
-use pbrs::render::scene::RenderScene;
+use pbrs::image::compare::compare;
+use pbrs::lights::{LightSampler, LightSamplerKind};
+use pbrs::sampling::Pcg32;
+use pbrs::integrators::RenderScene;
 use pbrs::scene::{IntegratorSettings, LightSampleStrategy};
 
 /// `n` small downward-facing emissive triangles scattered over a floor
@@ -201,7 +201,7 @@ fn every_strategy_gives_the_same_image() {
 /// Past `SPATIAL_MAX_LIGHTS` lights, "spatial" chooses by the BVH and says so.
 #[test]
 fn spatial_falls_back_to_the_bvh_past_the_light_limit() {
-    let n = pbrs::render::lights::SPATIAL_MAX_LIGHTS + 1;
+    let n = pbrs::lights::SPATIAL_MAX_LIGHTS + 1;
     let l = load_text(&many_lights_scene(n, 4, 1, "spatial", ""));
     let scene = RenderScene::new(&l.scene);
     let ls = LightSampler::new(LightSamplerKind::Spatial, &scene.lights, &scene.geometry);

@@ -10,10 +10,10 @@ mod common;
 
 use common::material_bsdf;
 use glam::{Vec2, Vec3};
-use pbrs::render::bxdf::{Bxdf, BxdfModel, MicrofacetDistribution, MicrofacetModel, MAX_BXDFS};
-use pbrs::render::materials::{Bsdf, BxdfFlags};
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
+use pbrs::bxdf::{Bxdf, BxdfModel, MicrofacetDistribution, MicrofacetModel, MAX_BXDFS};
+use pbrs::materials::{Bsdf, BxdfFlags};
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
 use std::path::Path;
 
 /// Polar angles of wo (degrees); 135 is inside (below the surface).

@@ -14,10 +14,10 @@ use glam::{Vec2, Vec3};
 use pbrs::lang::FileLoader;
 use pbrs::loader::fourier::read_bsdf;
 use pbrs::loader::{load_scene, load_scene_with};
-use pbrs::render::bxdf::{BxdfModel, FourierBsdf};
-use pbrs::render::materials::{Bsdf, BxdfFlags, Material};
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
+use pbrs::bxdf::{BxdfModel, FourierBsdf};
+use pbrs::materials::{Bsdf, BxdfFlags, Material};
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
 use pbrs::scene::{FourierTable, ParamValue};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -557,7 +557,7 @@ fn sampling_matches_pdf_chi2() {
 /// pbrs keeps pbrt-v3's normalisation: the integral follows that ratio.
 #[test]
 fn rough_glass_pdf_uses_the_files_cdf() {
-    use pbrs::render::sampling::interpolation::catmull_rom_weights;
+    use pbrs::sampling::interpolation::catmull_rom_weights;
     let t = table("roughglass_alpha_0.2.bsdf");
     let b = FourierBsdf::new(&t);
     let n_mu = t.n_mu();
@@ -797,7 +797,7 @@ fn renders_without_nan_or_negative_samples() {
         });
         d
     };
-    let mean = |img: &pbrs::render::film::Image| {
+    let mean = |img: &pbrs::image::Image| {
         img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len() as f64
     };
     for (what, d) in [("path", desc), ("directlighting", direct)] {

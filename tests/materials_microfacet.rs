@@ -8,10 +8,10 @@ mod common;
 
 use common::{material_bsdf, materials_of};
 use glam::Vec3;
-use pbrs::render::bxdf::{
+use pbrs::bxdf::{
     roughness_to_alpha, Bxdf, Fresnel, MicrofacetDistribution, TrowbridgeReitz, MAX_BXDFS,
 };
-use pbrs::render::materials::{Bsdf, BxdfFlags, MATERIALS};
+use pbrs::materials::{Bsdf, BxdfFlags, MATERIALS};
 
 fn close(a: Vec3, b: Vec3) -> bool {
     (a - b).abs().max_element() < 1e-5

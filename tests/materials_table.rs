@@ -20,10 +20,10 @@ mod common;
 
 use common::material_bsdf;
 use glam::{Vec2, Vec3};
-use pbrs::render::bxdf::{Bxdf, BxdfModel};
-use pbrs::render::materials::{Bsdf, BxdfFlags, Support, MATERIALS};
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
+use pbrs::bxdf::{Bxdf, BxdfModel};
+use pbrs::materials::{Bsdf, BxdfFlags, Support, MATERIALS};
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
 
 struct Case {
     kind: &'static str,

@@ -10,13 +10,13 @@ use common::{error_text as errors, load_text as load, warning_text as warnings};
 
 use glam::{DMat4, Vec2, Vec3};
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::render::film::compare::compare;
-use pbrs::render::film::Image;
-use pbrs::render::geometry::{Bounds2i, Ray};
-use pbrs::render::media::{phase_hg, HenyeyGreenstein, Medium, MEDIA};
-use pbrs::render::media::{Coefficients, Density, Grid, Homogeneous};
-use pbrs::render::samplers::Sampler;
-use pbrs::render::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
+use pbrs::image::compare::compare;
+use pbrs::image::Image;
+use pbrs::geometry::{Bounds2i, Ray};
+use pbrs::media::{phase_hg, HenyeyGreenstein, Medium, MEDIA};
+use pbrs::media::{Coefficients, Density, Grid, Homogeneous};
+use pbrs::samplers::Sampler;
+use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::scene::{SamplerDesc, SamplerKind, SceneDescription};
 use std::sync::Arc;
 
@@ -254,7 +254,7 @@ fn henyey_greenstein_sampling_matches_its_density() {
 #[test]
 fn henyey_greenstein_sign_convention() {
     let wo = Vec3::new(0.0, 0.6, -0.8);
-    let mut rng = pbrs::render::sampling::rng::Pcg32::with_sequence(9);
+    let mut rng = pbrs::sampling::rng::Pcg32::with_sequence(9);
     for g in [-0.8f32, -0.3, 0.0, 0.5, 0.95] {
         let hg = HenyeyGreenstein { g };
         let n = 200_000;

@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use pbrs::loader::load_scene_str;
 use pbrs::loader::ply::read_ply;
-use pbrs::render::film::Image;
+use pbrs::image::Image;
 use pbrs::scene::MeshData;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

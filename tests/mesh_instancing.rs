@@ -6,7 +6,7 @@
 mod common;
 use common::*;
 use pbrs::loader::load_scene_str;
-use pbrs::render::film::compare::mean_rgb;
+use pbrs::image::compare::mean_rgb;
 use std::process::Command;
 
 const DIRECT: &str = r#"
@@ -57,7 +57,7 @@ fn render(
     transform: &str,
     material: &str,
     shape: &str,
-) -> pbrs::render::film::Image {
+) -> pbrs::image::Image {
     let text = template
         .replace("SHAPE", shape)
         .replace("TRANSFORM", transform)
@@ -133,11 +133,11 @@ fn instanced_dragon_renders_like_the_direct_one() {
             .count();
         if differing * 20 >= a.data.len() / 3 {
             let d = output_dir("instancing");
-            let _ = pbrs::render::film::io::write_image(&d.join("direct.png"), &a);
-            let _ = pbrs::render::film::io::write_image(&d.join("instanced.png"), &b);
-            let _ = pbrs::render::film::io::write_image(
+            let _ = pbrs::image::io::write_image(&d.join("direct.png"), &a);
+            let _ = pbrs::image::io::write_image(&d.join("instanced.png"), &b);
+            let _ = pbrs::image::io::write_image(
                 &d.join("difference.png"),
-                &pbrs::render::film::compare::false_colour_difference(&a, &b),
+                &pbrs::image::compare::false_colour_difference(&a, &b),
             );
         }
         assert!(
@@ -185,6 +185,6 @@ fn instanced_scene_does_not_depend_on_thread_count() {
     let one = render_at(load("scenes/instancing-dragons.pbrt"), 48, 2, Some(1)).0;
     let two = render_at(load("scenes/instancing-dragons.pbrt"), 48, 2, Some(2)).0;
     let bits =
-        |i: &pbrs::render::film::Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        |i: &pbrs::image::Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&one), bits(&two));
 }

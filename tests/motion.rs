@@ -433,9 +433,9 @@ fn motion_bounds_hold_rotations_up_to_half_a_turn() {
 // transform puts it.
 
 use glam::{Vec2, Vec3};
-use pbrs::render::geometry::Ray;
-use pbrs::render::samplers::CameraSample;
-use pbrs::render::scene::RenderScene;
+use pbrs::geometry::Ray;
+use pbrs::samplers::CameraSample;
+use pbrs::integrators::RenderScene;
 
 fn render_scene(text: &str) -> RenderScene {
     RenderScene::new(&load(text).scene)

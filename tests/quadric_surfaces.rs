@@ -12,11 +12,11 @@
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use pbrs::loader::load_scene_str;
-use pbrs::render::geometry::{offset_ray_origin, Frame};
-use pbrs::render::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
-use pbrs::render::sampling::Pcg32;
-use pbrs::render::scene::RenderScene;
-use pbrs::render::shapes::{
+use pbrs::geometry::{offset_ray_origin, Frame};
+use pbrs::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
+use pbrs::sampling::Pcg32;
+use pbrs::integrators::RenderScene;
+use pbrs::shapes::{
     hyperboloid_coefficients, Cone, Hyperboloid, Paraboloid, Quadric, SurfacePoint,
 };
 use std::f64::consts::TAU;

@@ -11,7 +11,7 @@ mod common;
 use common::*;
 use glam::{DVec3, Vec3};
 use pbrs::loader::load_scene_str;
-use pbrs::render::film::compare::mean_rgb;
+use pbrs::image::compare::mean_rgb;
 use pbrs::scene::{Geometry, MeshData};
 use std::sync::Arc;
 

@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use pbrs::loader::load_scene_str;
-use pbrs::render::film::compare::{mean_rgb, relative_mse};
+use pbrs::image::compare::{mean_rgb, relative_mse};
 use std::process::Command;
 
 /// A scene of `scenes/` (camera `LookAt 0 1 6.8  0 1 0  0 1 0`) with
@@ -194,7 +194,7 @@ fn renders_png_pfm_and_exr() {
             .status()
             .unwrap();
         assert!(st.success());
-        let img = pbrs::render::film::io::read_image(&out).unwrap();
+        let img = pbrs::image::io::read_image(&out).unwrap();
         assert_eq!((img.width, img.height), (51, 51), "{ext}");
     }
 }

@@ -2,8 +2,8 @@
 //! inputs, degenerate inputs, and chi-square fits of the sampled histograms.
 
 use glam::Vec2;
-use pbrs::render::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
-use pbrs::render::sampling::{Distribution1D, Distribution2D, Pcg32, ONE_MINUS_EPSILON};
+use pbrs::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
+use pbrs::sampling::{Distribution1D, Distribution2D, Pcg32, ONE_MINUS_EPSILON};
 
 /// Chi-square tests in this file (for the Šidák correction).
 const N_CHI2_TESTS: usize = 2 * 8;

@@ -2,9 +2,9 @@
 //! equidistribution, thousands of dimensions, and the array API.
 
 use glam::{IVec2, Vec2};
-use pbrs::render::geometry::Bounds2i;
-use pbrs::render::samplers::{CameraSample, Sampler};
-use pbrs::render::sampling::chi2::chi2_survival;
+use pbrs::geometry::Bounds2i;
+use pbrs::samplers::{CameraSample, Sampler};
+use pbrs::sampling::chi2::chi2_survival;
 use pbrs::scene::{SamplerDesc, SamplerKind};
 
 fn desc(kind: SamplerKind, spp: u32) -> SamplerDesc {
@@ -417,14 +417,14 @@ fn bench_samplers() {
     }
 }
 
-/// Every kind of `render::samplers::SAMPLERS`, loaded from a statement:
+/// Every kind of `samplers::SAMPLERS`, loaded from a statement:
 /// its settings, and its sampler's values in [0, 1) and the same for the
 /// same pixel and index. Unsupported kinds render with halton and say so.
 /// A kind of the table without a case here fails.
 #[test]
 fn every_sampler_kind_loads_and_samples() {
     use pbrs::loader::load_scene_str;
-    use pbrs::render::samplers::SAMPLERS;
+    use pbrs::samplers::SAMPLERS;
     use std::path::Path;
     let cases: &[(&str, &str, SamplerDesc)] = &[
         (

@@ -3,8 +3,8 @@
 //! fail (deliberately wrong pdfs are rejected).
 
 use glam::{Vec2, Vec3};
-use pbrs::render::sampling::chi2::{chi2_sphere, chi2_square, sidak_significance, Chi2Config};
-use pbrs::render::sampling::*;
+use pbrs::sampling::chi2::{chi2_sphere, chi2_square, sidak_significance, Chi2Config};
+use pbrs::sampling::*;
 
 /// Number of chi-square tests that must pass in this file.
 const N_TESTS: usize = 9;

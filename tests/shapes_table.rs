@@ -1,10 +1,10 @@
-//! Every kind of `render::shapes::SHAPES`, loaded from a `Shape` statement
+//! Every kind of `shapes::SHAPES`, loaded from a `Shape` statement
 //! (mesh files written next to the scene): it builds the geometry it should,
 //! without warnings, and its checks fire on a bad parameter, located at the
 //! parameter. A kind of the table without a case here fails.
 
 use pbrs::loader::load_scene_str;
-use pbrs::render::shapes::{kind_name, SHAPES};
+use pbrs::shapes::{kind_name, SHAPES};
 use pbrs::scene::Geometry;
 use std::path::{Path, PathBuf};
 

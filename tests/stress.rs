@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use pbrs::render::driver::RenderStats;
-use pbrs::render::film::Image;
+use pbrs::image::Image;
 
 fn render_file(rel: &str, res: Option<u32>, spp: Option<u32>) -> (Image, RenderStats) {
     let mut desc = load(rel);

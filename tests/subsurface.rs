@@ -8,9 +8,9 @@ mod tex_common;
 
 use common::{load_text, warning_text};
 use glam::Vec3;
-use pbrs::render::bssrdf::table::RHO_SAMPLES;
-use pbrs::render::materials::{BsdfContext, Material, MaterialKind, MATERIALS};
-use pbrs::render::media::presets;
+use pbrs::bssrdf::table::RHO_SAMPLES;
+use pbrs::materials::{BsdfContext, Material, MaterialKind, MATERIALS};
+use pbrs::media::presets;
 use pbrs::scene::{ParamKind, ParamValue, ParamValues, SpectrumDefault, SpectrumTex, Tex};
 use tex_common::*;
 
@@ -74,8 +74,8 @@ fn subsurface_defaults_and_presets() {
     assert_eq!(m.boundary.g, 0.0);
     assert_eq!(sa, Vec3::splat(5.0));
     assert_eq!(ss, 10.0 * Vec3::from(skim.sigma_prime_s));
-    assert!(pbrs::render::materials::Subsurface::load_warnings(&params(k, vec![])).is_empty());
-    let w = pbrs::render::materials::Subsurface::load_warnings(&params(
+    assert!(pbrs::materials::Subsurface::load_warnings(&params(k, vec![])).is_empty());
+    let w = pbrs::materials::Subsurface::load_warnings(&params(
         k,
         vec![("name", ParamValue::String("Skimmlik".into()))],
     ));
@@ -129,9 +129,9 @@ fn kdsubsurface_inverts_kd_through_the_table() {
 /// sphere at the origin and a matte sphere at x = 3, both of radius 1.
 #[test]
 fn probe_rays_find_the_hits_of_the_entry_points_material() {
-    use pbrs::render::bssrdf::probe::{find_exit, ProbeSegment};
-    use pbrs::render::geometry::Ray;
-    use pbrs::render::scene::RenderScene;
+    use pbrs::bssrdf::probe::{find_exit, ProbeSegment};
+    use pbrs::geometry::Ray;
+    use pbrs::integrators::RenderScene;
     let s = load_text(
         "WorldBegin\nMaterial \"subsurface\"\nShape \"sphere\" \"float radius\" 1\nAttributeBegin\nTranslate 3 0 0\nMaterial \"matte\"\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\nWorldEnd\n",
     );

@@ -1,4 +1,4 @@
-//! Every texture class of `render::textures::TEXTURES`, loaded through the
+//! Every texture class of `textures::TEXTURES`, loaded through the
 //! real loader and evaluated at chosen points against pbrt-v3's formulas
 //! evaluated independently in f64 (`tex_common`). `every_class_has_a_case`
 //! fails when a class of the table has no case here. Also: the mappings,
@@ -7,7 +7,7 @@
 mod tex_common;
 
 use glam::{DMat4, Vec2, Vec3};
-use pbrs::render::textures::{Class, Mapping2D, TEXTURES};
+use pbrs::textures::{Class, Mapping2D, TEXTURES};
 use pbrs::scene::{FloatTex, SpectrumTex, Tex};
 use std::f64::consts::PI;
 use tex_common::*;

@@ -6,9 +6,9 @@ mod tex_common;
 
 use glam::{Vec2, Vec3};
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::render::geometry::Ray;
-use pbrs::render::materials::{BsdfContext, Material};
-use pbrs::render::scene::RenderScene;
+use pbrs::geometry::Ray;
+use pbrs::materials::{BsdfContext, Material};
+use pbrs::integrators::RenderScene;
 use pbrs::scene::Geometry;
 use tex_common::*;
 

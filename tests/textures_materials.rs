@@ -7,8 +7,8 @@
 mod tex_common;
 
 use glam::{Vec2, Vec3};
-use pbrs::render::materials::BxdfFlags;
-use pbrs::render::materials::{link_materials, Bsdf, BsdfContext, Material, Support, MATERIALS};
+use pbrs::materials::BxdfFlags;
+use pbrs::materials::{link_materials, Bsdf, BsdfContext, Material, Support, MATERIALS};
 use pbrs::scene::{ParamKind, ParamSpec};
 use tex_common::*;
 
@@ -35,7 +35,7 @@ fn bsdf_at<'a>(m: &'a [Material], i: usize, at: &At) -> Bsdf<'a> {
 
 /// The kinds pbrs renders, but `none` and `mix` (no parameters of their
 /// own to texture or bump).
-fn surface_kinds() -> impl Iterator<Item = &'static pbrs::render::materials::MaterialKind> {
+fn surface_kinds() -> impl Iterator<Item = &'static pbrs::materials::MaterialKind> {
     MATERIALS
         .iter()
         .filter(|k| k.support == Support::Supported && !matches!(k.name, "none" | "mix"))
@@ -159,7 +159,7 @@ fn test_value(p: &ParamSpec) -> f32 {
 }
 
 /// The parameters a texture can drive (not `bumpmap`, tested above).
-fn textured_params(k: &pbrs::render::materials::MaterialKind) -> Vec<&'static ParamSpec> {
+fn textured_params(k: &pbrs::materials::MaterialKind) -> Vec<&'static ParamSpec> {
     k.params
         .iter()
         .filter(|p| {

@@ -5,8 +5,8 @@
 //! every texel of the level directly.
 
 use glam::{Vec2, Vec3};
-use pbrs::render::sampling::rng::Pcg32;
-use pbrs::render::textures::{ewa_weights, MipMap, Wrap};
+use pbrs::sampling::rng::Pcg32;
+use pbrs::textures::{ewa_weights, MipMap, Wrap};
 
 fn rng() -> Pcg32 {
     Pcg32::with_sequence(7)

@@ -6,7 +6,7 @@
 
 use pbrs::loader::load_scene_str;
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::render::film::io::read_image;
+use pbrs::image::io::read_image;
 use std::path::PathBuf;
 
 const QUAD: &str = "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point P\" [-3 -3 0 3 -3 0 3 3 0 -3 3 0] \"point2 uv\" [0 0 1 0 1 1 0 1]";

@@ -6,8 +6,8 @@
 
 use crate::loader::{load_scene, print_diagnostics};
 use crate::render::driver::{RenderOptions, Renderer};
-use crate::render::film::compare::compare;
-use crate::render::film::io::{read_image, write_atomic};
+use crate::image::compare::compare;
+use crate::image::io::{read_image, write_atomic};
 use clap::Args as ClapArgs;
 use std::fmt::Write as _;
 use std::path::PathBuf;

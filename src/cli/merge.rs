@@ -1,7 +1,7 @@
 //! `pbrs merge OUT PART...`: the image of a frame rendered in parts (tiles
 //! or sample ranges, see [`crate::render::film::part`]).
 
-use crate::render::film::io::{check_output_path, write_image};
+use crate::image::io::{check_output_path, write_image};
 use crate::render::film::part::{merge, read_part};
 use std::path::PathBuf;
 use std::time::Instant;

@@ -8,9 +8,9 @@ use crate::loader::{load_scene_files_each, print_diagnostics};
 use crate::render::driver::{
     peak_memory_bytes, render_observed, render_part, ChunkDone, RenderOptions,
 };
-use crate::render::film::io::{check_output_path, format_for_path, write_image, ImageFormat};
+use crate::image::io::{check_output_path, format_for_path, write_image, ImageFormat};
 use crate::render::film::part::PartKind;
-use crate::render::film::Image;
+use crate::image::Image;
 use crate::scene::{Light, SamplerKind, SceneDescription};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;

@@ -1,5 +1,5 @@
 //! The `Camera` directive: the kind's builder from
-//! [`CAMERAS`](crate::render::camera::CAMERAS) (pbrt-v3's `Create*Camera`
+//! [`CAMERAS`](crate::cameras::CAMERAS) (pbrt-v3's `Create*Camera`
 //! with its checks, in the kinds' files), the camera transform and the
 //! shutter, which every kind has. The realistic camera's lens file is read
 //! here (file names resolve as pbrt-v3's, relative to the top-level file).
@@ -9,7 +9,7 @@ use super::Ctx;
 use crate::lang::params::ParamList;
 use crate::lang::parser::Name;
 use crate::lang::Loc;
-use crate::render::camera::{CameraInput, FileSource, CAMERAS};
+use crate::cameras::{CameraInput, FileSource, CAMERAS};
 use crate::scene::{CameraDesc, FilmDesc};
 use glam::DMat4;
 use std::path::PathBuf;

@@ -9,9 +9,9 @@ use super::Ctx;
 use crate::lang::params::{Param, ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
-use crate::render::filters::{Filter, FILTERS};
-use crate::render::lights::{AreaLightBuild, LightBuild, AREA_LIGHTS, LIGHTS};
-use crate::render::samplers::SAMPLERS;
+use crate::filters::{Filter, FILTERS};
+use crate::lights::{AreaLightBuild, LightBuild, AREA_LIGHTS, LIGHTS};
+use crate::samplers::SAMPLERS;
 use crate::scene::kind;
 use crate::scene::*;
 use glam::{DMat4, Vec3};
@@ -174,7 +174,7 @@ const AREA_LIGHT_FAMILY: Family<AreaLightBuild> = Family {
     unknown: Unknown::Warn,
 };
 
-/// `LightSource`: a type of `render::lights::LIGHTS`, its parameters read
+/// `LightSource`: a type of `lights::LIGHTS`, its parameters read
 /// through its table and the light built by its builder with the CTM as
 /// light-to-world; types pbrs does not render, unknown types and lights
 /// the builder refuses are warned about and skipped.
@@ -199,7 +199,7 @@ pub fn light(ctx: &mut Ctx, name: &Name, p: &ParamList, ctm: DMat4) -> Option<Li
     light
 }
 
-/// Whether `AreaLightSource` names a type of `render::lights::AREA_LIGHTS`
+/// Whether `AreaLightSource` names a type of `lights::AREA_LIGHTS`
 /// (else a warning: later shapes do not emit). Its parameters are read by
 /// [`area_light`] when a shape first uses it.
 pub fn area_light_known(ctx: &mut Ctx, name: &Name, p: &ParamList) -> bool {
@@ -395,7 +395,7 @@ pub fn sampler(ctx: &mut Ctx, s: Ent) -> SamplerDesc {
 }
 
 /// The integrator of an `Integrator` statement, read through
-/// [`INTEGRATORS`](crate::render::integrators::INTEGRATORS): the kind's
+/// [`INTEGRATORS`](crate::integrators::INTEGRATORS): the kind's
 /// builder checks its settings; a kind pbrs does not render is `path` with
 /// the statement's `maxdepth`, with a warning.
 pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorSettings {
@@ -403,7 +403,7 @@ pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorSettings {
     let family = Family {
         directive: "Integrator",
         noun: "integrator",
-        table: crate::render::integrators::INTEGRATORS,
+        table: crate::integrators::INTEGRATORS,
         unknown: Unknown::Error,
     };
     let Some((name, p)) = s else {

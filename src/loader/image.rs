@@ -21,7 +21,7 @@
 //! | `.png` | `image` crate | 8-bit: `v/255`; 16-bit: the high byte `/255` (pbrt-v3's lodepng reduces to 8 bits); grey replicated, alpha dropped |
 //! | `.tga` | `image` crate | `v/255`, top row first whatever the file's origin, colour maps expanded |
 //! | `.exr` | `exr` crate | `R`, `G`, `B` (a missing one is 0, as OpenEXR's RGBA interface fills it), or `Y` alone as grey; half, float or uint samples; the data window of the first flat part, at its largest resolution level |
-//! | `.pfm` | `render::film::io` | `PF` or `Pf`, either byte order, times \|scale\| when it is not 1 |
+//! | `.pfm` | `image::io` | `PF` or `Pf`, either byte order, times \|scale\| when it is not 1 |
 //! | `.hdr` | `image` crate | Radiance RGBE, linear. **A pbrs extension**: pbrt-v3 reads no `.hdr` |
 //!
 //! Every reader checks the declared size against [`MAX_IMAGE_PIXELS`]
@@ -292,7 +292,7 @@ fn decode_exr(bytes: &[u8]) -> Result<RgbImage, String> {
 }
 
 fn decode_pfm(bytes: &[u8]) -> Result<RgbImage, String> {
-    let img = crate::render::film::io::parse_pfm(bytes)?;
+    let img = crate::image::io::parse_pfm(bytes)?;
     let pixels = img
         .data
         .chunks_exact(3)
@@ -490,7 +490,7 @@ mod tests {
             }
             // A cut at 60% of the file always loses pixels.
             assert!(dec(&bytes[..bytes.len() * 3 / 5], name).is_err(), "{name}");
-            let mut rng = crate::render::sampling::Pcg32::with_sequence(7);
+            let mut rng = crate::sampling::Pcg32::with_sequence(7);
             for _ in 0..300 {
                 let mut b = bytes.clone();
                 for _ in 0..1 + rng.uniform_u32() % 4 {

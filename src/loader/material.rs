@@ -1,5 +1,5 @@
 //! Materials as declared, and their parameters read through the kind's
-//! `ParamSpec` list from `render::materials::MATERIALS`, with pbrt-v3's
+//! `ParamSpec` list from `materials::MATERIALS`, with pbrt-v3's
 //! lookup rules (`TextureParams`): the shape's parameters first when it may
 //! override its material's, a texture reference before a value in each list.
 
@@ -11,7 +11,7 @@ use super::texture::Textures;
 use super::{Ctx, DeclaredKind};
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::Loc;
-use crate::render::materials::{self, MaterialKind, Support, MATERIALS};
+use crate::materials::{self, MaterialKind, Support, MATERIALS};
 use crate::scene::{
     Elem, FloatTex, MaterialDesc, ParamKind, ParamSpec, ParamValue, ParamValues, Range,
     SpectrumDefault, SpectrumTex,

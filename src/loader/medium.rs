@@ -1,5 +1,5 @@
 //! `MakeNamedMedium`: the medium of its `type` from
-//! [`MEDIA`](crate::render::media::MEDIA), built by the type's builder
+//! [`MEDIA`](crate::media::MEDIA), built by the type's builder
 //! (pbrt-v3's `MakeMedium` with its checks, in the types' files) in the
 //! space current at the statement.
 
@@ -7,7 +7,7 @@ use super::kinds::{self, Family, StatementReport, Unknown};
 use super::Ctx;
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::parser::Name;
-use crate::render::media::{Medium, MediumInput, MEDIA};
+use crate::media::{Medium, MediumInput, MEDIA};
 use crate::scene::kind::closest_name;
 use glam::DMat4;
 

@@ -6,12 +6,12 @@
 //! `PBRS_WRITE_REFERENCE=1` is set.
 
 use super::color::sampled_to_rgb;
-use crate::render::materials::{MaterialKind, Support, MATERIALS};
+use crate::materials::{MaterialKind, Support, MATERIALS};
 use crate::scene::{ParamKind, ParamSpec, Range, SpectrumDefault};
 use std::fmt::Write;
 
 /// The line that opens the generated material section.
-pub const MATERIALS_BEGIN: &str = "<!-- BEGIN generated from render::materials::MATERIALS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+pub const MATERIALS_BEGIN: &str = "<!-- BEGIN generated from materials::MATERIALS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
 /// The line that closes it.
 pub const MATERIALS_END: &str = "<!-- END generated materials -->";
 
@@ -211,17 +211,17 @@ pub fn splice(doc: &str, section: &str) -> Option<String> {
 }
 
 /// The line that opens the generated media section.
-pub const MEDIA_BEGIN: &str = "<!-- BEGIN generated from render::media::MEDIA: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+pub const MEDIA_BEGIN: &str = "<!-- BEGIN generated from media::MEDIA: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
 /// The line that closes it.
 pub const MEDIA_END: &str = "<!-- END generated media -->";
 
 /// The media section, between its markers (both included), from
-/// [`MEDIA`](crate::render::media::MEDIA).
+/// [`MEDIA`](crate::media::MEDIA).
 pub fn media_section() -> String {
     let mut out = String::new();
     out.push_str(MEDIA_BEGIN);
     out.push('\n');
-    for k in crate::render::media::MEDIA {
+    for k in crate::media::MEDIA {
         let _ = write!(out, "\n### `{}`\n\n{}\n", k.name, sentence(k.doc));
         out.push_str("\n| parameter | type | default | meaning |\n|---|---|---|---|\n");
         for p in k.params {
@@ -286,34 +286,34 @@ pub fn kinds_section<B>(
     out
 }
 
-/// The filter section, from [`FILTERS`](crate::render::filters::FILTERS).
+/// The filter section, from [`FILTERS`](crate::filters::FILTERS).
 pub fn filters_section() -> String {
-    let (b, e) = markers("render::filters::FILTERS", "filters");
-    kinds_section((&b, &e), crate::render::filters::FILTERS)
+    let (b, e) = markers("filters::FILTERS", "filters");
+    kinds_section((&b, &e), crate::filters::FILTERS)
 }
 
-/// The sampler section, from [`SAMPLERS`](crate::render::samplers::SAMPLERS).
+/// The sampler section, from [`SAMPLERS`](crate::samplers::SAMPLERS).
 pub fn samplers_section() -> String {
-    let (b, e) = markers("render::samplers::SAMPLERS", "samplers");
-    kinds_section((&b, &e), crate::render::samplers::SAMPLERS)
+    let (b, e) = markers("samplers::SAMPLERS", "samplers");
+    kinds_section((&b, &e), crate::samplers::SAMPLERS)
 }
 
-/// The camera section, from [`CAMERAS`](crate::render::camera::CAMERAS).
+/// The camera section, from [`CAMERAS`](crate::cameras::CAMERAS).
 pub fn cameras_section() -> String {
-    let (b, e) = markers("render::camera::CAMERAS", "cameras");
-    kinds_section((&b, &e), crate::render::camera::CAMERAS)
+    let (b, e) = markers("cameras::CAMERAS", "cameras");
+    kinds_section((&b, &e), crate::cameras::CAMERAS)
 }
 
 /// The line that opens the generated lights section.
-pub const LIGHTS_BEGIN: &str = "<!-- BEGIN generated from render::lights::LIGHTS and AREA_LIGHTS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+pub const LIGHTS_BEGIN: &str = "<!-- BEGIN generated from lights::LIGHTS and AREA_LIGHTS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
 /// The line that closes it.
 pub const LIGHTS_END: &str = "<!-- END generated lights -->";
 
 /// The lights section, between its markers (both included), from
-/// [`LIGHTS`](crate::render::lights::LIGHTS) (`LightSource`) and
-/// [`AREA_LIGHTS`](crate::render::lights::AREA_LIGHTS) (`AreaLightSource`).
+/// [`LIGHTS`](crate::lights::LIGHTS) (`LightSource`) and
+/// [`AREA_LIGHTS`](crate::lights::AREA_LIGHTS) (`AreaLightSource`).
 pub fn lights_section() -> String {
-    use crate::render::lights::{AREA_LIGHTS, LIGHTS};
+    use crate::lights::{AREA_LIGHTS, LIGHTS};
     use crate::scene::Kind;
     fn title<B>(k: &Kind<B>) -> String {
         let mut t = format!("`{}`", k.name);
@@ -360,21 +360,21 @@ pub fn lights_section() -> String {
     out
 }
 
-/// The shape section, from [`SHAPES`](crate::render::shapes::SHAPES).
+/// The shape section, from [`SHAPES`](crate::shapes::SHAPES).
 pub fn shapes_section() -> String {
-    let (b, e) = markers("render::shapes::SHAPES", "shapes");
-    kinds_section((&b, &e), crate::render::shapes::SHAPES)
+    let (b, e) = markers("shapes::SHAPES", "shapes");
+    kinds_section((&b, &e), crate::shapes::SHAPES)
 }
 
 /// The line that opens the generated integrators section.
-pub const INTEGRATORS_BEGIN: &str = "<!-- BEGIN generated from render::integrators::INTEGRATORS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
+pub const INTEGRATORS_BEGIN: &str = "<!-- BEGIN generated from integrators::INTEGRATORS: edit the tables, then run `PBRS_WRITE_REFERENCE=1 cargo test --release --test lang_grammar` -->";
 /// The line that closes it.
 pub const INTEGRATORS_END: &str = "<!-- END generated integrators -->";
 
 /// The integrators section, between its markers (both included), from
-/// [`INTEGRATORS`](crate::render::integrators::INTEGRATORS).
+/// [`INTEGRATORS`](crate::integrators::INTEGRATORS).
 pub fn integrators_section() -> String {
-    use crate::render::integrators::INTEGRATORS;
+    use crate::integrators::INTEGRATORS;
     let mut out = String::new();
     out.push_str(INTEGRATORS_BEGIN);
     out.push('\n');

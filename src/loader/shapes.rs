@@ -1,5 +1,5 @@
 //! `Shape` statements: the kind found in
-//! [`SHAPES`](crate::render::shapes::SHAPES) and built from its parameters
+//! [`SHAPES`](crate::shapes::SHAPES) and built from its parameters
 //! (unknown shapes: a warning, and the shape is skipped, as pbrt-v3); the
 //! files a kind's builder asks for (PLY, OBJ, glTF meshes) and the refined
 //! shapes' meshes come from here, through [`ShapeInput`].
@@ -10,7 +10,7 @@ use super::ply::{read_ply, PlyMesh};
 use super::Ctx;
 use crate::lang::params::ParamList;
 use crate::lang::parser::Name;
-use crate::render::shapes::{MeshFormat, ShapeBuild, ShapeInput, SHAPES};
+use crate::shapes::{MeshFormat, ShapeBuild, ShapeInput, SHAPES};
 use crate::scene::{kind, Geometry, MeshData, Report};
 use std::collections::HashMap;
 use std::path::PathBuf;

@@ -8,8 +8,8 @@ use super::texture::{self as texture, Defined, TextureState, Textures};
 use super::Ctx;
 use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
 use crate::lang::Loc;
-use crate::render::bxdf::MAX_BXDFS;
-use crate::render::materials::Material;
+use crate::bxdf::MAX_BXDFS;
+use crate::materials::Material;
 use crate::scene::motion;
 use crate::scene::*;
 use glam::{DMat3, DMat4, DVec3, DVec4};
@@ -124,13 +124,13 @@ pub struct Builder<'s, 'c> {
     pub unsupported_shapes: usize,
     /// Every medium `MakeNamedMedium` made, with its statement's location
     /// and its index in `scene_media` once something refers to it.
-    medium_defs: Vec<(crate::render::media::Medium, Loc, Option<MediumId>)>,
+    medium_defs: Vec<(crate::media::Medium, Loc, Option<MediumId>)>,
     /// The definition each name refers to now (a redefinition replaces it
     /// for later statements, as pbrt-v3's `namedMedia[name] = medium`).
     medium_names: HashMap<String, usize>,
     /// Undefined medium names already reported, by the interface statement.
     reported_media: HashSet<(String, u32, u32, u32)>,
-    pub scene_media: Vec<crate::render::media::Medium>,
+    pub scene_media: Vec<crate::media::Medium>,
     pub camera_medium: Option<MediumId>,
     /// The first `MediumInterface` statement (pbrt-v3's `haveScatteringMedia`).
     pub first_medium_interface: Option<Loc>,
@@ -964,7 +964,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 }
                 // Hints only for a known kind: an unknown one is read as a
                 // matte, whose names would mislead.
-                let specs = crate::render::materials::kind(&spec.ty).map_or(&[][..], |k| k.params);
+                let specs = crate::materials::kind(&spec.ty).map_or(&[][..], |k| k.params);
                 self.ctx.report_unused_with_specs(
                     p,
                     &format!("Material \"{}\"", spec.ty),
@@ -1013,7 +1013,7 @@ impl<'s, 'c> Builder<'s, 'c> {
     ) -> (
         CameraDesc,
         FilmDesc,
-        crate::render::filters::Filter,
+        crate::filters::Filter,
         SamplerDesc,
         IntegratorSettings,
     ) {

@@ -1,6 +1,6 @@
 //! The summary `pbrs --check` prints: options and counts by type.
 
-use crate::render::materials::{self, Support};
+use crate::materials::{self, Support};
 use crate::scene::*;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -24,7 +24,7 @@ pub struct Summary {
     /// Lights other than area lights, by type.
     pub lights_by_type: BTreeMap<&'static str, usize>,
     /// Materials built (distinct), by the type declared for them, a name in
-    /// `render::materials::MATERIALS` (an unsupported type counts under its
+    /// `materials::MATERIALS` (an unsupported type counts under its
     /// own name, though it is rendered as a matte).
     pub materials_by_type: BTreeMap<&'static str, usize>,
     /// Materials of types pbrs does not know (read as mattes), by type.
@@ -104,7 +104,7 @@ impl Summary {
         for sh in &scene.shapes {
             s.shapes += 1;
             *s.shapes_by_type
-                .entry(crate::render::shapes::kind_name(&sh.geometry))
+                .entry(crate::shapes::kind_name(&sh.geometry))
                 .or_default() += 1;
             s.triangles += triangles(&sh.geometry);
             s.area_lights += usize::from(sh.area_light.is_some());
@@ -144,7 +144,7 @@ impl Summary {
 /// The type a built material was declared with.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum DeclaredKind {
-    /// A kind of `render::materials::MATERIALS`.
+    /// A kind of `materials::MATERIALS`.
     Table(&'static str),
     /// A type pbrs does not know (built as a matte).
     Unknown(String),

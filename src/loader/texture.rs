@@ -1,5 +1,5 @@
 //! The `Texture` directive: a texture of a class in
-//! `render::textures::TEXTURES`, its parameters read through the class's
+//! `textures::TEXTURES`, its parameters read through the class's
 //! `ParamSpec` list with pbrt-v3's rules (`TextureParams` over the
 //! statement's own parameters: texture references by name resolve to the
 //! textures defined before, of the type the parameter needs), its mapping,
@@ -13,7 +13,7 @@ use super::Ctx;
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
-use crate::render::textures::{
+use crate::textures::{
     self, ImageSource, Mapping2D, Mapping3D, MappingUse, MipCache, TexBuilder, TexValue,
     TextureClass, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, TEXTURES, UV_MAPPING_PARAMS,
 };

@@ -3,12 +3,13 @@
 //! image is bit-identical for any thread count), and count what happened.
 
 use crate::render::film::part::{self, PartHeader, PartKind};
-use crate::render::film::{luminance, Film, FilmTile, Image, TileMaker};
-use crate::render::geometry::Bounds2i;
-use crate::render::geometry::{Ray, RayDiff};
-use crate::render::integrators::{Batch, Integrator, RayCounts, Scratch};
-use crate::render::samplers::{CameraSample, Sampler};
-use crate::render::scene::RenderScene;
+use crate::image::Image;
+use crate::render::film::{luminance, Film, FilmTile, TileMaker};
+use crate::geometry::Bounds2i;
+use crate::geometry::{Ray, RayDiff};
+use crate::integrators::{Batch, Integrator, RayCounts, Scratch};
+use crate::samplers::{CameraSample, Sampler};
+use crate::integrators::RenderScene;
 use crate::scene::SceneDescription;
 use glam::{IVec2, Vec3};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -289,12 +290,12 @@ impl Renderer {
                 ls.kind(),
                 ls.active_count(),
                 match (ls.kind(), ls.bvh_shape()) {
-                    (crate::render::lights::LightSamplerKind::Spatial, _) =>
+                    (crate::lights::LightSamplerKind::Spatial, _) =>
                         format!(", {} voxel distributions built", ls.voxels_built()),
                     (_, Some((tree, inf, depth))) => format!(
                         ", {tree} in a light BVH of depth {depth}, {inf} at infinity{}",
                         if ls.spatial_fallback() {
-                            format!(" (\"spatial\" asked for: past {} lights pbrt-v3's voxel distributions would cost 128 estimates × every light per voxel, so the light BVH chooses instead)", crate::render::lights::SPATIAL_MAX_LIGHTS)
+                            format!(" (\"spatial\" asked for: past {} lights pbrt-v3's voxel distributions would cost 128 estimates × every light per voxel, so the light BVH chooses instead)", crate::lights::SPATIAL_MAX_LIGHTS)
                         } else {
                             String::new()
                         }

@@ -1,20 +1,8 @@
-//! The render core: geometry, shapes, acceleration, materials, lights,
-//! samplers, integrators and film. It consumes a [`crate::scene::SceneDescription`].
+//! What makes the image: compiling the scene description into the render-ready
+//! scene ([`compile`]), the render loop over tiles and threads ([`driver`]) and
+//! the film with its image files ([`film`]). The families it drives (shapes,
+//! lights, cameras, materials, integrators, ...) are modules of their own.
 
-pub mod accel;
-pub mod bssrdf;
-pub mod bxdf;
-pub mod camera;
+pub mod compile;
 pub mod driver;
 pub mod film;
-pub mod filters;
-pub mod geometry;
-pub mod integrators;
-pub mod lights;
-pub mod materials;
-pub mod media;
-pub mod samplers;
-pub mod sampling;
-pub mod scene;
-pub mod shapes;
-pub mod textures;

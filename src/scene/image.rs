@@ -25,10 +25,7 @@
 
 use glam::Vec3;
 
-/// Largest image (width × height) any reader accepts: 2^27 texels, e.g. a
-/// 16384 × 8192 environment map, 1.5 GiB as RGB f32. Checked against the
-/// file's declared size before anything is allocated.
-pub const MAX_IMAGE_PIXELS: u64 = 1 << 27;
+pub use crate::image::MAX_IMAGE_PIXELS;
 
 /// How a file stored its samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

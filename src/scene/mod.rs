@@ -21,7 +21,7 @@ pub use motion::AnimatedTransform;
 pub use params::{Elem, ParamKind, ParamSpec, ParamValue, ParamValues, Range, SpectrumDefault};
 pub use textures::{FloatTex, SpectrumTex, Tex};
 
-pub use crate::render::lights::{DiffuseEmission, Light};
+pub use crate::lights::{DiffuseEmission, Light};
 use glam::{DMat4, Vec2, Vec3};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -31,7 +31,7 @@ use std::sync::Arc;
 pub struct SceneDescription {
     pub camera: CameraDesc,
     pub film: FilmDesc,
-    pub filter: crate::render::filters::Filter,
+    pub filter: crate::filters::Filter,
     pub sampler: SamplerDesc,
     pub integrator: IntegratorSettings,
     /// Materials referenced by shapes (by index). Only referenced ones are built.
@@ -48,7 +48,7 @@ pub struct SceneDescription {
     pub instances: Vec<InstanceDesc>,
     /// Participating media referenced by the camera or by a shape's
     /// interface (by index: [`MediumId`]).
-    pub media: Vec<crate::render::media::Medium>,
+    pub media: Vec<crate::media::Medium>,
     /// The camera's medium (pbrt-v3: the outside medium of the graphics
     /// state when the camera is made, at WorldEnd).
     pub camera_medium: Option<MediumId>,
@@ -93,7 +93,7 @@ pub struct CameraDesc {
     pub motion: Option<Arc<AnimatedTransform>>,
     /// The camera kind with its settings, as its builder checked them; its
     /// mapping is derived from the film when the scene is compiled.
-    pub projection: crate::render::camera::Projection,
+    pub projection: crate::cameras::Projection,
     pub shutter_open: f32,
     pub shutter_close: f32,
 }
@@ -166,12 +166,12 @@ pub enum DirectStrategy {
 }
 
 /// The integrator: a kind's settings, built by its row of
-/// `render::integrators::INTEGRATORS`.
-pub use crate::render::integrators::{
+/// `integrators::INTEGRATORS`.
+pub use crate::integrators::{
     DirectLightingSettings, IntegratorSettings, PathSettings, VolPathSettings, WhittedSettings,
 };
 
-/// A material: its kind (a name in `render::materials::MATERIALS`) and the
+/// A material: its kind (a name in `materials::MATERIALS`) and the
 /// values of the parameters that kind declares, defaults applied.
 /// `Material "none"` / `""` is the kind "none" (no BSDF: the surface only
 /// delimits media).
@@ -217,7 +217,7 @@ pub struct ShapeDesc {
     pub medium_interface: MediumInterfaceDesc,
 }
 
-/// A shape as its kind built it (`render::shapes::SHAPES`), in its object
+/// A shape as its kind built it (`shapes::SHAPES`), in its object
 /// space; the render core places it (once per instance for shapes inside
 /// `ObjectBegin`).
 #[derive(Clone, Debug)]
@@ -231,7 +231,7 @@ pub enum Geometry {
     /// A sphere, disk, cylinder, cone, paraboloid or hyperboloid: the
     /// render core's own shape, built at the origin (identity transform)
     /// and placed with `Quadric::placed`.
-    Quadric(crate::render::shapes::Quadric),
+    Quadric(crate::shapes::Quadric),
 }
 
 /// pbrt-v3's curve types.

@@ -3,12 +3,12 @@
 //! A handle is a constant (the common case, kept a plain value so that
 //! reading it costs a field read and a predicted branch) or a shared,
 //! immutable texture: its class, mapping and parameters as built by
-//! `render::textures` from a `Texture` statement (pbrt-v3 semantics: a
+//! `textures` from a `Texture` statement (pbrt-v3 semantics: a
 //! texture refers to the textures defined before it, by value, so the graph
 //! is a tree of `Arc`s fixed at load time). Evaluation is in
-//! `render::textures`.
+//! `textures`.
 
-use crate::render::textures::Texture;
+use crate::textures::Texture;
 use glam::Vec3;
 use std::fmt;
 use std::sync::Arc;

@@ -4,9 +4,9 @@
 
 use pbrs::loader::load_scene;
 use pbrs::render::driver::{render, RenderOptions, RenderStats};
-use pbrs::render::film::compare::{compare, false_colour_difference, Comparison};
-use pbrs::render::film::io::{read_image, write_image};
-use pbrs::render::film::Image;
+use pbrs::image::compare::{compare, false_colour_difference, Comparison};
+use pbrs::image::io::{read_image, write_image};
+use pbrs::image::Image;
 use pbrs::scene::SceneDescription;
 use std::path::{Path, PathBuf};
 
@@ -207,7 +207,7 @@ pub fn average(images: &[Image]) -> Image {
 ///
 /// `decl` may start with other statements (`MakeNamedMaterial` lines): then
 /// its last line is a whole `Material` statement.
-pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usize) {
+pub fn materials_of(decl: &str) -> (Vec<pbrs::materials::Material>, usize) {
     let text = if decl.contains('\n') {
         format!("WorldBegin\n{decl}\nShape \"sphere\"\nWorldEnd\n")
     } else {
@@ -220,9 +220,9 @@ pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usiz
         .scene
         .materials
         .iter()
-        .map(pbrs::render::materials::Material::new)
+        .map(pbrs::materials::Material::new)
         .collect();
-    pbrs::render::materials::link_materials(&mut m);
+    pbrs::materials::link_materials(&mut m);
     (m, first)
 }
 
@@ -230,7 +230,7 @@ pub fn materials_of(decl: &str) -> (Vec<pbrs::render::materials::Material>, usiz
 /// material needs them, dp/du = +x and dp/dv = +y. The materials are leaked
 /// (the BSDF may refer to them); for tabulated materials, whose tables are
 /// large, use [`bsdf_of`] with materials the test keeps.
-pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::materials::Bsdf<'static> {
+pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::materials::Bsdf<'static> {
     let (materials, first) = materials_of(decl);
     bsdf_of(Vec::leak(materials), first, multiple_lobes)
 }
@@ -238,14 +238,14 @@ pub fn material_bsdf(decl: &str, multiple_lobes: bool) -> pbrs::render::material
 /// The BSDF of `materials[first]` (the others are what it may refer to) at
 /// the point of [`material_bsdf`].
 pub fn bsdf_of(
-    materials: &[pbrs::render::materials::Material],
+    materials: &[pbrs::materials::Material],
     first: usize,
     multiple_lobes: bool,
-) -> pbrs::render::materials::Bsdf<'_> {
+) -> pbrs::materials::Bsdf<'_> {
     use glam::{Vec2, Vec3};
-    use pbrs::render::accel::SurfaceHit;
-    use pbrs::render::materials::{BsdfContext, ShadingContext};
-    use pbrs::render::shapes::{DiffGeom, SurfacePoint};
+    use pbrs::accel::SurfaceHit;
+    use pbrs::materials::{BsdfContext, ShadingContext};
+    use pbrs::shapes::{DiffGeom, SurfacePoint};
     let hit = SurfaceHit {
         point: SurfacePoint {
             p: Vec3::ZERO,

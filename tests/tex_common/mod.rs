@@ -6,9 +6,9 @@
 use glam::{Vec2, Vec3};
 use pbrs::lang::parser::FileLoader;
 use pbrs::loader::{load_scene_with, LoadFailure, LoadedScene};
-use pbrs::render::accel::SurfaceHit;
-use pbrs::render::materials::ShadingContext;
-use pbrs::render::shapes::{DiffGeom, SurfacePoint};
+use pbrs::accel::SurfaceHit;
+use pbrs::materials::ShadingContext;
+use pbrs::shapes::{DiffGeom, SurfacePoint};
 use pbrs::scene::{FloatTex, SpectrumTex};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

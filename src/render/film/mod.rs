@@ -7,13 +7,12 @@
 //! caller in a fixed order with plain additions, so an image does not depend
 //! on the number of threads.
 
-pub mod compare;
-pub mod io;
 pub mod part;
 
-pub use crate::render::filters::Filter;
+pub use crate::filters::Filter;
 
-use crate::render::geometry::Bounds2i;
+use crate::geometry::Bounds2i;
+use crate::image::Image;
 use crate::scene::FilmDesc;
 use glam::{DVec3, IVec2, Vec2, Vec3};
 
@@ -21,38 +20,7 @@ use glam::{DVec3, IVec2, Vec2, Vec3};
 pub const FILTER_TABLE_WIDTH: usize = 16;
 const TABLE_SIZE: usize = FILTER_TABLE_WIDTH * FILTER_TABLE_WIDTH;
 
-pub use crate::render::geometry::luminance;
-
-/// A linear RGB image: `data` holds `width * height` RGB triples, rows from
-/// top to bottom.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Image {
-    pub width: u32,
-    pub height: u32,
-    pub data: Vec<f32>,
-}
-
-impl Image {
-    pub fn new(width: u32, height: u32) -> Image {
-        Image {
-            width,
-            height,
-            data: vec![0.0; width as usize * height as usize * 3],
-        }
-    }
-
-    #[inline]
-    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
-        let i = 3 * (y as usize * self.width as usize + x as usize);
-        Vec3::new(self.data[i], self.data[i + 1], self.data[i + 2])
-    }
-
-    #[inline]
-    pub fn set_pixel(&mut self, x: u32, y: u32, v: Vec3) {
-        let i = 3 * (y as usize * self.width as usize + x as usize);
-        self.data[i..i + 3].copy_from_slice(&v.to_array());
-    }
-}
+pub use crate::geometry::luminance;
 
 /// Running sums of one pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -20,7 +20,7 @@
 //!   terms in another order (see [`merge`] for the bound).
 
 use super::{pixel_rgb, Film, Image, PixelSums};
-use crate::render::geometry::Bounds2i;
+use crate::geometry::Bounds2i;
 use crate::scene::SceneDescription;
 use glam::{IVec2, Vec2};
 use std::fmt::Write as _;
@@ -306,7 +306,7 @@ pub fn write_tile_part(path: &Path, header: &PartHeader, film: &Film) -> Result<
         .collect();
     let bytes = encode_part(header, film.pixel_bounds(), rect, channels)
         .map_err(|e| format!("{}: {e}", path.display()))?;
-    super::io::write_atomic(path, &bytes)
+    crate::image::io::write_atomic(path, &bytes)
 }
 
 /// Writes the sums of every pixel of `film` as part `header.kind`
@@ -334,7 +334,7 @@ pub fn write_samples_part(path: &Path, header: &PartHeader, film: &Film) -> Resu
     }
     let bytes =
         encode_part(header, pb, pb, channels).map_err(|e| format!("{}: {e}", path.display()))?;
-    super::io::write_atomic(path, &bytes)
+    crate::image::io::write_atomic(path, &bytes)
 }
 
 /// Reads a part file; an error names the file and says what is wrong

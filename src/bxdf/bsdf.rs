@@ -1,0 +1,380 @@
+//! The BSDF at a surface point: up to [`MAX_BXDFS`] lobes in the shading
+//! frame, plus the geometric normal that decides reflection versus
+//! transmission (pbrt-v3's `BSDF`). Lobe choice, densities and values follow
+//! pbrt-v3's `BSDF::Sample_f`, `f` and `Pdf` exactly: a lobe is chosen
+//! uniformly among those matching the flags, and for a non-specular sample
+//! the density is the average of the matching lobes' densities and the value
+//! their sum.
+
+use super::{Bxdf, BxdfFlags, BxdfModel, BxdfSample};
+use crate::geometry::Frame;
+use crate::sampling::ONE_MINUS_EPSILON;
+use arrayvec::ArrayVec;
+use glam::{Vec2, Vec3};
+
+/// Lobes per BSDF (pbrt-v3's `MaxBxDFs`). Materials check at load time that
+/// they stay within it (a `mix` adds the lobes of both its materials).
+pub const MAX_BXDFS: usize = 8;
+
+/// One lobe with its weight (pbrt-v3's `ScaledBxDF` when not one).
+#[derive(Clone, Copy, Debug)]
+pub struct Lobe<'a> {
+    pub bxdf: Bxdf<'a>,
+    pub scale: Vec3,
+    /// `bxdf.flags()`, cached.
+    pub flags: BxdfFlags,
+}
+
+/// A sampled incident direction (world space).
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// BSDF value (not multiplied by the cosine).
+    pub f: Vec3,
+    pub wi: Vec3,
+    pub pdf: f32,
+    /// The lobe type that was sampled.
+    pub flags: BxdfFlags,
+}
+
+impl BsdfSample {
+    #[inline]
+    pub fn is_specular(&self) -> bool {
+        self.flags.is_specular()
+    }
+    #[inline]
+    pub fn is_transmission(&self) -> bool {
+        self.flags.is_transmission()
+    }
+}
+
+/// `'a`: the lifetime of the material the lobes may refer to.
+#[derive(Clone, Debug)]
+pub struct Bsdf<'a> {
+    pub frame: Frame,
+    pub ng: Vec3,
+    /// Relative index of refraction (1 for opaque materials), for the path
+    /// tracer's Russian roulette (pbrt-v3's `BSDF::eta`).
+    pub eta: f32,
+    lobes: ArrayVec<Lobe<'a>, MAX_BXDFS>,
+}
+
+impl<'a> Bsdf<'a> {
+    #[inline]
+    pub fn new(frame: Frame, ng: Vec3, eta: f32) -> Bsdf<'a> {
+        Bsdf {
+            frame,
+            ng,
+            eta,
+            lobes: ArrayVec::new(),
+        }
+    }
+
+    /// A BSDF with no lobes and a z-up frame, to be [`Bsdf::reset`].
+    #[inline]
+    pub fn empty() -> Bsdf<'a> {
+        let frame = Frame {
+            s: Vec3::X,
+            t: Vec3::Y,
+            n: Vec3::Z,
+        };
+        Bsdf::new(frame, Vec3::Z, 1.0)
+    }
+
+    /// Empties the BSDF for a new hit (eta 1).
+    #[inline]
+    pub fn reset(&mut self, frame: Frame, ng: Vec3) {
+        self.frame = frame;
+        self.ng = ng;
+        self.eta = 1.0;
+        self.lobes.clear();
+    }
+
+    /// Adds a lobe (pbrt-v3's `BSDF::Add`). Beyond [`MAX_BXDFS`] lobes are
+    /// dropped; materials are checked at load time never to get there.
+    #[inline]
+    pub fn add(&mut self, b: impl Into<Bxdf<'a>>) {
+        self.add_scaled(b, Vec3::ONE);
+    }
+
+    #[inline]
+    pub fn add_scaled(&mut self, b: impl Into<Bxdf<'a>>, scale: Vec3) {
+        if self.lobes.is_full() {
+            return;
+        }
+        let len = self.lobes.len();
+        let bxdf = b.into();
+        let flags = bxdf.flags();
+        // The lobe's fields are written straight into its slot: a lobe
+        // built on the stack and pushed was copied with wide loads that
+        // stalled on the narrower stores that had just built it (store
+        // forwarding fails), at every shaded vertex.
+        // SAFETY: the array is not full, so slot `len` is inside the
+        // array; its three fields are written before the length covers
+        // it, and `Lobe` has no other fields.
+        unsafe {
+            let slot = self.lobes.as_mut_ptr().add(len);
+            std::ptr::addr_of_mut!((*slot).bxdf).write(bxdf);
+            std::ptr::addr_of_mut!((*slot).scale).write(scale);
+            std::ptr::addr_of_mut!((*slot).flags).write(flags);
+            self.lobes.set_len(len + 1);
+        }
+    }
+
+    /// Multiplies the weights of lobes `from..` by `s` (for `mix`).
+    #[inline]
+    pub fn scale_from(&mut self, from: usize, s: Vec3) {
+        for l in self.lobes.iter_mut().skip(from) {
+            l.scale *= s;
+        }
+    }
+
+    #[inline]
+    pub fn lobes(&self) -> &[Lobe<'a>] {
+        &self.lobes
+    }
+
+    /// pbrt-v3's `NumComponents(flags)`.
+    #[inline]
+    pub fn num_components(&self, flags: BxdfFlags) -> usize {
+        self.lobes.iter().filter(|l| l.flags.matches(flags)).count()
+    }
+
+    /// True if the BSDF has a lobe that light sampling can use.
+    #[inline]
+    pub fn has_non_specular(&self) -> bool {
+        self.lobes.iter().any(|l| !l.flags.is_specular())
+    }
+
+    /// True if the BSDF has a specular lobe.
+    #[inline]
+    pub fn has_specular(&self) -> bool {
+        self.lobes.iter().any(|l| l.flags.is_specular())
+    }
+
+    /// True if the BSDF has no lobes at all.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.lobes.is_empty()
+    }
+
+    /// The reflectance if the BSDF is exactly one unscaled Lambertian
+    /// reflection lobe (the four-lane light estimate handles those).
+    #[inline]
+    pub fn single_lambertian(&self) -> Option<Vec3> {
+        match self.lobes.as_slice() {
+            [Lobe {
+                bxdf: Bxdf::LambertianReflection(l),
+                scale,
+                ..
+            }] if *scale == Vec3::ONE => Some(l.r),
+            _ => None,
+        }
+    }
+
+    /// Value for a pair of world directions, summed over the lobes matching
+    /// `flags` whose hemisphere (by the geometric normal) matches.
+    #[inline]
+    pub fn f(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> Vec3 {
+        self.f_pdf(wo_w, wi_w, flags).0
+    }
+
+    /// `(f, pdf)` for a pair of world directions in one pass.
+    #[inline]
+    pub fn f_pdf(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> (Vec3, f32) {
+        let wo = self.frame.to_local(wo_w);
+        if wo.z == 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let wi = self.frame.to_local(wi_w);
+        let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
+        if let [l] = self.lobes.as_slice() {
+            // One lobe (the common case): no sums, the same values.
+            if !l.flags.matches(flags) {
+                return (Vec3::ZERO, 0.0);
+            }
+            let (lobe_f, lobe_pdf) = lambertian_inline_f_pdf(&l.bxdf, wo, wi);
+            let side =
+                (reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission());
+            return (if side { lobe_f * l.scale } else { Vec3::ZERO }, lobe_pdf);
+        }
+        let mut f = Vec3::ZERO;
+        let mut pdf = 0.0;
+        let mut matching = 0u32;
+        for l in &self.lobes {
+            let lf = l.flags;
+            if !lf.matches(flags) {
+                continue;
+            }
+            matching += 1;
+            let (lobe_f, lobe_pdf) = l.bxdf.f_pdf(wo, wi);
+            pdf += lobe_pdf;
+            if (reflect && lf.is_reflection()) || (!reflect && lf.is_transmission()) {
+                f += lobe_f * l.scale;
+            }
+        }
+        let pdf = if matching > 1 {
+            pdf / matching as f32
+        } else {
+            pdf
+        };
+        (f, pdf)
+    }
+
+    /// pbrt-v3's `BSDF::Pdf(wo, wi, flags)`.
+    #[inline]
+    pub fn pdf(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> f32 {
+        let wo = self.frame.to_local(wo_w);
+        if wo.z == 0.0 || self.lobes.is_empty() {
+            return 0.0;
+        }
+        let wi = self.frame.to_local(wi_w);
+        let mut pdf = 0.0;
+        let mut matching = 0u32;
+        for l in &self.lobes {
+            if l.flags.matches(flags) {
+                matching += 1;
+                pdf += l.bxdf.pdf(wo, wi);
+            }
+        }
+        match matching {
+            0 => 0.0,
+            1 => pdf,
+            n => pdf / n as f32,
+        }
+    }
+
+    /// Samples an incident direction (pbrt-v3's `BSDF::Sample_f`): `u.x`
+    /// chooses among the lobes matching `flags` and is then remapped.
+    pub fn sample(&self, wo_w: Vec3, u: Vec2, flags: BxdfFlags) -> Option<BsdfSample> {
+        if let [lobe] = self.lobes.as_slice() {
+            return self.sample_one(lobe, wo_w, u, flags);
+        }
+        let matching = self.num_components(flags);
+        if matching == 0 {
+            return None;
+        }
+        let comp = ((u.x * matching as f32) as usize).min(matching - 1);
+        let (index, lobe) = self
+            .lobes
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.flags.matches(flags))
+            .nth(comp)?;
+        let u_remapped = if matching == 1 {
+            u
+        } else {
+            Vec2::new(
+                (u.x * matching as f32 - comp as f32).min(ONE_MINUS_EPSILON),
+                u.y,
+            )
+        };
+        let wo = self.frame.to_local(wo_w);
+        if wo.z == 0.0 {
+            return None;
+        }
+        let s = lobe.bxdf.sample_f(wo, u_remapped)?;
+        if s.pdf == 0.0 || s.pdf.is_nan() {
+            return None;
+        }
+        let wi_w = self.frame.from_local(s.wi);
+        let lobe_flags = lobe.flags;
+        let mut pdf = s.pdf;
+        let mut f = s.f * lobe.scale;
+        if !lobe_flags.is_specular() {
+            if matching > 1 {
+                for (i, l) in self.lobes.iter().enumerate() {
+                    if i != index && l.flags.matches(flags) {
+                        pdf += l.bxdf.pdf(wo, s.wi);
+                    }
+                }
+            }
+            let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
+            f = Vec3::ZERO;
+            for l in &self.lobes {
+                let lf = l.flags;
+                if lf.matches(flags)
+                    && ((reflect && lf.is_reflection()) || (!reflect && lf.is_transmission()))
+                {
+                    f += l.bxdf.f(wo, s.wi) * l.scale;
+                }
+            }
+        }
+        if matching > 1 {
+            pdf /= matching as f32;
+        }
+        if !f.is_finite() {
+            return None;
+        }
+        Some(BsdfSample {
+            f,
+            wi: wi_w,
+            pdf,
+            flags: s.flags,
+        })
+    }
+
+    /// `sample` for a BSDF of one lobe (the common case): no lobe choice,
+    /// `u` used as it is, the value recomputed only for the hemisphere test.
+    #[inline]
+    fn sample_one(
+        &self,
+        lobe: &Lobe<'a>,
+        wo_w: Vec3,
+        u: Vec2,
+        flags: BxdfFlags,
+    ) -> Option<BsdfSample> {
+        if !lobe.flags.matches(flags) {
+            return None;
+        }
+        let wo = self.frame.to_local(wo_w);
+        if wo.z == 0.0 {
+            return None;
+        }
+        let s = lambertian_inline_sample_f(&lobe.bxdf, wo, u)?;
+        if s.pdf == 0.0 || s.pdf.is_nan() {
+            return None;
+        }
+        let wi_w = self.frame.from_local(s.wi);
+        let f = if lobe.flags.is_specular() {
+            s.f * lobe.scale
+        } else {
+            let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
+            if (reflect && lobe.flags.is_reflection()) || (!reflect && lobe.flags.is_transmission())
+            {
+                s.f * lobe.scale
+            } else {
+                Vec3::ZERO
+            }
+        };
+        if !f.is_finite() {
+            return None;
+        }
+        Some(BsdfSample {
+            f,
+            wi: wi_w,
+            pdf: s.pdf,
+            flags: s.flags,
+        })
+    }
+}
+
+/// `b.f_pdf` with Lambertian reflection, the most common lobe, inline; every
+/// other lobe through the enum's dispatch, which is too large to inline
+/// (measured on cornell-path: the call costs ~5% of its instructions).
+#[inline(always)]
+fn lambertian_inline_f_pdf(b: &Bxdf, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+    match b {
+        Bxdf::LambertianReflection(l) => l.f_pdf(wo, wi),
+        _ => b.f_pdf(wo, wi),
+    }
+}
+
+/// `b.sample_f` with Lambertian reflection inline (see
+/// [`lambertian_inline_f_pdf`]).
+#[inline(always)]
+fn lambertian_inline_sample_f(b: &Bxdf, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
+    match b {
+        Bxdf::LambertianReflection(l) => l.sample_f(wo, u),
+        _ => b.sample_f(wo, u),
+    }
+}

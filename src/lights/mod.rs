@@ -1,0 +1,280 @@
+//! Lights: one file per pbrt-v3 light type, each opening with its
+//! parameters (names, types, pbrt-v3's defaults) and its `KIND`, and
+//! holding the light's struct, its builder (with pbrt-v3's checks of the
+//! parameters) and its sampling code: [`point`], [`spot`], [`distant`],
+//! [`infinite`] (`LightSource`), and [`diffuse`] (`AreaLightSource`: one
+//! light per triangle, as pbrt-v3, or per analytic shape). Two tables,
+//! [`LIGHTS`] and [`AREA_LIGHTS`], are what the loader (parsing and "did
+//! you mean"), `--check`, `grammar/REFERENCE.md` and the tests read.
+//!
+//! [`Light`] is the closed set; it only delegates to the files (a `match`
+//! per call, no dynamic dispatch). Also here: the light sample type and the
+//! distributions that choose which light to sample.
+
+pub mod bvh;
+pub mod diffuse;
+pub mod distant;
+mod distribution;
+pub mod infinite;
+mod pack;
+pub mod point;
+pub mod spot;
+
+pub use diffuse::{AreaShape, DiffuseEmission, DiffuseLight, TriangleCache};
+pub use distant::DistantLight;
+pub use distribution::{LightSampler, LightSamplerKind, SPATIAL_MAX_LIGHTS};
+pub use infinite::{EnvMap, EnvSampling, InfiniteLight};
+pub use pack::{dot3, lane3, pack_triangle_lights, splat3, TriangleLightPack, Vec3x4};
+pub use point::PointLight;
+pub use spot::SpotLight;
+
+use crate::accel::Geometry;
+use crate::geometry::{luminance, Ray};
+use crate::shapes::SurfacePoint;
+use crate::scene::{Kind, ParamValues, Report, Support};
+use bvh::LightBounds;
+use glam::{DMat4, Vec2, Vec3};
+
+/// What a `LightSource` kind builds from its parameters and the CTM
+/// (light-to-world); `None` when pbrt-v3's checks refuse the light (the
+/// builder has said why).
+pub type LightBuild = fn(&ParamValues, DMat4, &mut dyn Report) -> Option<Light>;
+
+/// One `LightSource` type: its pbrt-v3 name, its parameters, its builder.
+pub type LightKind = Kind<LightBuild>;
+
+/// Every light type pbrt-v3's `MakeLight` knows, in its order.
+pub static LIGHTS: &[LightKind] = &[
+    point::KIND,
+    spot::KIND,
+    unsupported(
+        "goniometric",
+        "a point light whose intensity over directions is an image (goniometric diagram)",
+    ),
+    unsupported(
+        "projection",
+        "a point light projecting an image through a frustum",
+    ),
+    distant::KIND,
+    infinite::KIND,
+];
+
+/// What an `AreaLightSource` kind builds from its parameters: the emission
+/// of the shapes that follow it (each shape's light is made from it when
+/// the scene is built, [`DiffuseLight::new`]).
+pub type AreaLightBuild = fn(&ParamValues, &mut dyn Report) -> DiffuseEmission;
+
+/// One `AreaLightSource` type.
+pub type AreaLightKind = Kind<AreaLightBuild>;
+
+/// Every area light type pbrt-v3's `MakeAreaLight` knows.
+pub static AREA_LIGHTS: &[AreaLightKind] = &[diffuse::KIND];
+
+const fn unsupported(name: &'static str, doc: &'static str) -> LightKind {
+    LightKind {
+        name,
+        aliases: &[],
+        support: Support::Unsupported(doc),
+        params: &[],
+        doc,
+        build: |_, _, _| None,
+    }
+}
+
+/// A light sample as seen from a reference point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    pub li: Vec3,
+    pub wi: Vec3,
+    /// Solid-angle density (1 for delta lights).
+    pub pdf: f32,
+    /// The shadow ray to test; unoccluded means the light is seen.
+    pub shadow: Ray,
+}
+
+/// What every light type does (pbrt-v3's `Light` interface). The defaults
+/// are those of a light that rays cannot hit and that is not at infinity.
+pub trait LightModel {
+    /// A delta light (a point or a direction) cannot be hit by rays: no
+    /// BSDF sample for it in MIS.
+    fn is_delta(&self) -> bool;
+
+    /// Seen by rays that escape the scene ([`LightModel::le`]).
+    fn is_infinite(&self) -> bool {
+        false
+    }
+
+    /// At infinity (distant and infinite lights): no bounds in the light
+    /// BVH, chosen apart from it.
+    fn at_infinity(&self) -> bool {
+        false
+    }
+
+    /// Shadow samples a `directlighting` "all" estimate takes.
+    fn n_samples(&self) -> u32 {
+        1
+    }
+
+    /// The sample count `--quick` divides, for lights that have one.
+    fn n_samples_mut(&mut self) -> Option<&mut u32> {
+        None
+    }
+
+    /// Emitted power (pbrt-v3's `Power()`), as RGB.
+    fn power(&self) -> Vec3;
+
+    /// Emitted radiance of an area light at a point with normal `n`,
+    /// towards `w`.
+    #[inline]
+    fn emitted(&self, _n: Vec3, _w: Vec3) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    /// Radiance arriving along an escaping ray of direction `d` (pbrt-v3's
+    /// `Le`).
+    #[inline]
+    fn le(&self, _d: Vec3) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    /// luminance(Li)/pdf at `p` for one sample (not yet made finite and
+    /// non-negative): the spatial light distribution's estimate.
+    fn contribution(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
+        contribution_by_sampling(self, p, u, geom)
+    }
+
+    /// Sample incident light at `r` (pbrt-v3's `Sample_Li`). Visibility is
+    /// not tested here: the caller traces `shadow`.
+    fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample>;
+
+    /// Solid-angle density of `sample_li` producing direction `wi` from `r`
+    /// (pbrt-v3's `Pdf_Li`); 0 when `wi` cannot come from this light.
+    #[inline]
+    fn pdf_li(&self, _r: &SurfacePoint, _wi: Vec3, _geom: &Geometry) -> f32 {
+        0.0
+    }
+
+    /// `pdf_li` for the direction of `ray`, the ray spawned from `r` in
+    /// that direction.
+    #[inline]
+    fn pdf_li_ray(&self, _r: &SurfacePoint, _ray: &Ray, _geom: &Geometry) -> f32 {
+        0.0
+    }
+
+    /// Bounds for the light BVH (pbrt-v4's `Bounds()`); `None` for lights
+    /// at infinity.
+    fn bounds(&self, _geom: &Geometry) -> Option<LightBounds> {
+        None
+    }
+
+    /// What the light needs of the built scene (pbrt-v3's `Preprocess`:
+    /// the scene's bounding radius for distant and infinite lights).
+    fn preprocess(&mut self, _geom: &Geometry) {}
+}
+
+/// [`LightModel::contribution`] by one `sample_li` from a point with no
+/// normal and no error bounds (pbrt-v3 also ignores visibility here).
+pub fn contribution_by_sampling<L: LightModel + ?Sized>(
+    light: &L,
+    p: Vec3,
+    u: Vec2,
+    geom: &Geometry,
+) -> f32 {
+    let r = SurfacePoint {
+        p,
+        p_error: Vec3::ZERO,
+        n: Vec3::ZERO,
+        ns: Vec3::ZERO,
+    };
+    match light.sample_li(&r, u, geom) {
+        Some(s) if s.pdf > 0.0 => luminance(s.li) / s.pdf,
+        _ => 0.0,
+    }
+}
+
+/// The closed set of lights: each variant is one file's struct, and every
+/// method matches and delegates.
+macro_rules! lights {
+    ($($(#[$doc:meta])* $variant:ident($ty:ty) = $kind:expr,)*) => {
+        #[derive(Clone, Debug)]
+        pub enum Light {
+            $($(#[$doc])* $variant($ty),)*
+        }
+        $(impl From<$ty> for Light {
+            fn from(l: $ty) -> Light {
+                Light::$variant(l)
+            }
+        })*
+        impl Light {
+            /// The name of its kind in the table.
+            pub fn name(&self) -> &'static str {
+                match self { $(Light::$variant(_) => $kind.name,)* }
+            }
+            #[inline]
+            pub fn is_delta(&self) -> bool {
+                match self { $(Light::$variant(l) => l.is_delta(),)* }
+            }
+            pub fn is_infinite(&self) -> bool {
+                match self { $(Light::$variant(l) => l.is_infinite(),)* }
+            }
+            pub fn at_infinity(&self) -> bool {
+                match self { $(Light::$variant(l) => l.at_infinity(),)* }
+            }
+            pub fn n_samples(&self) -> u32 {
+                match self { $(Light::$variant(l) => l.n_samples(),)* }
+            }
+            pub fn n_samples_mut(&mut self) -> Option<&mut u32> {
+                match self { $(Light::$variant(l) => l.n_samples_mut(),)* }
+            }
+            /// Luminance of the emitted power (pbrt-v3's `Power().y()`), ≥ 0.
+            pub fn power(&self) -> f32 {
+                luminance(match self { $(Light::$variant(l) => l.power(),)* }).max(0.0)
+            }
+            #[inline]
+            pub fn emitted(&self, n: Vec3, w: Vec3) -> Vec3 {
+                match self { $(Light::$variant(l) => l.emitted(n, w),)* }
+            }
+            #[inline]
+            pub fn le(&self, d: Vec3) -> Vec3 {
+                match self { $(Light::$variant(l) => l.le(d),)* }
+            }
+            /// A cheap estimate of luminance(Li)/pdf at a point in space,
+            /// for the spatial light distribution: finite and ≥ 0.
+            pub fn contribution_estimate(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
+                let c = match self { $(Light::$variant(l) => l.contribution(p, u, geom),)* };
+                if c.is_finite() {
+                    c.max(0.0)
+                } else {
+                    0.0
+                }
+            }
+            #[inline]
+            pub fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample> {
+                match self { $(Light::$variant(l) => l.sample_li(r, u, geom),)* }
+            }
+            #[inline]
+            pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
+                match self { $(Light::$variant(l) => l.pdf_li(r, wi, geom),)* }
+            }
+            #[inline]
+            pub fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Geometry) -> f32 {
+                match self { $(Light::$variant(l) => l.pdf_li_ray(r, ray, geom),)* }
+            }
+            pub fn bounds(&self, geom: &Geometry) -> Option<LightBounds> {
+                match self { $(Light::$variant(l) => l.bounds(geom),)* }
+            }
+            pub fn preprocess(&mut self, geom: &Geometry) {
+                match self { $(Light::$variant(l) => l.preprocess(geom),)* }
+            }
+        }
+    };
+}
+
+lights! {
+    /// An area light on one triangle or analytic shape.
+    Diffuse(DiffuseLight) = diffuse::KIND,
+    Point(PointLight) = point::KIND,
+    Spot(SpotLight) = spot::KIND,
+    Distant(DistantLight) = distant::KIND,
+    Infinite(InfiniteLight) = infinite::KIND,
+}

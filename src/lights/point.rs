@@ -1,0 +1,100 @@
+//! `point`: an isotropic point light (pbrt-v3's `PointLight`).
+//!
+//! | parameter | type | pbrt-v3 default | |
+//! |---|---|---|---|
+//! | `I` | spectrum | 1 | radiant intensity |
+//! | `scale` | spectrum or float | 1 | multiplies `I` (pbrt-v3 reads a spectrum; pbrs also takes a float) |
+//! | `from` | point3 | 0 0 0 | position |
+//!
+//! As pbrt-v3's `CreatePointLight`, light-to-world is Translate(`from`) ·
+//! CTM, so the light sits at CTM·origin + `from` (not CTM·`from` when the
+//! CTM scales or rotates).
+
+use super::bvh::LightBounds;
+use super::{LightKind, LightModel, LightSample};
+use crate::accel::Geometry;
+use crate::geometry::{luminance, spawn_ray_to_point, Bounds3};
+use crate::shapes::SurfacePoint;
+use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::f32::consts::PI;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::spectrum_any("I", [1.0; 3], "radiant intensity"),
+    ParamSpec::spectrum_or_float(
+        "scale",
+        [1.0; 3],
+        "multiplies I (a spectrum in pbrt-v3; pbrs also takes a float)",
+    ),
+    ParamSpec::point3(
+        "from",
+        [0.0; 3],
+        "position, added to CTM·origin (light-to-world = Translate(from)·CTM)",
+    ),
+];
+
+pub const KIND: LightKind = LightKind {
+    name: "point",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "an isotropic point light of intensity I·scale",
+    build: |p, ctm, _| Some(PointLight::new(p, ctm).into()),
+};
+
+#[derive(Clone, Copy, Debug)]
+pub struct PointLight {
+    /// World-space position.
+    pub p: Vec3,
+    /// `I`·`scale`.
+    pub intensity: Vec3,
+}
+
+impl PointLight {
+    pub fn new(p: &ParamValues, ctm: DMat4) -> PointLight {
+        let intensity = p.spectrum("I") * p.spectrum("scale");
+        let from = p.point("from");
+        PointLight {
+            p: (ctm.transform_point3(DVec3::ZERO) + from).as_vec3(),
+            intensity,
+        }
+    }
+}
+
+impl LightModel for PointLight {
+    #[inline]
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    fn power(&self) -> Vec3 {
+        4.0 * PI * self.intensity
+    }
+
+    #[inline]
+    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+        let d = self.p - r.p;
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            li: self.intensity / d2,
+            wi: d / d2.sqrt(),
+            pdf: 1.0,
+            shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
+        })
+    }
+
+    /// pbrt-v4's: a point emitting in every direction, φ = 4π·I.
+    fn bounds(&self, _geom: &Geometry) -> Option<LightBounds> {
+        Some(LightBounds {
+            bounds: Bounds3::from_point(self.p),
+            w: Vec3::Z,
+            phi: 4.0 * PI * luminance(self.intensity),
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        })
+    }
+}

@@ -1,0 +1,397 @@
+//! Samplers: where the sample values of every pixel sample come from.
+//!
+//! [`Sampler`] is an enum (no dynamic dispatch per sample), `Clone + Send`:
+//! each tile clones one. Positioning is stateless: after
+//! [`Sampler::start_pixel_sample`]`(pixel, index)` the values returned are a
+//! function of (pixel, index, seed) and of the calls made since, never of
+//! earlier pixels or of the thread. Every value is in `[0, 1)`.
+//!
+//! Halton follows pbrt-v3's `HaltonSampler` + `GlobalSampler`: one global
+//! sequence over the image whose first two dimensions are the pixel position.
+
+pub mod halton;
+pub mod lowdiscrepancy;
+pub mod random;
+pub mod stratified;
+
+pub use halton::HaltonSampler;
+pub use random::RandomSampler;
+pub use stratified::StratifiedSampler;
+
+use crate::geometry::Bounds2i;
+use crate::scene::{Kind, ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind, Support};
+use glam::{IVec2, Vec2};
+
+/// What a sampler kind builds from its parameters: the sampler's settings
+/// (a typed struct, since the command line edits them: `--spp`, `--quick`).
+pub type SamplerBuild = fn(&ParamValues, &mut dyn Report) -> SamplerDesc;
+
+/// One sampler kind: its pbrt-v3 name, its parameters, its builder.
+pub type SamplerKindEntry = Kind<SamplerBuild>;
+
+/// Every sampler pbrt-v3's `MakeSampler` knows (an unknown one is an error).
+pub static SAMPLERS: &[SamplerKindEntry] = &[
+    halton::KIND,
+    random::KIND,
+    stratified::KIND,
+    SOBOL,
+    ZERO_TWO_SEQUENCE,
+    MAX_MIN_DIST,
+];
+
+/// The most samples per pixel pbrs takes (each sample index must fit the
+/// samplers' 32-bit arithmetic with room to spare).
+pub const MAX_SAMPLES: i64 = 1 << 24;
+
+/// A sample count parameter, checked to be in 1..=[`MAX_SAMPLES`]
+/// (an error otherwise, and the default).
+pub fn count(p: &ParamValues, name: &'static str, default: u32, report: &mut dyn Report) -> u32 {
+    let v = p.int(name) as i64;
+    if !(1..=MAX_SAMPLES).contains(&v) {
+        report.error(
+            Some(name),
+            format!("sample count \"{name}\" is {v}: it must be between 1 and {MAX_SAMPLES}"),
+            "out of range",
+        );
+        return default;
+    }
+    v as u32
+}
+
+const PIXELSAMPLES_16: ParamSpec = ParamSpec::int("pixelsamples", 16, "samples per pixel");
+const DIMENSIONS: ParamSpec = ParamSpec::int(
+    "dimensions",
+    4,
+    "dimensions sampled with the sampler's own pattern (read; pbrs's samplers use their pattern for every dimension)",
+);
+
+/// A pbrt-v3 sampler pbrs renders with `halton`, with a warning.
+fn substituted(kind: SamplerKind, p: &ParamValues, report: &mut dyn Report) -> SamplerDesc {
+    let name = match kind {
+        SamplerKind::Sobol => "sobol",
+        SamplerKind::ZeroTwoSequence => "02sequence",
+        _ => "maxmindist",
+    };
+    report.warn(
+        None,
+        format!("sampler \"{name}\" is not implemented: rendered with the halton sampler (same expected image, different noise)"),
+        "rendered with halton",
+    );
+    SamplerDesc {
+        kind,
+        pixel_samples: count(p, "pixelsamples", 16, report),
+        sample_pixel_center: false,
+    }
+}
+
+const SUBSTITUTED: &str =
+    "rendered with `halton` (same expected image, different noise), with a warning";
+
+const SOBOL: SamplerKindEntry = SamplerKindEntry {
+    name: "sobol",
+    aliases: &[],
+    support: Support::Unsupported(SUBSTITUTED),
+    params: &[PIXELSAMPLES_16],
+    doc: "pbrt-v3's SobolSampler",
+    build: |p, r| substituted(SamplerKind::Sobol, p, r),
+};
+
+const ZERO_TWO_SEQUENCE: SamplerKindEntry = SamplerKindEntry {
+    name: "02sequence",
+    aliases: &["lowdiscrepancy"],
+    support: Support::Unsupported(SUBSTITUTED),
+    params: &[PIXELSAMPLES_16, DIMENSIONS],
+    doc: "pbrt-v3's ZeroTwoSequenceSampler",
+    build: |p, r| substituted(SamplerKind::ZeroTwoSequence, p, r),
+};
+
+const MAX_MIN_DIST: SamplerKindEntry = SamplerKindEntry {
+    name: "maxmindist",
+    aliases: &[],
+    support: Support::Unsupported(SUBSTITUTED),
+    params: &[PIXELSAMPLES_16, DIMENSIONS],
+    doc: "pbrt-v3's MaxMinDistSampler",
+    build: |p, r| substituted(SamplerKind::MaxMinDist, p, r),
+};
+
+/// What a camera needs to generate a ray.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct CameraSample {
+    /// Position on the film in raster coordinates (pixel + offset in [0,1)).
+    pub p_film: Vec2,
+    pub p_lens: Vec2,
+    pub time: f32,
+}
+
+#[derive(Clone, Debug)]
+pub enum Sampler {
+    Halton(HaltonSampler),
+    Random(RandomSampler),
+    Stratified(StratifiedSampler),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Sampler::Halton($s) => $e,
+            Sampler::Random($s) => $e,
+            Sampler::Stratified($s) => $e,
+        }
+    };
+}
+
+impl Sampler {
+    /// Builds the sampler for `desc`. Kinds not implemented (sobol,
+    /// 02sequence, maxmindist) map to Halton. `sample_bounds` is the film's
+    /// sample bounds; `seed` changes scrambling and random streams (seed 0 is
+    /// pbrt-v3's own Halton permutations).
+    pub fn new(desc: &SamplerDesc, sample_bounds: Bounds2i, seed: u64) -> Sampler {
+        let spp = desc.pixel_samples.max(1);
+        match desc.kind {
+            SamplerKind::Random => Sampler::Random(RandomSampler::new(spp, seed)),
+            SamplerKind::Stratified {
+                jitter,
+                xsamples,
+                ysamples,
+            } => Sampler::Stratified(StratifiedSampler::new(
+                xsamples, ysamples, spp, jitter, seed,
+            )),
+            SamplerKind::Halton
+            | SamplerKind::Sobol
+            | SamplerKind::ZeroTwoSequence
+            | SamplerKind::MaxMinDist => Sampler::Halton(HaltonSampler::new(
+                spp,
+                sample_bounds,
+                desc.sample_pixel_center,
+                seed,
+            )),
+        }
+    }
+
+    pub fn samples_per_pixel(&self) -> u32 {
+        dispatch!(self, s => s.samples_per_pixel())
+    }
+
+    /// Bytes this copy of the sampler holds on the heap (its array store;
+    /// Halton's permutation tables are shared and not counted).
+    pub fn heap_bytes(&self) -> usize {
+        let a = dispatch!(self, s => &s.arrays);
+        a.data_1d.iter().map(|v| v.len() * 4).sum::<usize>()
+            + a.data_2d.iter().map(|v| v.len() * 8).sum::<usize>()
+    }
+
+    /// Asks for an array of `n` 1D values per sample. Call before rendering,
+    /// in the same order as the later `get_1d_array` calls.
+    pub fn request_1d_array(&mut self, n: u32) {
+        dispatch!(self, s => s.request_1d_array(n))
+    }
+
+    pub fn request_2d_array(&mut self, n: u32) {
+        dispatch!(self, s => s.request_2d_array(n))
+    }
+
+    /// The array size to request for `n` wanted values (no rounding needed
+    /// by the samplers here).
+    pub fn round_count(&self, n: u32) -> u32 {
+        n
+    }
+
+    /// Positions the sampler at sample `sample_index` of `pixel`.
+    #[inline]
+    pub fn start_pixel_sample(&mut self, pixel: IVec2, sample_index: u32) {
+        dispatch!(self, s => s.start_pixel_sample(pixel, sample_index))
+    }
+
+    /// `start_pixel_sample`, taking what the sampler computes once per
+    /// pixel from `at_pixel`, a sampler of the same kind already started at
+    /// `pixel` (so that the lanes of a batch do not each compute it again).
+    #[inline]
+    pub fn start_pixel_sample_from(&mut self, at_pixel: &Sampler, pixel: IVec2, sample_index: u32) {
+        if let (Sampler::Halton(h), Sampler::Halton(p)) = (&mut *self, at_pixel) {
+            h.take_pixel_offset(p);
+        }
+        self.start_pixel_sample(pixel, sample_index)
+    }
+
+    /// Whether lanes of a batch can each have a copy of this sampler at a
+    /// modest cost per pixel: not the stratified sampler, which computes
+    /// every sample of a pixel when it starts one.
+    pub fn batches_well(&self) -> bool {
+        !matches!(self, Sampler::Stratified(_))
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self) -> f32 {
+        dispatch!(self, s => s.get_1d())
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self) -> Vec2 {
+        dispatch!(self, s => s.get_2d())
+    }
+
+    /// Consumes a 2D sample whose value is not needed (a BSDF with no lobe
+    /// that would read it): the sampler is left where `get_2d` leaves it.
+    #[inline]
+    pub fn skip_2d(&mut self) {
+        match self {
+            Sampler::Halton(h) => h.skip_2d(),
+            _ => {
+                let _ = self.get_2d();
+            }
+        }
+    }
+
+    /// pbrt-v3's order: `p_film = pixel + get_2d()`, `time = get_1d()`,
+    /// `p_lens = get_2d()`. Call right after `start_pixel_sample`.
+    #[inline]
+    pub fn get_camera_sample(&mut self, pixel: IVec2) -> CameraSample {
+        self.camera_sample(pixel, true)
+    }
+
+    /// As `get_camera_sample`; with `lens == false` the time and lens
+    /// dimensions are consumed (later dimensions are the same) but their
+    /// values are not computed and read 0.5: for a pinhole camera without
+    /// motion, which never reads them.
+    #[inline(always)]
+    pub fn camera_sample(&mut self, pixel: IVec2, lens: bool) -> CameraSample {
+        let base = pixel.as_vec2();
+        // Keep p_film inside the pixel even when `pixel + offset` rounds up.
+        let top = Vec2::new(next_below(base.x + 1.0), next_below(base.y + 1.0));
+        let p_film = (base + self.get_2d()).min(top);
+        let (time, p_lens) = match self {
+            Sampler::Halton(h) if !lens => {
+                h.skip(3);
+                (0.5, Vec2::splat(0.5))
+            }
+            _ => {
+                let time = self.get_1d();
+                (time, self.get_2d())
+            }
+        };
+        CameraSample {
+            p_film,
+            p_lens,
+            time,
+        }
+    }
+
+    /// The next requested 1D array, if it has `n` entries; `None` once all
+    /// requested arrays were consumed for this sample (or on a size mismatch).
+    #[inline]
+    pub fn get_1d_array(&mut self, n: u32) -> Option<&[f32]> {
+        dispatch!(self, s => s.get_1d_array(n))
+    }
+
+    #[inline]
+    pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
+        dispatch!(self, s => s.get_2d_array(n))
+    }
+
+    /// The next requested 2D array's one value, if the next array has one
+    /// entry (as `get_2d_array(1)`, without a copy: Halton computes it
+    /// straight away).
+    #[inline]
+    pub fn get_2d_array1(&mut self) -> Option<Vec2> {
+        if let Sampler::Halton(h) = self {
+            return h.get_2d_array1();
+        }
+        self.get_2d_array(1).map(|a| a[0])
+    }
+
+    /// The next `out.len()` requested 2D arrays' values if each has one
+    /// entry (what as many `get_2d_array1` calls give, Halton's computed
+    /// together); false, with nothing consumed, otherwise (and always for
+    /// the other samplers, whose callers then take them one by one).
+    #[inline]
+    pub fn get_2d_arrays1(&mut self, out: &mut [Vec2]) -> bool {
+        match self {
+            Sampler::Halton(h) => h.get_2d_arrays1(out),
+            _ => false,
+        }
+    }
+
+    /// `get_2d_array` copied into `out` (cleared first): true if there was
+    /// an array, else `out` stays empty. Halton computes the values straight
+    /// into `out`.
+    #[inline]
+    pub fn fill_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
+        if let Sampler::Halton(h) = self {
+            return h.fill_2d_array(n, out);
+        }
+        out.clear();
+        match self.get_2d_array(n) {
+            Some(a) => {
+                out.extend_from_slice(a);
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// The largest `f32` below `x` (for finite, positive-step values).
+#[inline]
+fn next_below(x: f32) -> f32 {
+    if x > 0.0 {
+        f32::from_bits(x.to_bits() - 1)
+    } else if x == 0.0 {
+        -f32::from_bits(1)
+    } else {
+        f32::from_bits(x.to_bits() + 1)
+    }
+}
+
+/// Requested sample arrays and their current contents.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ArrayStore {
+    pub sizes_1d: Vec<u32>,
+    pub sizes_2d: Vec<u32>,
+    /// Each holds `size * copies` values: `copies` is 1 for samplers that fill
+    /// arrays per sample, `spp` for those that fill them per pixel.
+    pub data_1d: Vec<Vec<f32>>,
+    pub data_2d: Vec<Vec<Vec2>>,
+    pub next_1d: usize,
+    pub next_2d: usize,
+}
+
+impl ArrayStore {
+    pub fn request_1d(&mut self, n: u32, copies: u32) {
+        self.sizes_1d.push(n);
+        self.data_1d.push(vec![0.0; n as usize * copies as usize]);
+    }
+
+    pub fn request_2d(&mut self, n: u32, copies: u32) {
+        self.sizes_2d.push(n);
+        self.data_2d
+            .push(vec![Vec2::ZERO; n as usize * copies as usize]);
+    }
+
+    #[inline]
+    pub fn reset(&mut self) {
+        self.next_1d = 0;
+        self.next_2d = 0;
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self, n: u32, copy: usize) -> Option<&[f32]> {
+        let i = self.next_1d;
+        if i >= self.sizes_1d.len() || self.sizes_1d[i] != n {
+            return None;
+        }
+        self.next_1d += 1;
+        let start = copy * n as usize;
+        self.data_1d[i].get(start..start + n as usize)
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self, n: u32, copy: usize) -> Option<&[Vec2]> {
+        let i = self.next_2d;
+        if i >= self.sizes_2d.len() || self.sizes_2d[i] != n {
+            return None;
+        }
+        self.next_2d += 1;
+        let start = copy * n as usize;
+        self.data_2d[i].get(start..start + n as usize)
+    }
+}

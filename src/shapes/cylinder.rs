@@ -1,0 +1,312 @@
+//! pbrt-v3's `cylinder`: the tube x² + y² = `radius`² of its object space
+//! for z in [`zmin`, `zmax`] and φ in [0, `phimax`], open at both ends; its
+//! normal points away from the axis.
+//!
+//! | parameter | type  | pbrt-v3 default |
+//! |-----------|-------|-----------------|
+//! | `radius`  | float | 1               |
+//! | `zmin`    | float | -1              |
+//! | `zmax`    | float | 1               |
+//! | `phimax`  | float | 360 (degrees)   |
+//!
+//! Ray tests run in object space in f64; the hit is reprojected onto the
+//! tube, with pbrt-v3's object-space error bound γ3·|(x, y, 0)|. Area
+//! sampling is pbrt-v3's `Cylinder::Sample` (uniform in z and φ), density
+//! 1/(world area) (pbrt-v3 uses the object-space area).
+
+use super::quadric::{Analytic, QuadricHit};
+use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use crate::scene::{ParamSpec, ParamValues, Support};
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::float("radius", 1.0, "radius (> 0)"),
+    ParamSpec::float("zmin", -1.0, "lower end (pbrt-v3 orders zmin and zmax)"),
+    ParamSpec::float("zmax", 1.0, "upper end"),
+    PHIMAX,
+];
+
+pub const KIND: ShapeKind = ShapeKind {
+    name: "cylinder",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "a cylinder (or a sector of one) about the z axis. Open tube; zmin/zmax ordered, phimax clamped as pbrt-v3; radius ≤ 0: error; zmin = zmax or phimax 0: warning, skipped; area lights sampled uniformly in z and φ (pbrt-v3's `Cylinder::Sample`)",
+    build,
+};
+
+/// pbrt-v3's checks: a positive radius and finite ends (error), a
+/// non-empty extent (warning, skipped).
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+    let radius = p.float("radius");
+    let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
+    let phimax = p.float("phimax").clamp(0.0, 360.0);
+    if radius.is_nan()
+        || radius <= 0.0
+        || !radius.is_finite()
+        || !zmin.is_finite()
+        || !zmax.is_finite()
+    {
+        r.error(
+            Some("radius"),
+            format!("cylinder radius {radius} (zmin {zmin}, zmax {zmax}) is not a positive 32-bit float"),
+            "bad cylinder",
+        );
+        return None;
+    }
+    // pbrt-v3 orders zmin and zmax itself.
+    let (z0, z1) = (zmin.min(zmax), zmin.max(zmax));
+    if z0 >= z1 || phimax <= 0.0 {
+        r.warn(
+            None,
+            "cylinder with an empty extent (zmin = zmax or phimax 0): skipped".into(),
+            "empty cylinder",
+        );
+        return None;
+    }
+    at_origin(Cylinder::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+}
+
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::{gamma, Bounds3};
+use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
+use std::f64::consts::TAU;
+
+#[derive(Clone, Debug)]
+pub struct Cylinder {
+    /// The arguments of [`Cylinder::new`] but the placement: the shape as its
+    /// kind built it, placed again by [`Analytic::placed`].
+    pub args: (f32, f32, f32, f32),
+    pub radius: f64,
+    pub z_min: f64,
+    pub z_max: f64,
+    /// Radians.
+    pub phi_max: f64,
+    pub object_to_world: DMat4,
+    pub world_to_object: DMat4,
+    normal_matrix: DMat3,
+    det_abs: f64,
+    pub flip_normal: bool,
+    pub material: u32,
+    pub light: Option<u32>,
+    area: f32,
+}
+
+impl Cylinder {
+    pub fn new(
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        phi_max_deg: f32,
+        object_to_world: DMat4,
+        reverse: bool,
+        material: u32,
+    ) -> Cylinder {
+        let r = radius.abs() as f64;
+        let (zmin, zmax) = (z_min.min(z_max) as f64, z_min.max(z_max) as f64);
+        let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
+        let lin = DMat3::from_mat4(object_to_world);
+        let det = lin.determinant();
+        // World area: exact for similarities, a volume-based estimate
+        // otherwise (only light power reads it then; the density is exact).
+        let scale2 = det.abs().powf(2.0 / 3.0);
+        Cylinder {
+            args: (radius, z_min, z_max, phi_max_deg),
+            radius: r,
+            z_min: zmin,
+            z_max: zmax,
+            phi_max,
+            object_to_world,
+            world_to_object: object_to_world.inverse(),
+            normal_matrix: lin.inverse().transpose(),
+            det_abs: det.abs(),
+            flip_normal: reverse ^ (det < 0.0),
+            material,
+            light: None,
+            area: ((zmax - zmin) * r * phi_max * scale2) as f32,
+        }
+    }
+
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    pub fn is_valid(&self) -> bool {
+        self.world_to_object.is_finite()
+            && self.radius > 0.0
+            && self.z_max > self.z_min
+            && self.area > 0.0
+            && self.area.is_finite()
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        let r = self.radius;
+        let mut b = Bounds3::EMPTY;
+        for i in 0..8 {
+            let c = DVec3::new(
+                if i & 1 == 0 { -r } else { r },
+                if i & 2 == 0 { -r } else { r },
+                if i & 4 == 0 { self.z_min } else { self.z_max },
+            );
+            b = b.union_point(self.object_to_world.transform_point3(c).as_vec3());
+        }
+        let pad = (b.max.abs().max(b.min.abs())) * 4.0 * f32::EPSILON;
+        Bounds3 {
+            min: b.min - pad,
+            max: b.max + pad,
+        }
+    }
+
+    /// Closest hit with 0 < t < t_max (pbrt-v3's `Cylinder::Intersect`).
+    #[inline]
+    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, DVec3)> {
+        let oo = self.world_to_object.transform_point3(o.as_dvec3());
+        let od = self.world_to_object.transform_vector3(d.as_dvec3());
+        let a = od.x * od.x + od.y * od.y;
+        if a == 0.0 {
+            return None;
+        }
+        // Stable quadratic with the discriminant from the closest approach
+        // to the axis (as the sphere's).
+        let b = 2.0 * (od.x * oo.x + od.y * oo.y);
+        let (vx, vy) = (oo.x - b / (2.0 * a) * od.x, oo.y - b / (2.0 * a) * od.y);
+        let len = (vx * vx + vy * vy).sqrt();
+        let disc = 4.0 * a * (self.radius + len) * (self.radius - len);
+        if disc < 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        let q = if b < 0.0 {
+            -0.5 * (b - root)
+        } else {
+            -0.5 * (b + root)
+        };
+        let c = oo.x * oo.x + oo.y * oo.y - self.radius * self.radius;
+        let (mut t0, mut t1) = (q / a, if q != 0.0 { c / q } else { q / a });
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        let t_max = t_max as f64;
+        for t in [t0, t1] {
+            if !(t > 0.0 && t < t_max && t as f32 > 0.0) {
+                continue;
+            }
+            let mut p = oo + t * od;
+            let hit_r = (p.x * p.x + p.y * p.y).sqrt();
+            p.x *= self.radius / hit_r;
+            p.y *= self.radius / hit_r;
+            if p.z < self.z_min || p.z > self.z_max {
+                continue;
+            }
+            if self.phi_max < TAU && phi_of(p) > self.phi_max {
+                continue;
+            }
+            return Some((t as f32, p));
+        }
+        None
+    }
+
+    pub fn surface_point(&self, p_obj: DVec3) -> SurfacePoint {
+        let pw = self.object_to_world.transform_point3(p_obj);
+        let p = pw.as_vec3();
+        let obj_err = DVec3::new(p_obj.x.abs(), p_obj.y.abs(), 0.0) * gamma(3) as f64;
+        let lin = DMat3::from_mat4(self.object_to_world);
+        let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
+        let err = abs_lin * obj_err
+            + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
+                * gamma(3) as f64;
+        let mut n = (self.normal_matrix * DVec3::new(p_obj.x, p_obj.y, 0.0))
+            .normalize()
+            .as_vec3();
+        if self.flip_normal {
+            n = -n;
+        }
+        SurfacePoint {
+            p,
+            p_error: err.as_vec3() + p.abs() * f32::EPSILON,
+            n,
+            ns: n,
+        }
+    }
+
+    /// u = φ/φmax, v = (z − zmin)/(zmax − zmin); the Weingarten equations
+    /// for a tube give dn/du = dp/du / radius and dn/dv = 0.
+    pub fn diff_geom(&self, p_obj: DVec3) -> DiffGeom {
+        let u = phi_of(p_obj) / self.phi_max;
+        let v = (p_obj.z - self.z_min) / (self.z_max - self.z_min);
+        let dpdu = DVec3::new(-self.phi_max * p_obj.y, self.phi_max * p_obj.x, 0.0);
+        let dpdv = DVec3::new(0.0, 0.0, self.z_max - self.z_min);
+        let dndu_obj = dpdu / self.radius;
+        let lin = DMat3::from_mat4(self.object_to_world);
+        let (dpdu, dpdv) = ((lin * dpdu).as_vec3(), (lin * dpdv).as_vec3());
+        let dndu = (self.normal_matrix * dndu_obj).as_vec3();
+        let dndu = if dndu.is_finite() { dndu } else { Vec3::ZERO };
+        DiffGeom {
+            uv: Vec2::new(u as f32, v as f32),
+            dpdu,
+            dpdv,
+            dndu,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            shading_dndu: dndu,
+            ..DiffGeom::ZERO
+        }
+    }
+
+    /// Uniform in z and φ over the tube; density 1 / world area at the point.
+    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+        let z = self.z_min + (self.z_max - self.z_min) * u.x as f64;
+        let phi = self.phi_max * u.y as f64;
+        let p_obj = DVec3::new(self.radius * phi.cos(), self.radius * phi.sin(), z);
+        ShapeSample {
+            point: self.surface_point(p_obj),
+            pdf: self.area_density(p_obj),
+        }
+    }
+
+    /// dA_world / dA_obj = |det M| · |M^-T n_obj|.
+    #[inline]
+    pub fn area_density(&self, p_obj: DVec3) -> f32 {
+        let n_obj = DVec3::new(p_obj.x, p_obj.y, 0.0) / self.radius;
+        let obj_area = (self.z_max - self.z_min) * self.radius * self.phi_max;
+        (1.0 / (obj_area * self.det_abs * (self.normal_matrix * n_obj).length())) as f32
+    }
+}
+
+#[inline]
+fn phi_of(p: DVec3) -> f64 {
+    let phi = p.y.atan2(p.x);
+    if phi < 0.0 {
+        phi + TAU
+    } else {
+        phi
+    }
+}
+
+impl Analytic for Cylinder {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        let a = self.args;
+        Cylinder::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
+    }
+    fn valid(&self) -> bool {
+        self.is_valid()
+    }
+    #[inline]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
+        self.intersect(o, d, t_max)
+            .map(|(t, p)| (t, QuadricHit::Exact(p)))
+    }
+    #[inline]
+    fn point(&self, h: QuadricHit) -> SurfacePoint {
+        self.surface_point(h.point_and_error().0)
+    }
+    #[inline]
+    fn geom(&self, h: QuadricHit) -> DiffGeom {
+        self.diff_geom(h.point_and_error().0)
+    }
+    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
+        Some(self.sample_area(u))
+    }
+    fn density_at(&self, p_obj: DVec3) -> f32 {
+        self.area_density(p_obj)
+    }
+}

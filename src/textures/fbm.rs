@@ -1,0 +1,43 @@
+//! `fbm`: fractional Brownian motion of Perlin noise at the 3D-mapped
+//! point (pbrt-v3's `FBm`), the same value in every channel.
+//!
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `octaves` | integer | 8 | most octaves (fewer where the footprint is large) |
+//! | `roughness` | float | 0.5 | amplitude factor per octave (ω) |
+//!
+//! The parameters and their reading are shared with the other octave sum
+//! ([`super::noise::Octaves`]).
+
+use super::noise::{fbm, Octaves, OCTAVE_PARAMS};
+use super::{Class, MappingUse, Support, TexBuild, TexBuilder, TexValue, Texture, TextureClass};
+use crate::materials::ShadingContext;
+use crate::scene::Tex;
+
+pub const CLASS: TextureClass = TextureClass {
+    name: "fbm",
+    aliases: &[],
+    support: Support::Supported,
+    params: OCTAVE_PARAMS,
+    doc: "fractional Brownian motion (sum of noise octaves)",
+    build: TexBuild {
+        mapping: MappingUse::ThreeD,
+        float: Some(build::<f32>),
+        spectrum: Some(build::<glam::Vec3>),
+    },
+};
+
+pub struct Fbm(pub Octaves);
+
+fn build<T: TexValue>(b: &mut TexBuilder) -> Result<Tex<T>, String> {
+    Ok(Texture::new_handle(
+        b.name,
+        Class::Fbm(Fbm(Octaves::read(b))),
+    ))
+}
+
+impl Fbm {
+    pub fn eval(&self, sc: &ShadingContext) -> f32 {
+        self.0.eval(sc, fbm)
+    }
+}
