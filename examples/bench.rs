@@ -28,11 +28,11 @@
 //! `--runs N` repeats pbrs, baseline and Mitsuba alternately N times and
 //! reports each one's minimum wall time.
 
-use pbrs::loader::load_scene;
-use pbrs::render::driver::{peak_memory_bytes, render, RenderOptions};
 use pbrs::image::compare::compare;
 use pbrs::image::io::read_image;
 use pbrs::image::Image;
+use pbrs::loader::load_scene;
+use pbrs::render::driver::{peak_memory_bytes, render, RenderOptions};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;

@@ -9,8 +9,8 @@
 
 use glam::{DMat4, DVec3, Vec3};
 use pbrs::accel::{Geometry, Instance, Object};
-use pbrs::render::driver::peak_memory_bytes;
 use pbrs::geometry::Ray;
+use pbrs::render::driver::peak_memory_bytes;
 use pbrs::shapes::TriangleMesh;
 use std::process::Command;
 use std::sync::Arc;

@@ -9,9 +9,9 @@
 mod golden;
 
 use golden::{manifest, Check, PBRS_REFERENCE_RES, PBRS_REFERENCE_SPP};
+use pbrs::image::io::write_image;
 use pbrs::loader::load_scene;
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::image::io::write_image;
 use std::path::Path;
 
 fn main() {

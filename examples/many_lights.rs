@@ -11,10 +11,10 @@
 //! Strategies whose render would exceed a time limit at large n are still
 //! run: the table says what they cost.
 
-use pbrs::loader::load_scene_str;
-use pbrs::render::driver::{render, RenderOptions};
 use pbrs::image::compare::compare;
 use pbrs::image::Image;
+use pbrs::loader::load_scene_str;
+use pbrs::render::driver::{render, RenderOptions};
 use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;

@@ -8,11 +8,11 @@
 //! single-threaded. Compare two builds by running both in turn.
 
 use glam::Vec3;
-use pbrs::loader::load_scene;
 use pbrs::accel::{Geometry, Hit};
 use pbrs::geometry::{spawn_ray, spawn_ray_to_point, Ray};
-use pbrs::sampling::rng::Pcg32;
 use pbrs::integrators::RenderScene;
+use pbrs::loader::load_scene;
+use pbrs::sampling::rng::Pcg32;
 use std::path::Path;
 use std::time::Instant;
 

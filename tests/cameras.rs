@@ -8,11 +8,11 @@ mod common;
 
 use common::repo;
 use glam::{Vec2, Vec3};
-use pbrs::lang::parser::FileLoader;
-use pbrs::loader::{load_scene_str, load_scene_with, LoadFailure, LoadedScene};
 use pbrs::cameras::realistic::LensRay;
 use pbrs::cameras::{Camera, Projection, RealisticCamera};
 use pbrs::geometry::Ray;
+use pbrs::lang::parser::FileLoader;
+use pbrs::loader::{load_scene_str, load_scene_with, LoadFailure, LoadedScene};
 use pbrs::samplers::CameraSample;
 use pbrs::scene::SceneDescription;
 use std::collections::HashMap;

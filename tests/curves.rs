@@ -7,10 +7,10 @@
 mod common;
 use common::*;
 use glam::Vec3;
-use pbrs::loader::load_scene_str;
 use pbrs::geometry::Ray;
-use pbrs::sampling::Pcg32;
 use pbrs::integrators::RenderScene;
+use pbrs::loader::load_scene_str;
+use pbrs::sampling::Pcg32;
 use pbrs::shapes::{DiffGeom, SurfacePoint};
 
 fn load_text(text: &str) -> Result<pbrs::loader::LoadedScene, pbrs::loader::LoadFailure> {

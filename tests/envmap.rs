@@ -6,10 +6,10 @@
 //! of 8-bit maps, the per-scene cache and located errors for bad files.
 
 use glam::Vec3;
+use pbrs::image::Image;
 use pbrs::lang::FileLoader;
 use pbrs::loader::{load_scene_with, LoadFailure, LoadedScene};
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::image::Image;
 use pbrs::scene::{Light, SceneDescription};
 use std::collections::HashMap;
 use std::io::Cursor;

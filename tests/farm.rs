@@ -6,11 +6,11 @@
 mod common;
 
 use glam::Vec2;
-use pbrs::render::driver::{render, render_part, RenderOptions};
-use pbrs::image::io::write_image;
-use pbrs::render::film::part::{merge, read_part, tile_rect, Part, PartKind};
-use pbrs::image::Image;
 use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
+use pbrs::image::io::write_image;
+use pbrs::image::Image;
+use pbrs::render::driver::{render, render_part, RenderOptions};
+use pbrs::render::film::part::{merge, read_part, tile_rect, Part, PartKind};
 use pbrs::scene::SceneDescription;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -135,8 +135,7 @@ fn tiles_merge_to_the_full_render_byte_for_byte_for_every_filter() {
             let got = merged_bytes(&parts, &dir);
             assert!(got == want, "{name}, {n} tiles: merged EXR differs");
             // The parts really are the rows of the split.
-            let frame =
-                pbrs::geometry::Bounds2i::new(glam::IVec2::ZERO, glam::IVec2::new(40, 30));
+            let frame = pbrs::geometry::Bounds2i::new(glam::IVec2::ZERO, glam::IVec2::new(40, 30));
             for (k, p) in parts.iter().enumerate() {
                 assert_eq!(p.window, tile_rect(frame, k as u32, n));
             }

@@ -1,9 +1,9 @@
 //! Filters, film bounds, tiles and sample accumulation.
 
 use glam::{IVec2, Vec2, Vec3};
-use pbrs::render::film::{luminance, Film, FILTER_TABLE_WIDTH};
 use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
 use pbrs::geometry::Bounds2i;
+use pbrs::render::film::{luminance, Film, FILTER_TABLE_WIDTH};
 use pbrs::sampling::Pcg32;
 use pbrs::scene::FilmDesc;
 use rayon::prelude::*;

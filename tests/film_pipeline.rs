@@ -2,9 +2,9 @@
 //! parallel with one sampler clone each, merged in order.
 
 use glam::{Vec2, Vec3};
+use pbrs::filters::{BoxFilter, Filter, Gaussian};
 use pbrs::image::Image;
 use pbrs::render::film::Film;
-use pbrs::filters::{BoxFilter, Filter, Gaussian};
 use pbrs::samplers::Sampler;
 use pbrs::scene::{FilmDesc, SamplerDesc, SamplerKind};
 use rayon::prelude::*;

@@ -4,8 +4,8 @@
 //! table without a case here fails.
 
 use glam::Vec2;
-use pbrs::loader::load_scene_str;
 use pbrs::filters::{Filter, FILTERS};
+use pbrs::loader::load_scene_str;
 use std::path::Path;
 
 /// pbrt-v3's filter formulas in f64: the value at `p` for radius `r`.

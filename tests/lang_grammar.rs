@@ -379,8 +379,8 @@ fn reference_family_sections_are_generated_from_the_tables() {
 #[test]
 fn reference_lights_section_is_generated_from_the_tables() {
     let _one_writer = REFERENCE_LOCK.lock().unwrap_or_else(|e| e.into_inner());
-    use pbrs::loader::reference::{lights_section, splice_between, LIGHTS_BEGIN, LIGHTS_END};
     use pbrs::lights::{AREA_LIGHTS, LIGHTS};
+    use pbrs::loader::reference::{lights_section, splice_between, LIGHTS_BEGIN, LIGHTS_END};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar/REFERENCE.md");
     let doc = std::fs::read_to_string(&path).unwrap();
     let section = lights_section();

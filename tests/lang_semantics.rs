@@ -4,11 +4,11 @@ mod common;
 
 use common::{error_text as errors, load_text as load, warning_text as warnings};
 use glam::{DMat4, DVec3, Vec2, Vec3};
-use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
 use pbrs::cameras::Projection;
 use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
-use pbrs::shapes::Quadric;
+use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
 use pbrs::scene::*;
+use pbrs::shapes::Quadric;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 

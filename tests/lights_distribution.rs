@@ -15,9 +15,9 @@
 mod common;
 use common::*;
 use glam::{Vec2, Vec3};
+use pbrs::integrators::RenderScene;
 use pbrs::lights::{AreaShape, DiffuseLight, Light, LightSampler, LightSamplerKind};
 use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
-use pbrs::integrators::RenderScene;
 use pbrs::shapes::SurfacePoint;
 use std::f64::consts::PI;
 

@@ -16,13 +16,13 @@ mod common;
 
 use common::{load_text, warning_text};
 use glam::{Vec2, Vec3};
-use pbrs::loader::LoadedScene;
 use pbrs::geometry::luminance;
-use pbrs::lights::{Light, AREA_LIGHTS, LIGHTS};
-use pbrs::sampling::Pcg32;
 use pbrs::integrators::RenderScene;
-use pbrs::shapes::SurfacePoint;
+use pbrs::lights::{Light, AREA_LIGHTS, LIGHTS};
+use pbrs::loader::LoadedScene;
+use pbrs::sampling::Pcg32;
 use pbrs::scene::kind;
+use pbrs::shapes::SurfacePoint;
 use std::f32::consts::PI;
 
 struct Case {

@@ -6,9 +6,9 @@ mod common;
 
 use common::*;
 use pbrs::image::compare::compare;
+use pbrs::integrators::RenderScene;
 use pbrs::lights::{LightSampler, LightSamplerKind};
 use pbrs::sampling::Pcg32;
-use pbrs::integrators::RenderScene;
 use pbrs::scene::{IntegratorSettings, LightSampleStrategy};
 
 /// `n` small downward-facing emissive triangles scattered over a floor

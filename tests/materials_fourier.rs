@@ -11,10 +11,10 @@ mod common;
 
 use common::{bsdf_of, materials_of, render_at, repo};
 use glam::{Vec2, Vec3};
+use pbrs::bxdf::{BxdfModel, FourierBsdf};
 use pbrs::lang::FileLoader;
 use pbrs::loader::fourier::read_bsdf;
 use pbrs::loader::{load_scene, load_scene_with};
-use pbrs::bxdf::{BxdfModel, FourierBsdf};
 use pbrs::materials::{Bsdf, BxdfFlags, Material};
 use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::sampling::Pcg32;

@@ -9,12 +9,12 @@ mod common;
 use common::{error_text as errors, load_text as load, warning_text as warnings};
 
 use glam::{DMat4, Vec2, Vec3};
-use pbrs::render::driver::{render, RenderOptions};
+use pbrs::geometry::{Bounds2i, Ray};
 use pbrs::image::compare::compare;
 use pbrs::image::Image;
-use pbrs::geometry::{Bounds2i, Ray};
 use pbrs::media::{phase_hg, HenyeyGreenstein, Medium, MEDIA};
 use pbrs::media::{Coefficients, Density, Grid, Homogeneous};
+use pbrs::render::driver::{render, RenderOptions};
 use pbrs::samplers::Sampler;
 use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::scene::{SamplerDesc, SamplerKind, SceneDescription};

@@ -6,9 +6,9 @@
 
 mod common;
 use common::*;
+use pbrs::image::Image;
 use pbrs::loader::load_scene_str;
 use pbrs::loader::ply::read_ply;
-use pbrs::image::Image;
 use pbrs::scene::MeshData;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

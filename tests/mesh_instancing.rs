@@ -5,8 +5,8 @@
 
 mod common;
 use common::*;
-use pbrs::loader::load_scene_str;
 use pbrs::image::compare::mean_rgb;
+use pbrs::loader::load_scene_str;
 use std::process::Command;
 
 const DIRECT: &str = r#"
@@ -52,12 +52,7 @@ WorldEnd
 
 const DRAGON: &str = r#"Shape "plymesh" "string filename" [ "meshes/dragon_43k.ply" ]"#;
 
-fn render(
-    template: &str,
-    transform: &str,
-    material: &str,
-    shape: &str,
-) -> pbrs::image::Image {
+fn render(template: &str, transform: &str, material: &str, shape: &str) -> pbrs::image::Image {
     let text = template
         .replace("SHAPE", shape)
         .replace("TRANSFORM", transform)
@@ -184,7 +179,6 @@ fn hundred_dragons_fit_in_twice_the_memory_of_one() {
 fn instanced_scene_does_not_depend_on_thread_count() {
     let one = render_at(load("scenes/instancing-dragons.pbrt"), 48, 2, Some(1)).0;
     let two = render_at(load("scenes/instancing-dragons.pbrt"), 48, 2, Some(2)).0;
-    let bits =
-        |i: &pbrs::image::Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    let bits = |i: &pbrs::image::Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&one), bits(&two));
 }

@@ -434,8 +434,8 @@ fn motion_bounds_hold_rotations_up_to_half_a_turn() {
 
 use glam::{Vec2, Vec3};
 use pbrs::geometry::Ray;
-use pbrs::samplers::CameraSample;
 use pbrs::integrators::RenderScene;
+use pbrs::samplers::CameraSample;
 
 fn render_scene(text: &str) -> RenderScene {
     RenderScene::new(&load(text).scene)

@@ -11,11 +11,11 @@
 //!   warnings, never a panic or a hang.
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
-use pbrs::loader::load_scene_str;
 use pbrs::geometry::{offset_ray_origin, Frame};
+use pbrs::integrators::RenderScene;
+use pbrs::loader::load_scene_str;
 use pbrs::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
 use pbrs::sampling::Pcg32;
-use pbrs::integrators::RenderScene;
 use pbrs::shapes::{
     hyperboloid_coefficients, Cone, Hyperboloid, Paraboloid, Quadric, SurfacePoint,
 };

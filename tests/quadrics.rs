@@ -15,11 +15,11 @@
 mod common;
 use common::*;
 use glam::{DMat4, DVec3, Vec2, Vec3};
-use pbrs::loader::load_scene_str;
 use pbrs::geometry::{offset_ray_origin, Frame};
-use pbrs::lights::{AreaShape, DiffuseLight, Light};
-use pbrs::sampling::Pcg32;
 use pbrs::integrators::RenderScene;
+use pbrs::lights::{AreaShape, DiffuseLight, Light};
+use pbrs::loader::load_scene_str;
+use pbrs::sampling::Pcg32;
 use pbrs::shapes::{Cylinder, Disk, SurfacePoint};
 use std::f64::consts::PI;
 use std::path::Path;

@@ -10,8 +10,8 @@
 mod common;
 use common::*;
 use glam::{DVec3, Vec3};
-use pbrs::loader::load_scene_str;
 use pbrs::image::compare::mean_rgb;
+use pbrs::loader::load_scene_str;
 use pbrs::scene::{Geometry, MeshData};
 use std::sync::Arc;
 

@@ -3,8 +3,8 @@
 
 mod common;
 use common::*;
-use pbrs::loader::load_scene_str;
 use pbrs::image::compare::{mean_rgb, relative_mse};
+use pbrs::loader::load_scene_str;
 use std::process::Command;
 
 /// A scene of `scenes/` (camera `LookAt 0 1 6.8  0 1 0  0 1 0`) with

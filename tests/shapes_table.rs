@@ -4,8 +4,8 @@
 //! parameter. A kind of the table without a case here fails.
 
 use pbrs::loader::load_scene_str;
-use pbrs::shapes::{kind_name, SHAPES};
 use pbrs::scene::Geometry;
+use pbrs::shapes::{kind_name, SHAPES};
 use std::path::{Path, PathBuf};
 
 /// One kind's case: a good statement, what it builds (kind name, triangle

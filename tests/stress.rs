@@ -3,8 +3,8 @@
 
 mod common;
 use common::*;
-use pbrs::render::driver::RenderStats;
 use pbrs::image::Image;
+use pbrs::render::driver::RenderStats;
 
 fn render_file(rel: &str, res: Option<u32>, spp: Option<u32>) -> (Image, RenderStats) {
     let mut desc = load(rel);

@@ -7,8 +7,8 @@
 mod tex_common;
 
 use glam::{DMat4, Vec2, Vec3};
-use pbrs::textures::{Class, Mapping2D, TEXTURES};
 use pbrs::scene::{FloatTex, SpectrumTex, Tex};
+use pbrs::textures::{Class, Mapping2D, TEXTURES};
 use std::f64::consts::PI;
 use tex_common::*;
 

@@ -5,10 +5,10 @@
 mod tex_common;
 
 use glam::{Vec2, Vec3};
-use pbrs::render::driver::{render, RenderOptions};
 use pbrs::geometry::Ray;
-use pbrs::materials::{BsdfContext, Material};
 use pbrs::integrators::RenderScene;
+use pbrs::materials::{BsdfContext, Material};
+use pbrs::render::driver::{render, RenderOptions};
 use pbrs::scene::Geometry;
 use tex_common::*;
 

@@ -4,9 +4,9 @@
 //! that folder's README: one sample at each pixel centre, a distant light,
 //! so a pixel is a texture value times a cosine, without noise).
 
+use pbrs::image::io::read_image;
 use pbrs::loader::load_scene_str;
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::image::io::read_image;
 use std::path::PathBuf;
 
 const QUAD: &str = "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point P\" [-3 -3 0 3 -3 0 3 3 0 -3 3 0] \"point2 uv\" [0 0 1 0 1 1 0 1]";

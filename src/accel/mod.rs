@@ -19,10 +19,10 @@ mod split;
 pub use bvh4::BuildWork;
 
 use crate::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
+use crate::scene::AnimatedTransform;
 use crate::shapes::{
     intersect_triangle, DiffGeom, Quadric, QuadricHit, SurfacePoint, TriangleMesh,
 };
-use crate::scene::AnimatedTransform;
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
 use obvhs::aabb::Aabb;

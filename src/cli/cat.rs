@@ -27,11 +27,11 @@
 
 use super::render::scenes_label;
 use super::Args;
+use crate::image::io::write_atomic;
 use crate::lang::params::{Param, ParamList, ParamType, Values};
 use crate::lang::parser::{resolve, ActiveKind, DiskLoader, Name};
 use crate::lang::{DirKind, Directive, Stmt};
 use crate::loader::{parse_inputs, print_diagnostics, read_scene_input, Parsed};
-use crate::image::io::write_atomic;
 use crate::materials::MATERIALS;
 use crate::scene::ParamKind;
 use std::fmt::Write as _;

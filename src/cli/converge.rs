@@ -4,10 +4,10 @@
 //! log-log plot (SVG) with fitted slopes, and a table of efficiencies
 //! 1/(MSE × time), the figure of merit of the seed text.
 
-use crate::loader::{load_scene, print_diagnostics};
-use crate::render::driver::{RenderOptions, Renderer};
 use crate::image::compare::compare;
 use crate::image::io::{read_image, write_atomic};
+use crate::loader::{load_scene, print_diagnostics};
+use crate::render::driver::{RenderOptions, Renderer};
 use clap::Args as ClapArgs;
 use std::fmt::Write as _;
 use std::path::PathBuf;

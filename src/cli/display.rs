@@ -17,8 +17,8 @@
 //! pixels near tile edges that later tiles' filter footprints changed). Like
 //! pbrt-v4, the image is left open in the viewer when the render ends.
 
-use crate::image::Image;
 use crate::geometry::Bounds2i;
+use crate::image::Image;
 use std::io::Write;
 use std::net::{TcpStream, ToSocketAddrs};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};

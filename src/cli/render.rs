@@ -4,13 +4,13 @@
 
 use super::display::Display;
 use super::Args;
+use crate::image::io::{check_output_path, format_for_path, write_image, ImageFormat};
+use crate::image::Image;
 use crate::loader::{load_scene_files_each, print_diagnostics};
 use crate::render::driver::{
     peak_memory_bytes, render_observed, render_part, ChunkDone, RenderOptions,
 };
-use crate::image::io::{check_output_path, format_for_path, write_image, ImageFormat};
 use crate::render::film::part::PartKind;
-use crate::image::Image;
 use crate::scene::{Light, SamplerKind, SceneDescription};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;

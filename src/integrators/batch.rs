@@ -9,10 +9,10 @@ use super::path::{path_step, PathParams, PathState};
 use super::{First, Integrator, Scratch};
 use crate::accel::Hit;
 use crate::geometry::{Ray, RayDiff};
+use crate::integrators::RenderScene;
 use crate::lights::TriangleLightPack;
 use crate::materials::Bsdf;
 use crate::samplers::Sampler;
-use crate::integrators::RenderScene;
 use glam::{Vec2, Vec3};
 
 /// The samples a thread renders together (see [`Integrator::li_batch`]):

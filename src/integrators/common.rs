@@ -6,13 +6,11 @@
 use super::Scratch;
 use crate::accel::{Hit, SurfaceHit};
 use crate::geometry::RayDiff;
+use crate::integrators::RenderScene;
 use crate::lights::LightSampler;
-use crate::materials::{
-    Bsdf, BsdfContext, BsdfSample, BxdfFlags, Material, ShadingContext,
-};
+use crate::materials::{Bsdf, BsdfContext, BsdfSample, BxdfFlags, Material, ShadingContext};
 use crate::samplers::Sampler;
 use crate::sampling::power_heuristic;
-use crate::integrators::RenderScene;
 use crate::shapes::{DiffGeom, SurfacePoint};
 use glam::{Vec2, Vec3};
 

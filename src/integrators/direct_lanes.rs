@@ -23,11 +23,11 @@
 use super::Scratch;
 use crate::accel::SurfaceHit;
 use crate::geometry::{offset_ray_origin, spawn_ray_from_to, Ray};
+use crate::integrators::RenderScene;
 use crate::lights::{dot3, lane3, splat3, TriangleLightPack, Vec3x4};
 use crate::materials::Bsdf;
 use crate::samplers::Sampler;
 use crate::sampling::{power_heuristic, sin_cos_quarter};
-use crate::integrators::RenderScene;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 

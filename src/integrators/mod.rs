@@ -18,9 +18,7 @@
 //! the runtime integrator from them.
 
 use crate::geometry::{Ray, RayDiff};
-use crate::lights::{
-    pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack,
-};
+use crate::lights::{pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack};
 use crate::materials::Bsdf;
 use crate::samplers::Sampler;
 use crate::scene::kind::{Kind, Report, Support};

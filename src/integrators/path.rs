@@ -15,13 +15,13 @@ use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
 use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::accel::Hit;
 use crate::geometry::{spawn_ray, Ray, RayDiff};
+use crate::integrators::RenderScene;
 use crate::lights::LightSampler;
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
-use crate::integrators::RenderScene;
-use crate::shapes::SurfacePoint;
 use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
+use crate::shapes::SurfacePoint;
 use glam::Vec3;
 
 pub const PARAMS: &[ParamSpec] = &[

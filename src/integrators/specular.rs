@@ -9,9 +9,9 @@ use super::{directlighting, whitted, Integrator, Scratch, MAX_PASS_THROUGH};
 use super::{DirectLightingSettings, WhittedSettings};
 use crate::accel::{Hit, SurfaceHit};
 use crate::geometry::{spawn_ray, Ray, RayDiff};
+use crate::integrators::RenderScene;
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
-use crate::integrators::RenderScene;
 use crate::shapes::DiffGeom;
 use glam::Vec3;
 

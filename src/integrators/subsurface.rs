@@ -7,9 +7,9 @@ use crate::accel::{Hit, SurfaceHit};
 use crate::bssrdf::probe::{find_exit, pdf_sp, probe_segment};
 use crate::bxdf::SwAdapter;
 use crate::geometry::Frame;
+use crate::integrators::RenderScene;
 use crate::materials::{Bsdf, BsdfSample, BxdfFlags, Material, ShadingContext};
 use crate::samplers::Sampler;
-use crate::integrators::RenderScene;
 use crate::shapes::DiffGeom;
 use glam::Vec3;
 

@@ -34,15 +34,15 @@ use super::subsurface::{sample_exit, subsurface_exit};
 use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH};
 use crate::accel::{Hit, SurfaceHit};
 use crate::geometry::{offset_ray_origin, spawn_ray, Ray, RayDiff, SHADOW_EPSILON};
+use crate::integrators::RenderScene;
 use crate::lights::LightSampler;
 use crate::materials::{Bsdf, BxdfFlags, Material};
 use crate::media::HenyeyGreenstein;
 use crate::samplers::Sampler;
 use crate::sampling::power_heuristic;
-use crate::integrators::RenderScene;
-use crate::shapes::SurfacePoint;
 use crate::scene::kind::Support;
 use crate::scene::ParamSpec;
+use crate::shapes::SurfacePoint;
 use glam::Vec3;
 
 /// The same parameters as `path`.

@@ -8,9 +8,9 @@
 
 use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
 use crate::accel::SurfaceHit;
+use crate::integrators::RenderScene;
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
-use crate::integrators::RenderScene;
 use crate::scene::kind::{Report, Support};
 use crate::scene::{ParamSpec, ParamValues};
 use glam::Vec3;

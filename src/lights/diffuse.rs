@@ -22,8 +22,8 @@ use super::bvh::LightBounds;
 use super::{contribution_by_sampling, AreaLightKind, LightModel, LightSample};
 use crate::accel::Geometry;
 use crate::geometry::{luminance, spawn_ray, spawn_ray_to, Bounds3, Ray};
-use crate::shapes::{sample_triangle_point, SurfacePoint};
 use crate::scene::{ParamSpec, ParamValues, Support};
+use crate::shapes::{sample_triangle_point, SurfacePoint};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 

@@ -16,8 +16,8 @@
 use super::{LightKind, LightModel, LightSample};
 use crate::accel::Geometry;
 use crate::geometry::spawn_ray_to_point;
-use crate::shapes::SurfacePoint;
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
+use crate::shapes::SurfacePoint;
 use glam::{DMat4, Vec2, Vec3};
 use std::f32::consts::PI;
 

@@ -30,8 +30,8 @@ pub use spot::SpotLight;
 
 use crate::accel::Geometry;
 use crate::geometry::{luminance, Ray};
-use crate::shapes::SurfacePoint;
 use crate::scene::{Kind, ParamValues, Report, Support};
+use crate::shapes::SurfacePoint;
 use bvh::LightBounds;
 use glam::{DMat4, Vec2, Vec3};
 

@@ -21,8 +21,8 @@ use super::bvh::{safe_acos, LightBounds};
 use super::{LightKind, LightModel, LightSample};
 use crate::accel::Geometry;
 use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame};
-use crate::shapes::SurfacePoint;
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
+use crate::shapes::SurfacePoint;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::f32::consts::PI;
 

@@ -6,10 +6,10 @@
 
 use super::kinds::{self, Buffered, Family, StatementReport, Unknown};
 use super::Ctx;
+use crate::cameras::{CameraInput, FileSource, CAMERAS};
 use crate::lang::params::ParamList;
 use crate::lang::parser::Name;
 use crate::lang::Loc;
-use crate::cameras::{CameraInput, FileSource, CAMERAS};
 use crate::scene::{CameraDesc, FilmDesc};
 use glam::DMat4;
 use std::path::PathBuf;

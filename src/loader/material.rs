@@ -4,8 +4,8 @@
 //! override its material's, a texture reference before a value in each list.
 
 use super::color::sampled_to_rgb;
-use super::entities::{find_spectrum, float_opt, one, spectrum_value};
 use super::fourier::fourier_table;
+use super::lookup::{find_spectrum, float_opt, one, spectrum_value};
 use super::state::closest_name;
 use super::texture::Textures;
 use super::{Ctx, DeclaredKind};

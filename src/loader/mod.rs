@@ -1,8 +1,11 @@
 //! Scene building: graphics state to a plain scene description.
 //!
 //! - [`state`]: the walk over statements with pbrt-v3's graphics state.
-//! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
-//!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
+//! - [`kinds`]: any family's statement read through its kind's table and
+//!   built by the kind's builder; [`options`]: the camera, film, filter,
+//!   sampler and integrator statements; [`lights`], [`material`],
+//!   [`texture`], [`medium`], [`shapes`] (with [`camera`]: lens files) the
+//!   others; [`lookup`]: parameters by name for everything else.
 //! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
 //!   [`spd`]: spectrum files; [`ply`]: the PLY reader for `plymesh`;
 //!   [`fourier`]: the tabulated BSDF reader for the `fourier` material;
@@ -13,13 +16,15 @@
 pub mod camera;
 pub mod cie1931;
 pub mod color;
-pub mod entities;
 pub mod fourier;
 pub mod image;
 pub mod kinds;
+pub mod lights;
+pub mod lookup;
 pub mod material;
 pub mod medium;
 pub mod meshfile;
+pub mod options;
 pub mod ply;
 pub mod reference;
 pub mod refine;

@@ -2,13 +2,13 @@
 //! and transform stacks, current and named materials, textures, area light,
 //! ReverseOrientation, object definitions, and the option directives.
 
-use super::entities;
 use super::material::{self, Lookup, MaterialSpec};
 use super::texture::{self as texture, Defined, TextureState, Textures};
 use super::Ctx;
+use super::{lights, lookup, options};
+use crate::bxdf::MAX_BXDFS;
 use crate::lang::parser::{ActiveKind, DirKind, Directive, Name, Stmt};
 use crate::lang::Loc;
-use crate::bxdf::MAX_BXDFS;
 use crate::materials::Material;
 use crate::scene::motion;
 use crate::scene::*;
@@ -511,7 +511,7 @@ impl<'s, 'c> Builder<'s, 'c> {
                 if !self.ctm[0].is_finite() {
                     self.ctx.error(s.loc, "the light's transform has non-finite entries (overflow in the transform statements)", "this LightSource", None);
                     self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
-                } else if let Some(l) = entities::light(self.ctx, name, params, self.ctm[0]) {
+                } else if let Some(l) = lights::light(self.ctx, name, params, self.ctm[0]) {
                     // pbrt-v3 resolves the interface for every light (its
                     // media matter to bdpt only): undefined names are errors.
                     let media = self.graphics.media.clone();
@@ -525,7 +525,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             }
             K::AreaLightSource => {
                 let Directive::Entity { name, params } = &s.dir else { return };
-                self.graphics.area_light = entities::area_light_known(self.ctx, name, params).then_some((i, name.loc));
+                self.graphics.area_light = lights::area_light_known(self.ctx, name, params).then_some((i, name.loc));
             }
             K::Shape => self.shape(i, s),
             K::MakeNamedMedium => {
@@ -895,7 +895,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         let Directive::Entity { name, params } = &stmts[i].dir else {
             unreachable!("area light statement")
         };
-        let a = entities::area_light(self.ctx, name, params);
+        let a = lights::area_light(self.ctx, name, params);
         self.area_lights.insert(i, a);
         a
     }
@@ -908,7 +908,7 @@ impl<'s, 'c> Builder<'s, 'c> {
     ) -> MaterialId {
         let stmts = self.stmts;
         let mat_params = spec.stmt.and_then(|i| stmts[i].params());
-        let overrides = entities::shape_may_set_material_params(shape_params);
+        let overrides = lookup::shape_may_set_material_params(shape_params);
         if !overrides {
             if let Some(&id) = self.material_ids.get(&spec.stmt) {
                 return id;
@@ -1007,7 +1007,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         id
     }
 
-    /// Builds the option entities and notes what was left out.
+    /// Builds the render options and notes what was left out.
     pub fn finish(
         &mut self,
     ) -> (
@@ -1025,8 +1025,8 @@ impl<'s, 'c> Builder<'s, 'c> {
             })
         };
         // The film first: the realistic camera needs its size.
-        let film = entities::film(self.ctx, ent(self.film));
-        let mut camera = entities::camera(
+        let film = options::film(self.ctx, ent(self.film));
+        let mut camera = options::camera(
             self.ctx,
             self.camera
                 .and_then(|(i, m)| ent(Some(i)).map(|e| (e, m[0]))),
@@ -1034,7 +1034,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         );
         if let Some((i, [start, end])) = self.camera {
             if start != end {
-                // The start inverse was checked by `entities::camera`.
+                // The start inverse was checked by `options::camera`.
                 let end_inv = end.inverse();
                 if end_inv.is_finite() && end.determinant().abs() >= 1e-300 {
                     camera.motion = self.animated([camera.camera_to_world, end_inv]);
@@ -1044,9 +1044,9 @@ impl<'s, 'c> Builder<'s, 'c> {
                 }
             }
         }
-        let filter = entities::filter(self.ctx, ent(self.filter));
-        let sampler = entities::sampler(self.ctx, ent(self.sampler));
-        let integrator = entities::integrator(self.ctx, ent(self.integrator));
+        let filter = options::filter(self.ctx, ent(self.filter));
+        let sampler = options::sampler(self.ctx, ent(self.sampler));
+        let integrator = options::integrator(self.ctx, ent(self.integrator));
         if let Some(loc) = self.first_medium_interface {
             // pbrt-v3's warning for integrators without volume scattering.
             let name = (!integrator.renders_media()).then(|| integrator.name());

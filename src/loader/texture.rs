@@ -5,19 +5,19 @@
 //! textures defined before, of the type the parameter needs), its mapping,
 //! and its images. Also the shapes' `alpha` and `shadowalpha` textures.
 
-use super::entities::one;
 use super::image::load_image;
+use super::lookup::one;
 use super::material::{read_params, read_params_as, Lookup};
 use super::state::closest_name;
 use super::Ctx;
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
+use crate::scene::{Decode, FloatTex, ParamValues, RgbImage, Tex};
 use crate::textures::{
     self, ImageSource, Mapping2D, Mapping3D, MappingUse, MipCache, TexBuilder, TexValue,
     TextureClass, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, TEXTURES, UV_MAPPING_PARAMS,
 };
-use crate::scene::{Decode, FloatTex, ParamValues, RgbImage, Tex};
 use glam::{DMat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;

@@ -18,8 +18,8 @@
 use super::ShadingContext;
 use crate::accel::SurfaceHit;
 use crate::geometry::face_forward;
-use crate::shapes::DiffGeom;
 use crate::scene::FloatTex;
+use crate::shapes::DiffGeom;
 use glam::Vec2;
 
 /// The hit and differential geometry with the shading frame bumped by `d`.

@@ -42,8 +42,8 @@ pub use uber::Uber;
 use crate::accel::SurfaceHit;
 use crate::bxdf::{roughness_to_alpha, MicrofacetDistribution, TrowbridgeReitz};
 use crate::geometry::Frame;
-use crate::shapes::DiffGeom;
 use crate::scene::{FloatTex, MaterialDesc, MaterialId, ParamValues, SpectrumTex};
+use crate::shapes::DiffGeom;
 use std::sync::Arc;
 
 pub use crate::scene::Support;

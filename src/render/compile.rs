@@ -5,12 +5,12 @@
 
 use crate::accel::{Geometry, Instance, MovingInstance, Object};
 use crate::cameras::Camera;
+use crate::integrators::{RenderScene, SurfaceMedia};
 use crate::lights::{AreaShape, DiffuseEmission, DiffuseLight, Light};
 use crate::materials::{link_materials, Material};
 use crate::media::Medium;
-use crate::shapes::{AlphaMask, Curve, CurveCommon, Quadric, TriangleMesh};
-use crate::integrators::{RenderScene, SurfaceMedia};
 use crate::scene::{self, MediumInterfaceDesc, SceneDescription, ShapeDesc};
+use crate::shapes::{AlphaMask, Curve, CurveCommon, Quadric, TriangleMesh};
 use glam::{DMat3, DMat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;

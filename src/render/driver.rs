@@ -2,14 +2,14 @@
 //! 16×16 tiles in parallel with rayon, merge them in a fixed order (so the
 //! image is bit-identical for any thread count), and count what happened.
 
-use crate::render::film::part::{self, PartHeader, PartKind};
-use crate::image::Image;
-use crate::render::film::{luminance, Film, FilmTile, TileMaker};
 use crate::geometry::Bounds2i;
 use crate::geometry::{Ray, RayDiff};
-use crate::integrators::{Batch, Integrator, RayCounts, Scratch};
-use crate::samplers::{CameraSample, Sampler};
+use crate::image::Image;
 use crate::integrators::RenderScene;
+use crate::integrators::{Batch, Integrator, RayCounts, Scratch};
+use crate::render::film::part::{self, PartHeader, PartKind};
+use crate::render::film::{luminance, Film, FilmTile, TileMaker};
+use crate::samplers::{CameraSample, Sampler};
 use crate::scene::SceneDescription;
 use glam::{IVec2, Vec3};
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -2,11 +2,11 @@
 //! compare with noise-aware metrics, and leave images to look at on failure.
 #![allow(dead_code)]
 
-use pbrs::loader::load_scene;
-use pbrs::render::driver::{render, RenderOptions, RenderStats};
 use pbrs::image::compare::{compare, false_colour_difference, Comparison};
 use pbrs::image::io::{read_image, write_image};
 use pbrs::image::Image;
+use pbrs::loader::load_scene;
+use pbrs::render::driver::{render, RenderOptions, RenderStats};
 use pbrs::scene::SceneDescription;
 use std::path::{Path, PathBuf};
 

@@ -4,12 +4,12 @@
 #![allow(dead_code)]
 
 use glam::{Vec2, Vec3};
+use pbrs::accel::SurfaceHit;
 use pbrs::lang::parser::FileLoader;
 use pbrs::loader::{load_scene_with, LoadFailure, LoadedScene};
-use pbrs::accel::SurfaceHit;
 use pbrs::materials::ShadingContext;
-use pbrs::shapes::{DiffGeom, SurfacePoint};
 use pbrs::scene::{FloatTex, SpectrumTex};
+use pbrs::shapes::{DiffGeom, SurfacePoint};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 

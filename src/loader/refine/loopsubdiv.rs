@@ -70,7 +70,7 @@ pub fn read(p: &ParamList, notes: &mut Notes) -> Result<LoopSubdiv, Problem> {
         (None, Some(l)) => (l, "nlevels"),
         (None, None) => (3, "levels"),
     };
-    let _ = crate::loader::entities::string(p, "scheme");
+    let _ = crate::loader::lookup::string(p, "scheme");
     let Some(iq) = array(p, "indices", ParamType::Integer) else {
         return Err(Problem::shape(
             "needs the vertex indices \"integer indices\"",

@@ -97,12 +97,12 @@ pub(crate) fn array<'a>(p: &'a ParamList, name: &str, ty: ParamType) -> Option<&
 
 /// pbrt-v3's `FindOneInt`: the value of a one-value integer parameter.
 pub(crate) fn one_int(p: &ParamList, name: &str) -> Option<i64> {
-    super::entities::one(p, name, |t| t == ParamType::Integer).map(|q| q.nums()[0] as i64)
+    super::lookup::one(p, name, |t| t == ParamType::Integer).map(|q| q.nums()[0] as i64)
 }
 
 /// pbrt-v3's `FindOneFloat`.
 pub(crate) fn one_float(p: &ParamList, name: &str) -> Option<f64> {
-    super::entities::one(p, name, |t| t == ParamType::Float).map(|q| q.nums()[0])
+    super::lookup::one(p, name, |t| t == ParamType::Float).map(|q| q.nums()[0])
 }
 
 /// The first value of `v` that is not finite as a 32-bit float, with its index.
