@@ -289,7 +289,7 @@ impl Integrator {
             scratch.counts.closest += 1;
             let wo = -ray.d;
             for pack in packs {
-                direct_lanes::draw_samples(sampler, pack.count, &mut d.u);
+                d.u.extend_from_slice(&direct_lanes::draw_samples(sampler, pack.count));
             }
             if 1 < settings.max_depth {
                 sampler.skip_2d();

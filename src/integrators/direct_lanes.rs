@@ -28,6 +28,7 @@ use crate::lights::{dot3, lane3, splat3, TriangleLightPack, Vec3x4};
 use crate::materials::Bsdf;
 use crate::samplers::Sampler;
 use crate::sampling::{power_heuristic, sin_cos_quarter};
+use arrayvec::ArrayVec;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
 
@@ -292,25 +293,28 @@ fn lane_ld(
 
 /// The samples of `count` lights as `sample_all_lights` draws them (per
 /// light: the two one-entry arrays, or two 2D samples when there are no
-/// arrays left), appended to `out` light by light: light sample, then BSDF
-/// sample.
+/// arrays left), light by light: light sample, then BSDF sample.
 #[inline]
-pub(super) fn draw_samples(sampler: &mut Sampler, count: usize, out: &mut impl Extend<Vec2>) {
+pub(super) fn draw_samples(sampler: &mut Sampler, count: usize) -> ArrayVec<Vec2, 8> {
+    let mut out = ArrayVec::new();
     let mut both = [Vec2::ZERO; 8];
     if sampler.get_2d_arrays1(&mut both[..2 * count]) {
-        out.extend(both[..2 * count].iter().copied());
-        return;
+        for &u in &both[..2 * count] {
+            out.push(u);
+        }
+        return out;
     }
     for _ in 0..count {
         let got_light = sampler.get_2d_array1();
         let got_scatter = sampler.get_2d_array1();
-        if let (Some(a), Some(b)) = (got_light, got_scatter) {
-            out.extend([a, b]);
-        } else {
-            let (a, b) = (sampler.get_2d(), sampler.get_2d());
-            out.extend([a, b]);
-        }
+        let (a, b) = match (got_light, got_scatter) {
+            (Some(a), Some(b)) => (a, b),
+            _ => (sampler.get_2d(), sampler.get_2d()),
+        };
+        out.push(a);
+        out.push(b);
     }
+    out
 }
 
 /// The sum over all lights of EstimateDirect at `s`, whose BSDF is the
@@ -330,8 +334,7 @@ pub(super) fn sample_all_lights_packed(
     let v4 = Vertex4::splat(&v);
     let mut l = Vec3::ZERO;
     for (k, pack) in packs.iter().enumerate() {
-        let mut u = arrayvec::ArrayVec::<Vec2, 8>::new();
-        draw_samples(sampler, pack.count, &mut u);
+        let u = draw_samples(sampler, pack.count);
         let lanes = |k: usize| x4(|i| u.get(2 * i + k).copied().unwrap_or_default());
         let e = estimate4(pack, &v4, lanes(0), lanes(1), first_lanes(pack.count));
         for lane in 0..pack.count {

@@ -182,7 +182,13 @@ impl Integrator {
                     }
                 }
                 // Pushed transmission first so that reflection is expanded first.
-                stack.extend(children.into_iter().rev().flatten());
+                let [reflected, transmitted] = children;
+                if let Some(t) = transmitted {
+                    stack.push(t);
+                }
+                if let Some(r) = reflected {
+                    stack.push(r);
+                }
             }
         }
         scratch.work = stack;
