@@ -20,6 +20,7 @@
 //! reflection or transmission lobe only if Kr or Kt is not black.
 
 use super::Roughness;
+use super::REMAP_ROUGHNESS;
 use super::{BsdfContext, Material, MaterialKind, ShadingContext, Support};
 use crate::bxdf::{
     Bsdf, Fresnel, FresnelSpecular, MicrofacetReflection, MicrofacetTransmission,
@@ -35,11 +36,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float_tex("index", 1.5, "index of refraction when `eta` is absent"),
     ParamSpec::nonneg_tex("uroughness", 0.0, "roughness along dp/du (0: smooth)"),
     ParamSpec::nonneg_tex("vroughness", 0.0, "roughness along dp/dv (0: smooth)"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 

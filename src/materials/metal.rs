@@ -16,6 +16,7 @@
 //! loader as pbrt-v3's `RGBSpectrum::FromSampled` does.
 
 use super::Roughness;
+use super::REMAP_ROUGHNESS;
 use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::bxdf::{Bsdf, Fresnel, MicrofacetReflection};
 use crate::scene::{ParamSpec, ParamValues, SpectrumDefault, SpectrumTex};
@@ -125,11 +126,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ),
     ParamSpec::nonneg_tex_opt("uroughness", "roughness along dp/du (default: roughness)"),
     ParamSpec::nonneg_tex_opt("vroughness", "roughness along dp/dv (default: roughness)"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 

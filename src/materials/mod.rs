@@ -397,6 +397,13 @@ pub fn trowbridge_reitz(u: f32, v: f32, remap: bool) -> MicrofacetDistribution {
     TrowbridgeReitz::new(ax, ay).into()
 }
 
+/// The `remaproughness` row of every material with a microfacet lobe.
+pub const REMAP_ROUGHNESS: crate::scene::ParamSpec = crate::scene::ParamSpec::boolean(
+    "remaproughness",
+    true,
+    "roughness → α as pbrt-v3's RoughnessToAlpha",
+);
+
 /// The microfacet roughness of `glass`, `metal`, `substrate`, `uber` and
 /// the subsurface boundaries: along dp/du and dp/dv, and whether it is
 /// remapped to α by pbrt-v3's `RoughnessToAlpha`.

@@ -13,6 +13,7 @@
 //!
 //! Lobes: Lambertian if Kd ≠ 0, then the microfacet reflection if Ks ≠ 0.
 
+use super::REMAP_ROUGHNESS;
 use super::{trowbridge_reitz, Material, MaterialKind, ShadingContext, Support};
 use crate::bxdf::{Bsdf, Fresnel, LambertianReflection, MicrofacetReflection};
 use crate::scene::{FloatTex, ParamSpec, ParamValues, SpectrumTex};
@@ -22,11 +23,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::spectrum("Kd", 0.25, "diffuse reflectance"),
     ParamSpec::spectrum("Ks", 0.25, "glossy reflectance"),
     ParamSpec::nonneg_tex("roughness", 0.1, "microfacet roughness"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 

@@ -15,6 +15,7 @@
 //! Lobes: the FresnelBlend if Kd or Ks ≠ 0.
 
 use super::Roughness;
+use super::REMAP_ROUGHNESS;
 use super::{Material, MaterialKind, ShadingContext, Support};
 use crate::bxdf::{Bsdf, FresnelBlend};
 use crate::scene::{ParamSpec, ParamValues, SpectrumTex};
@@ -25,11 +26,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::spectrum("Ks", 0.5, "glossy reflectance at normal incidence"),
     ParamSpec::nonneg_tex("uroughness", 0.1, "roughness along dp/du"),
     ParamSpec::nonneg_tex("vroughness", 0.1, "roughness along dp/dv"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 

@@ -26,6 +26,7 @@
 //! [`Subsurface::coefficients`] and the table (computed once per material,
 //! for its `g` and `eta`).
 
+use super::REMAP_ROUGHNESS;
 use super::{BsdfContext, Glass, Material, MaterialKind, ShadingContext, Support};
 use crate::bssrdf::{BssrdfTable, TabulatedBssrdf};
 use crate::bxdf::Bsdf;
@@ -73,11 +74,7 @@ pub const BOUNDARY_PARAMS: [ParamSpec; 7] = [
     ParamSpec::spectrum("Kt", 1.0, "transmission scale"),
     ParamSpec::nonneg_tex("uroughness", 0.0, "roughness along dp/du (0: smooth)"),
     ParamSpec::nonneg_tex("vroughness", 0.0, "roughness along dp/dv (0: smooth)"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 

@@ -18,6 +18,7 @@
 //! `FresnelDielectric(1, 1.5)` and microfacet transmission transmit·Ks from
 //! 1 into 1.5, each only if its weight is not black.
 
+use super::REMAP_ROUGHNESS;
 use super::{may_scatter, trowbridge_reitz, Material, MaterialKind, ShadingContext, Support};
 use crate::bxdf::{
     Bsdf, Fresnel, LambertianReflection, LambertianTransmission, MicrofacetReflection,
@@ -35,11 +36,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::spectrum("reflect", 0.5, "fraction reflected"),
     ParamSpec::spectrum("transmit", 0.5, "fraction transmitted"),
     ParamSpec::nonneg_tex("roughness", 0.1, "glossy roughness"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 

@@ -26,6 +26,7 @@
 //! 5. specular transmission op·Kt from η 1 into `eta`.
 
 use super::Roughness;
+use super::REMAP_ROUGHNESS;
 use super::{may_scatter, Material, MaterialKind, ShadingContext, Support};
 use crate::bxdf::{
     Bsdf, Fresnel, LambertianReflection, MicrofacetReflection, SpecularReflection,
@@ -52,11 +53,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float_tex_opt("eta", "index of refraction (read before `index`)"),
     ParamSpec::float_tex("index", 1.5, "index of refraction when `eta` is absent"),
     ParamSpec::spectrum("opacity", 1.0, "opacity (1 − opacity passes through)"),
-    ParamSpec::boolean(
-        "remaproughness",
-        true,
-        "roughness → α as pbrt-v3's RoughnessToAlpha",
-    ),
+    REMAP_ROUGHNESS,
     ParamSpec::BUMPMAP,
 ];
 
