@@ -837,15 +837,10 @@ impl Geometry {
 }
 
 /// Build quality by primitive count: obvhs's slower builders give BVHs that
-/// trace faster, worth it while the build stays a small part of the render.
-/// Measured with obvhs's CWBVH (`cargo run --release --example bvh_bench`,
-/// cornell-path, cornell-dragon): the Cornell box traced 5% faster with
-/// `very_slow_build` than `medium_build`, the 43k-triangle dragon 10% faster
-/// with `slow_build` at the same build time (0.06 s); a 1M-triangle mesh
-/// built in 0.8-0.9 s with `medium_build` but 1.2-1.3 s with `slow_build`, so
-/// large levels keep `medium_build` (0.7-0.8 s with the four-wide collapse,
-/// which is cheaper than obvhs's CWBVH conversion). Only the PLOC and
-/// reinsertion parameters apply here (see `bvh4`).
+/// trace faster, worth it while the build stays a small part of the render,
+/// so small levels take the slower builders and large ones `medium_build`
+/// (`cargo run --release --example bvh_bench` measures both sides). Only the
+/// PLOC and reinsertion parameters apply here (see `bvh4`).
 fn build_params(n: usize) -> BvhBuildParams {
     if n <= 4096 {
         BvhBuildParams::very_slow_build()

@@ -359,8 +359,7 @@ impl<'a> Bsdf<'a> {
 }
 
 /// `b.f_pdf` with Lambertian reflection, the most common lobe, inline; every
-/// other lobe through the enum's dispatch, which is too large to inline
-/// (measured on cornell-path: the call costs ~5% of its instructions).
+/// other lobe through the enum's dispatch, which is too large to inline.
 #[inline(always)]
 fn lambertian_inline_f_pdf(b: &Bxdf, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     match b {

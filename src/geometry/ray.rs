@@ -74,8 +74,7 @@ impl RayDiff {
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
     // Negated when w·n < 0, by the sign bit rather than a branch (which
-    // side a ray leaves by is as good as random to the predictor; a branch
-    // here made cornell-path 2.5% slower).
+    // side a ray leaves by is as good as random to the predictor).
     let flip = ((w.dot(n) < 0.0) as u32) << 31;
     let offset = Vec3::from_array(
         (d * n)

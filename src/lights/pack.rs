@@ -25,8 +25,7 @@ pub fn splat3(v: Vec3) -> Vec3x4 {
 
 /// Lane `i` of `v`. Read through the lanes' arrays: glam's `Vec4` index
 /// is a `match` on the lane, compiled as a jump table whose indirect jump
-/// was mispredicted almost every time (cachegrind's branch model: 99% of
-/// cornell-direct's indirect mispredictions).
+/// is mispredicted almost every time.
 #[inline(always)]
 pub fn lane3(v: &Vec3x4, i: usize) -> Vec3 {
     Vec3::new(lane(&v[0], i), lane(&v[1], i), lane(&v[2], i))
