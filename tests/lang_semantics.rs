@@ -265,7 +265,7 @@ fn area_light_applies_to_later_shapes_in_scope() {
 fn lights() {
     let s = load("WorldBegin\nTranslate 1 0 0\nLightSource \"point\" \"rgb I\" [1 1 1] \"rgb scale\" [2 2 2] \"point from\" [0 1 0]\nLightSource \"distant\" \"point from\" [0 0 0] \"point to\" [0 0 1]\nLightSource \"spot\" \"point from\" [0 0 0] \"point to\" [0 1 0] \"float coneangle\" 20\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\nLightSource \"goniometric\"\nWorldEnd");
     let l = &s.scene.lights;
-    assert_eq!(l.len(), 4);
+    assert_eq!(l.len(), 5);
     let Light::Point(point) = &l[0] else { panic!() };
     assert!(close32(point.p, Vec3::new(1.0, 1.0, 0.0)));
     assert_eq!(point.intensity, Vec3::splat(2.0));
@@ -279,7 +279,10 @@ fn lights() {
     assert!(close32(spot.frame.n, Vec3::Y));
     assert!(close32(spot.p, Vec3::X));
     assert!(matches!(&l[3], Light::Infinite(i) if i.n_samples == 1));
-    assert!(warnings(&s).contains("\"goniometric\" is not supported"));
+    let Light::Goniometric(g) = &l[4] else {
+        panic!()
+    };
+    assert!(close32(g.p, Vec3::X) && g.map.is_none());
     // pbrt-v3 point.cpp: Translate(from) · CTM, so `from` is not scaled by the CTM.
     let s = load("WorldBegin\nTranslate 1 0 0\nScale 2 2 2\nLightSource \"point\" \"point from\" [0 1 0]\nWorldEnd");
     let Light::Point(point) = &s.scene.lights[0] else {

@@ -15,22 +15,26 @@ pub mod bvh;
 pub mod diffuse;
 pub mod distant;
 mod distribution;
+pub mod goniometric;
 pub mod infinite;
 mod pack;
 pub mod point;
+pub mod projection;
 pub mod spot;
 
 pub use diffuse::{AreaShape, DiffuseEmission, DiffuseLight, TriangleCache};
 pub use distant::DistantLight;
 pub use distribution::{LightSampler, LightSamplerKind, SPATIAL_MAX_LIGHTS};
+pub use goniometric::GoniometricLight;
 pub use infinite::{EnvMap, EnvSampling, InfiniteLight};
 pub use pack::{dot3, lane3, pack_triangle_lights, splat3, TriangleLightPack, Vec3x4};
 pub use point::PointLight;
+pub use projection::ProjectionLight;
 pub use spot::SpotLight;
 
 use crate::accel::Geometry;
 use crate::geometry::{luminance, Ray};
-use crate::scene::{Kind, ParamValues, Report, Support};
+use crate::scene::{Kind, ParamValues, Report};
 use crate::shapes::SurfacePoint;
 use bvh::LightBounds;
 use glam::{DMat4, Vec2, Vec3};
@@ -47,14 +51,8 @@ pub type LightKind = Kind<LightBuild>;
 pub static LIGHTS: &[LightKind] = &[
     point::KIND,
     spot::KIND,
-    unsupported(
-        "goniometric",
-        "a point light whose intensity over directions is an image (goniometric diagram)",
-    ),
-    unsupported(
-        "projection",
-        "a point light projecting an image through a frustum",
-    ),
+    goniometric::KIND,
+    projection::KIND,
     distant::KIND,
     infinite::KIND,
 ];
@@ -69,17 +67,6 @@ pub type AreaLightKind = Kind<AreaLightBuild>;
 
 /// Every area light type pbrt-v3's `MakeAreaLight` knows.
 pub static AREA_LIGHTS: &[AreaLightKind] = &[diffuse::KIND];
-
-const fn unsupported(name: &'static str, doc: &'static str) -> LightKind {
-    LightKind {
-        name,
-        aliases: &[],
-        support: Support::Unsupported(doc),
-        params: &[],
-        doc,
-        build: |_, _, _| None,
-    }
-}
 
 /// A light sample as seen from a reference point.
 #[derive(Clone, Copy, Debug)]
@@ -275,6 +262,8 @@ lights! {
     Diffuse(DiffuseLight) = diffuse::KIND,
     Point(PointLight) = point::KIND,
     Spot(SpotLight) = spot::KIND,
+    Goniometric(GoniometricLight) = goniometric::KIND,
+    Projection(ProjectionLight) = projection::KIND,
     Distant(DistantLight) = distant::KIND,
     Infinite(InfiniteLight) = infinite::KIND,
 }
