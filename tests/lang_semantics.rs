@@ -348,13 +348,16 @@ fn materials_and_substitutes() {
     );
     assert_eq!(m("\"none\"").0.kind, "none");
     assert_eq!(m("\"\"").0.kind, "none");
-    let (p, w) = m("\"hair\" \"rgb Kd\" [0.1 0.2 0.3] \"float eumelanin\" 1.3");
-    assert_eq!(matte_of(&p), (Vec3::new(0.1, 0.2, 0.3), 0.0));
+    let (h, w) = m("\"hair\" \"float eumelanin\" 1.3");
+    assert!(h.kind == "hair" && w.is_empty(), "{w}");
+    // pbrt-v3's warnings about the absorption parameters it ignores.
+    let (_, w) =
+        m("\"hair\" \"rgb sigma_a\" [1 1 1] \"rgb color\" [0.5 0.5 0.5] \"float pheomelanin\" 1");
     assert!(
-        w.contains("\"hair\" is not supported by pbrs") && w.contains("substituted by a matte"),
+        w.contains("ignoring \"color\" parameter since \"sigma_a\" was provided")
+            && w.contains("ignoring \"pheomelanin\" parameter since \"sigma_a\" was provided"),
         "{w}"
     );
-    assert!(!w.contains("not used"), "{w}");
     // A shape parameter that nothing uses is reported even when the material is substituted.
     let s = load("WorldBegin\nMaterial \"metal\"\nShape \"sphere\" \"float radiuss\" 2\nWorldEnd");
     assert!(
@@ -759,9 +762,6 @@ fn unused_material_parameters_say_what_was_meant() {
 
 #[test]
 fn summary_counts_declared_material_kinds() {
-    use pbrs::materials::{kind, Support};
-    // The hair's substitute has matte's default Kd, so it equals the
-    // matte; it is still counted under its own kind.
     let s = load("WorldBegin\nMaterial \"matte\"\nShape \"sphere\"\nMaterial \"glass\"\nShape \"sphere\"\nMaterial \"hair\"\nShape \"sphere\"\nMaterial \"BUSH1\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\nWorldEnd");
     let sum = &s.summary;
     let by: Vec<(&str, usize)> = sum
@@ -775,15 +775,6 @@ fn summary_counts_declared_material_kinds() {
     let text = sum.to_string();
     assert!(
         text.contains("materials:  4 (1 glass, 1 hair, 1 matte, 1 \"BUSH1\" (unknown))"),
-        "{text}"
-    );
-    let Some(Support::Unsupported(why)) = kind("hair").map(|k| k.support) else {
-        panic!("hair is in the table as unsupported");
-    };
-    assert!(
-        text.contains(&format!(
-            "hair: not supported by pbrs ({why}), rendered as matte"
-        )),
         "{text}"
     );
     assert!(

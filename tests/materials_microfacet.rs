@@ -48,6 +48,7 @@ fn kinds(b: &Bsdf) -> Vec<&'static str> {
             Bxdf::DisneyClearcoat(_) => "disney-clearcoat",
             Bxdf::Fourier(_) => "fourier",
             Bxdf::SwAdapter(_) => "sw-adapter",
+            Bxdf::Hair(_) => "hair",
         })
         .collect()
 }

@@ -176,6 +176,15 @@ const CASES: &[Case] = &[
         "\"string namedmaterial1\" \"m1\" \"string namedmaterial2\" \"m2\" \"rgb amount\" [0.3 0.3 0.3]",
         (0.3, 0.95),
     ),
+    // pbrt-v3's hair model is not reciprocal (its own test of it is
+    // disabled). No absorption: the a_p sum to 1 and each lobe integrates
+    // to about 1 (m_p is an approximation); with absorption, less.
+    nonreciprocal("hair", "\"rgb sigma_a\" [0 0 0]", (0.9, 1.05)),
+    nonreciprocal(
+        "hair",
+        "\"rgb color\" [0.8 0.5 0.3] \"float beta_m\" 0.6 \"float beta_n\" 0.2 \"float alpha\" 3",
+        (0.05, 1.0),
+    ),
     // A mix with a specular material: lobes of both kinds in one BSDF.
     nonreciprocal(
         "mix",

@@ -14,6 +14,7 @@ mod disney;
 mod fourier;
 mod fresnel;
 mod fresnel_blend;
+pub mod hair;
 mod lambertian;
 mod microfacet;
 mod microfacet_lobes;
@@ -29,6 +30,7 @@ pub use disney::{
 pub use fourier::FourierBsdf;
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use fresnel_blend::FresnelBlend;
+pub use hair::HairBsdf;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
 pub use microfacet::{
     roughness_to_alpha, Beckmann, MicrofacetDistribution, MicrofacetModel, TrowbridgeReitz,
@@ -197,6 +199,7 @@ bxdfs! {
     DisneyClearcoat(DisneyClearcoat),
     Fourier(FourierBsdf<'a>),
     SwAdapter(SwAdapter),
+    Hair(HairBsdf),
 }
 
 // ---------------------------------------------------------- local-frame trigonometry

@@ -242,6 +242,11 @@ pub fn material(
             ctx.warn(spec.loc, format!("{what}: {msg}"), "disney");
         }
     }
+    if kind.name == "hair" {
+        for msg in materials::Hair::load_warnings(&params) {
+            ctx.warn(spec.loc, format!("{what}: {msg}"), "hair");
+        }
+    }
     if kind.name == "subsurface" {
         for msg in materials::Subsurface::load_warnings(&params) {
             ctx.warn(spec.loc, format!("{what}: {msg}"), "subsurface");

@@ -11,6 +11,7 @@ mod bump;
 mod disney;
 mod fourier;
 mod glass;
+mod hair;
 mod kdsubsurface;
 mod matte;
 mod metal;
@@ -28,6 +29,7 @@ pub use bump::bump;
 pub use disney::Disney;
 pub use fourier::Fourier;
 pub use glass::Glass;
+pub use hair::Hair;
 pub use kdsubsurface::KdSubsurface;
 pub use matte::Matte;
 pub use metal::Metal;
@@ -71,10 +73,7 @@ pub static MATERIALS: &[MaterialKind] = &[
     NONE_KIND,
     subsurface::KIND,
     kdsubsurface::KIND,
-    unsupported(
-        "hair",
-        "pbrt-v3's HairBSDF is not implemented yet (curves are): a matte with the material's Kd stands in",
-    ),
+    hair::KIND,
 ];
 
 const NONE_KIND: MaterialKind = MaterialKind {
@@ -85,17 +84,6 @@ const NONE_KIND: MaterialKind = MaterialKind {
     doc: "no surface: rays pass through (it only delimits media)",
     build: |_| Material::None,
 };
-
-const fn unsupported(name: &'static str, why: &'static str) -> MaterialKind {
-    MaterialKind {
-        name,
-        aliases: &[],
-        support: Support::Unsupported(why),
-        params: &[],
-        doc: why,
-        build: |_| Material::None,
-    }
-}
 
 /// The table entry of a material type (`""` is `"none"`, as in pbrt-v3).
 pub fn kind(name: &str) -> Option<&'static MaterialKind> {
@@ -138,6 +126,7 @@ pub enum Material {
     /// BSSRDF from their coefficients and table.
     Subsurface(Arc<Subsurface>),
     KdSubsurface(Arc<KdSubsurface>),
+    Hair(Hair),
     /// `Material "none"`: no BSDF.
     None,
     /// A material with a `bumpmap`: its shading frame is bumped before its
@@ -200,6 +189,7 @@ impl Material {
             Material::Fourier(m) => m.needs_geom(),
             Material::Subsurface(m) => m.needs_geom(),
             Material::KdSubsurface(m) => m.needs_geom(),
+            Material::Hair(m) => m.needs_geom(),
             Material::None => false,
             Material::Bumped(_) => true,
         }
@@ -218,6 +208,8 @@ impl Material {
             Material::Disney(m) => m.anisotropic(),
             Material::Subsurface(m) => m.boundary.anisotropic(),
             Material::KdSubsurface(m) => m.boundary.anisotropic(),
+            // The hair's frame follows the curve.
+            Material::Hair(_) => true,
             // pbrt-v3's FourierBSDF is isotropic.
             Material::Matte(_)
             | Material::Plastic(_)
@@ -246,6 +238,7 @@ impl Material {
             Material::Fourier(m) => m.max_lobes(),
             Material::Subsurface(m) => m.boundary.max_lobes(),
             Material::KdSubsurface(m) => m.boundary.max_lobes(),
+            Material::Hair(m) => m.max_lobes(),
             Material::None => 0,
             Material::Bumped(b) => b.material.max_lobes(lobes_of),
         }
@@ -364,6 +357,7 @@ impl Material {
             Material::Fourier(m) => m.scatter(sc, bsdf),
             Material::Subsurface(m) => m.boundary.scatter(sc, ctx, bsdf),
             Material::KdSubsurface(m) => m.boundary.scatter(sc, ctx, bsdf),
+            Material::Hair(m) => m.scatter(sc, bsdf),
             Material::None => {}
             // The caller bumped the hit if this material leads the BSDF
             // (see `leading_bump`); a mix's second material's bump map
