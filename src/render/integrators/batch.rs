@@ -98,10 +98,10 @@ pub(super) fn trace_paths<M: PathMedium>(
     scratch: &mut Scratch,
 ) {
     b.active.clear();
-    for j in 0..b.len {
+    for (j, st) in states.iter_mut().enumerate().take(b.len) {
         b.l[j] = Vec3::ZERO;
         if b.weights[j] > 0.0 {
-            states[j].reset(b.rays[j], &b.diffs[j], start);
+            st.reset(b.rays[j], &b.diffs[j], start);
             b.active.push(j as u32);
         }
     }

@@ -15,6 +15,9 @@
 //! [`TriangleLightPack`]: a vertex splatted into lanes with a pack of four
 //! lights, or four vertices with a pack of one light repeated.
 //!
+//! [`DirectLanes`] holds a batch's Lambertian camera vertices and their
+//! samples between the two passes.
+//!
 //! Every operation is the scalar path's (`estimate_direct` with
 //! `TriangleCache::sample_li`, `Bsdf::f_pdf`, `Bsdf::sample` and
 //! `TriangleCache::hit_pdf`), in the same order, so the image is the same

@@ -1,15 +1,18 @@
 //! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
 //! power-heuristic MIS, Russian roulette), `volpath` (the same with
-//! participating media, in [`volpath`]), `directlighting` (strategy all or
-//! one, specular lobes followed recursively) and `whitted`.
+//! participating media), `directlighting` (strategy all or one, specular
+//! lobes followed recursively) and `whitted`.
 //!
-//! One file per integrator: [`path`], [`volpath`], [`directlighting`] and
+//! One file per integrator: [`path`] (with the per-vertex step `path` and
+//! `volpath` share, over the medium the path is in), [`volpath`] (the
+//! medium tracking and transmittance of that step), [`directlighting`] and
 //! [`whitted`]; the recursive specular tree that directlighting and
 //! whitted share ([`specular`]); the batch of samples a thread renders
-//! together ([`batch`]); directlighting's four-lane estimate
-//! ([`direct_lanes`]); and what several of them share, written once
-//! ([`common`]: shading, emission, light choice and sampling, MIS weights,
-//! Russian roulette; [`subsurface`]: the BSSRDF exit of path and volpath).
+//! together ([`batch`]: `path` and `volpath` one vertex of every lane at a
+//! time); directlighting's four-lane estimate ([`direct_lanes`]); and what
+//! several of them share, written once ([`common`]: shading, emission,
+//! light choice and sampling, MIS weights, Russian roulette;
+//! [`subsurface`]: the BSSRDF exit of path and volpath).
 //!
 //! [`INTEGRATORS`] is the table of kinds the loader, `--check`,
 //! `grammar/REFERENCE.md` and the tests read; a kind's builder gives its
