@@ -1,5 +1,5 @@
-//! The batched renderer (several samples in flight per thread, `path`
-//! advancing all of a batch's paths one vertex at a time) gives the image of
+//! The batched renderer (several samples in flight per thread, `path` and
+//! `volpath` advancing all of a batch's paths one vertex at a time) gives the image of
 //! the scalar loop bit for bit, with the same rays traced: each scene is
 //! rendered both ways (`RenderOptions::scalar`) and compared pixel by pixel.
 //! The scenes cover every integrator, specular and subsurface paths, media,
@@ -11,7 +11,7 @@
 
 mod common;
 
-use pbrs::scene::{SamplerKind, SceneDescription};
+use pbrs::scene::{IntegratorSettings, SamplerKind, SceneDescription};
 
 fn both_ways(mut desc: SceneDescription, res: u32, spp: u32, what: &str) {
     desc.film.xresolution = res;
@@ -135,12 +135,24 @@ WorldEnd
     }
 }
 
+/// volpath's batch: homogeneous and heterogeneous media, the camera in a
+/// medium, material-less boundaries (nested media, shadow rays through
+/// them), subsurface exits in a medium, and a scene without media (glass).
 #[test]
 fn volpath_subsurface_and_media() {
     scenes(&[
         ("scenes/fog/fog.pbrt", 24, 5),
+        ("scenes/fog/fog-spot.pbrt", 24, 5),
+        ("scenes/grid/grid.pbrt", 24, 4),
         ("scenes/subsurface/subsurface.pbrt", 24, 4),
+        ("scenes/subsurface/subsurface-fog.pbrt", 24, 3),
     ]);
+    let mut desc = common::load("scenes/cornell-glass.pbrt");
+    let IntegratorSettings::Path(settings) = desc.integrator else {
+        panic!("cornell-glass renders with path: {:?}", desc.integrator)
+    };
+    desc.integrator = IntegratorSettings::VolPath(settings);
+    both_ways(desc, 24, 9, "cornell-glass with volpath");
 }
 
 #[test]

@@ -1,16 +1,20 @@
 //! What the integrators share, written once: shading a hit, emission
-//! (with and without MIS weights), choosing and sampling a light (the
-//! light strategy of MIS), the BSDF strategy's weight, pbrt-v3's Russian
-//! roulette and its `etaScale`.
+//! (with and without MIS weights), building the light distribution,
+//! choosing and sampling a light (the light strategy of MIS, for a BSDF or
+//! a phase function, with shadow rays blocked by surfaces or attenuated by
+//! media), the BSDF strategy's weight, pbrt-v3's Russian roulette and its
+//! `etaScale`.
 
 use super::Scratch;
 use crate::accel::{Hit, SurfaceHit};
-use crate::geometry::RayDiff;
+use crate::geometry::{Ray, RayDiff};
 use crate::integrators::RenderScene;
-use crate::lights::LightSampler;
+use crate::lights::{LightSampler, LightSamplerKind};
 use crate::materials::{Bsdf, BsdfContext, BsdfSample, BxdfFlags, Material, ShadingContext};
+use crate::media::HenyeyGreenstein;
 use crate::samplers::Sampler;
 use crate::sampling::power_heuristic;
+use crate::scene::LightSampleStrategy;
 use crate::shapes::{DiffGeom, SurfacePoint};
 use glam::{Vec2, Vec3};
 
@@ -252,80 +256,199 @@ pub(super) fn choose_light(
     Some((light, pmf, u_light))
 }
 
-/// Next-event estimation of the path tracer: choose a light, sample it,
-/// trace the shadow ray, weight against the BSDF strategy (whose sample is
+/// What scatters light at a vertex, as the light strategy of MIS reads it:
+/// the value (with the cosine, for a surface) and the density of
+/// scattering from `wi` to `wo`.
+pub(super) trait Scatter {
+    fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32);
+}
+
+/// A surface's BSDF, restricted to the lobes `flags`, with the shading
+/// normal `ns` for the cosine.
+pub(super) struct SurfaceScatter<'b, 'a> {
+    pub bsdf: &'b Bsdf<'a>,
+    pub ns: Vec3,
+    pub flags: BxdfFlags,
+}
+
+impl Scatter for SurfaceScatter<'_, '_> {
+    #[inline(always)]
+    fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let (f, pdf) = self.bsdf.f_pdf(wo, wi, self.flags);
+        (f * wi.dot(self.ns).abs(), pdf)
+    }
+}
+
+/// A medium's phase function (its value is its density).
+impl Scatter for HenyeyGreenstein {
+    #[inline(always)]
+    fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let p = self.p(wo, wi);
+        (Vec3::splat(p), p)
+    }
+}
+
+/// How light reaches a vertex along a shadow ray: blocked by any surface
+/// ([`Unoccluded`]: `path`, `directlighting`), or attenuated by media and
+/// passing through material-less surfaces (`volpath`).
+pub(super) trait ShadowRay {
+    /// `f` times the transmittance along `shadow` (leaving the vertex in
+    /// direction `wi`), traced and counted; `None` when it is blocked.
+    #[allow(clippy::too_many_arguments)]
+    fn through(
+        &self,
+        scene: &RenderScene,
+        shadow: &Ray,
+        time: f32,
+        wi: Vec3,
+        f: Vec3,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Option<Vec3>;
+}
+
+/// A shadow ray that any surface blocks (pbrt-v3's `Unoccluded`).
+#[derive(Clone, Copy)]
+pub(super) struct Unoccluded;
+
+impl ShadowRay for Unoccluded {
+    #[inline(always)]
+    fn through(
+        &self,
+        scene: &RenderScene,
+        shadow: &Ray,
+        time: f32,
+        _wi: Vec3,
+        f: Vec3,
+        _sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Option<Vec3> {
+        scratch.counts.shadow += 1;
+        (!scene.geometry.occluded_at(shadow, time)).then_some(f)
+    }
+}
+
+/// Next-event estimation of `path` and `volpath` at `point` (a surface or
+/// a medium point) at scene time `time`: choose a light, sample it, trace
+/// the shadow ray, weight against the scattering strategy (whose sample is
 /// the path's continuation, see `path_li`).
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn sample_light_mis(
     scene: &RenderScene,
-    s: &SurfaceHit,
-    bsdf: &Bsdf,
+    point: &SurfacePoint,
+    time: f32,
+    scatter: &impl Scatter,
     wo: Vec3,
+    shadow: impl ShadowRay,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
     lights: &LightSampler,
 ) -> Vec3 {
     let Some((light_index, pmf, u_light)) =
-        choose_light(scene, &s.point, sampler, lights, LightSampleFirst::Yes)
+        choose_light(scene, point, sampler, lights, LightSampleFirst::Yes)
     else {
         return Vec3::ZERO;
     };
     light_strategy(
         scene,
-        s,
-        bsdf,
+        point,
+        time,
+        scatter,
         wo,
         light_index,
         u_light,
         pmf,
-        BxdfFlags::ALL,
+        shadow,
+        sampler,
         scratch,
     )
 }
 
-/// The light-sampling strategy of MIS: sample light `light_index`, trace the
-/// shadow ray, and weight the sample by the power heuristic against the BSDF
-/// density. `pmf` is the light's selection probability as the weights should
-/// see it: the path tracer's weights include it; pbrt-v3's EstimateDirect
-/// passes 1 and divides by the selection probability afterwards. `flags`:
-/// the lobes of the BSDF strategy it is weighted against (all of them for
-/// the path tracer, whose continuation is that strategy; the non-specular
-/// ones for EstimateDirect, as pbrt-v3).
+/// The light-sampling strategy of MIS at `point`: sample light
+/// `light_index`, trace the shadow ray, and weight the sample by the power
+/// heuristic against the scattering density. `pmf` is the light's
+/// selection probability as the weights should see it: the path tracer's
+/// weights include it; pbrt-v3's EstimateDirect passes 1 and divides by the
+/// selection probability afterwards. `scatter`: the strategy it is weighted
+/// against (all of a BSDF's lobes for the path tracer, whose continuation
+/// is that strategy; the non-specular ones for EstimateDirect, as pbrt-v3;
+/// a phase function).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn light_strategy(
     scene: &RenderScene,
-    s: &SurfaceHit,
-    bsdf: &Bsdf,
+    point: &SurfacePoint,
+    time: f32,
+    scatter: &impl Scatter,
     wo: Vec3,
     light_index: u32,
     u_light: Vec2,
     pmf: f32,
-    flags: BxdfFlags,
+    shadow: impl ShadowRay,
+    sampler: &mut Sampler,
     scratch: &mut Scratch,
 ) -> Vec3 {
     let light = &scene.lights[light_index as usize];
     // Read in place: moved out of the option, the sample was copied by
     // wide loads that stalled on the narrower stores that had just made it.
-    let sample = light.sample_li(&s.point, u_light, &scene.geometry);
+    let sample = light.sample_li(point, u_light, &scene.geometry);
     let Some(ls) = sample.as_ref() else {
         return Vec3::ZERO;
     };
     if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let (f, scattering_pdf) = bsdf.f_pdf(wo, ls.wi, flags);
-    let f = f * ls.wi.dot(s.point.ns).abs();
+    let (f, scattering_pdf) = scatter.f_pdf(wo, ls.wi);
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    scratch.counts.shadow += 1;
-    if scene.geometry.occluded_at(&ls.shadow, s.time) {
+    let Some(f) = shadow.through(scene, &ls.shadow, time, ls.wi, f, sampler, scratch) else {
         return Vec3::ZERO;
-    }
+    };
     let light_pdf = pmf * ls.pdf;
     if light.is_delta() {
         return f * ls.li / light_pdf;
     }
     f * ls.li * power_heuristic(1, light_pdf, 1, scattering_pdf) / light_pdf
+}
+
+/// The radiance of light `light_index` along `ray` (direction `wi`, at
+/// scene time `time`): its emission if the ray's first hit is on it, its
+/// radiance towards `wi` if the ray escapes (the BSDF strategy of pbrt-v3's
+/// EstimateDirect, scalar and four-lane). The ray is traced and counted.
+#[inline(always)]
+pub(super) fn light_along(
+    scene: &RenderScene,
+    ray: &Ray,
+    wi: Vec3,
+    time: f32,
+    light_index: u32,
+    scratch: &mut Scratch,
+) -> Vec3 {
+    scratch.counts.closest += 1;
+    let light = &scene.lights[light_index as usize];
+    match scene.geometry.intersect_at(ray, time) {
+        Some(h) => {
+            let hs = scene.geometry.surface_at(&h, time);
+            if hs.light == Some(light_index) {
+                light.emitted(hs.point.n, -wi)
+            } else {
+                Vec3::ZERO
+            }
+        }
+        None => light.le(wi),
+    }
+}
+
+/// The light distribution a `lightsamplestrategy` names, built over the
+/// scene's lights.
+pub(super) fn light_sampler(strategy: LightSampleStrategy, scene: &RenderScene) -> LightSampler {
+    let kind = match strategy {
+        LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
+        LightSampleStrategy::Power => LightSamplerKind::Power,
+        LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
+        LightSampleStrategy::Bvh => LightSamplerKind::Bvh,
+    };
+    LightSampler::new(kind, &scene.lights, &scene.geometry)
 }

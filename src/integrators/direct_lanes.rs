@@ -15,11 +15,15 @@
 //! [`TriangleLightPack`]: a vertex splatted into lanes with a pack of four
 //! lights, or four vertices with a pack of one light repeated.
 //!
+//! [`DirectLanes`] holds a batch's Lambertian camera vertices and their
+//! samples between the two passes.
+//!
 //! Every operation is the scalar path's (`estimate_direct` with
 //! `TriangleCache::sample_li`, `Bsdf::f_pdf`, `Bsdf::sample` and
 //! `TriangleCache::hit_pdf`), in the same order, so the image is the same
 //! bit for bit; tests render both ways and compare.
 
+use super::common::light_along;
 use super::Scratch;
 use crate::accel::SurfaceHit;
 use crate::geometry::{offset_ray_origin, spawn_ray_from_to, Ray};
@@ -31,6 +35,38 @@ use crate::sampling::{power_heuristic, sin_cos_quarter};
 use arrayvec::ArrayVec;
 use glam::{BVec4A, Vec2, Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_4};
+
+/// directlighting's Lambertian camera vertices of a batch (see
+/// [`super::directlighting`]'s `li_batch`): the batch lane of each, the vertex, its
+/// emission, its light and BSDF samples for every light, and the sums of
+/// the light estimates. Grown to the batch's need on the first batch.
+#[derive(Default)]
+pub(super) struct DirectLanes {
+    pub(super) lanes: Vec<u32>,
+    pub(super) verts: Vec<LambertVertex>,
+    pub(super) emitted: Vec<Vec3>,
+    pub(super) u: Vec<Vec2>,
+    pub(super) sums: Vec<Vec3>,
+}
+
+impl DirectLanes {
+    /// Bytes held (after a batch has grown them).
+    pub(super) fn bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.lanes.capacity() * size_of::<u32>()
+            + self.verts.capacity() * size_of::<LambertVertex>()
+            + (self.emitted.capacity() + self.sums.capacity()) * size_of::<Vec3>()
+            + self.u.capacity() * size_of::<Vec2>()
+    }
+
+    pub(super) fn clear(&mut self) {
+        self.lanes.clear();
+        self.verts.clear();
+        self.emitted.clear();
+        self.u.clear();
+        self.sums.clear();
+    }
+}
 
 /// A Lambertian vertex, as the estimate reads it.
 #[derive(Clone, Copy, Debug)]
@@ -271,20 +307,8 @@ fn lane_ld(
         if f != Vec3::ZERO {
             let wi = lane3(&e.wi_b, lane);
             let weight = power_heuristic(1, e.pdf_b[lane], 1, e.light_pdf_b[lane]);
-            scratch.counts.closest += 1;
             let ray = Ray::new(lane3(&e.o_b, lane), wi);
-            let light = &scene.lights[light_index as usize];
-            let li = match scene.geometry.intersect_at(&ray, v.time) {
-                Some(h) => {
-                    let hs = scene.geometry.surface_at(&h, v.time);
-                    if hs.light == Some(light_index) {
-                        light.emitted(hs.point.n, -wi)
-                    } else {
-                        Vec3::ZERO
-                    }
-                }
-                None => light.le(wi),
-            };
+            let li = light_along(scene, &ray, wi, v.time, light_index, scratch);
             ld += f * li * weight / e.pdf_b[lane];
         }
     }

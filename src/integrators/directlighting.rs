@@ -10,18 +10,23 @@
 //! | `strategy` | string | `all` | `all` lights at every vertex, or `one` chosen uniformly |
 //! | `pixelbounds` | | | ignored, with a warning |
 
-use super::common::{choose_light, light_strategy, LightSampleFirst};
+use super::batch::{trace_camera_rays, Batch};
+use super::common::{
+    choose_light, emitted, light_along, light_sampler, light_strategy, shade_geom, with_diff,
+    LightSampleFirst, SurfaceScatter, Unoccluded,
+};
 use super::direct_lanes;
-use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
+use super::specular::{specular_tree_li, tree_lanes, tree_li, First, SpecularTree};
+use super::{Integrate, IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
 use crate::accel::SurfaceHit;
-use crate::geometry::spawn_ray;
-use crate::integrators::RenderScene;
-use crate::lights::{LightSampler, TriangleLightPack};
+use crate::geometry::{spawn_ray, Ray, RayDiff};
+use crate::lights::{pack_triangle_lights, LightSampler, TriangleLightPack};
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
 use crate::sampling::power_heuristic;
+use crate::integrators::RenderScene;
 use crate::scene::kind::{Report, Support};
-use crate::scene::{DirectStrategy, ParamSpec, ParamValues};
+use crate::scene::{DirectStrategy, LightSampleStrategy, ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -96,43 +101,257 @@ impl DirectLightingSettings {
     }
 }
 
-/// How directlighting lights a vertex: its strategy, the light choice of
-/// strategy `one`, the sample counts of strategy `all` and its four-lane
-/// packs (empty unless every light is a triangle with one sample).
-pub(super) struct Lights<'a> {
-    pub strategy: DirectStrategy,
-    pub lights: &'a LightSampler,
-    pub n_light_samples: &'a [u32],
-    pub packs: &'a [TriangleLightPack],
+/// The runtime `directlighting`: its settings, its light distribution
+/// (strategy `one`), the sample counts (strategy `all`) and the four-lane
+/// light packs.
+pub struct DirectLighting {
+    settings: DirectLightingSettings,
+    lights: LightSampler,
+    n_light_samples: Vec<u32>,
+    /// The lights four to a pack, for strategy "all" when every light is
+    /// a triangle of constant normal with one sample (else empty).
+    packs: Vec<TriangleLightPack>,
+    /// Light `i` of `packs` in all four lanes, for the camera vertices of
+    /// a batch (one light at four vertices).
+    uniform: Vec<TriangleLightPack>,
 }
 
-/// Adds to `local` the direct light at `s` (nothing without lights).
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-pub(super) fn add_direct(
-    local: &mut Vec3,
-    scene: &RenderScene,
-    s: &SurfaceHit,
-    bsdf: &Bsdf,
-    wo: Vec3,
-    sampler: &mut Sampler,
-    scratch: &mut Scratch,
-    how: &Lights,
-) {
-    if !scene.lights.is_empty() {
-        *local += match (how.strategy, bsdf.single_lambertian()) {
-            (DirectStrategy::All, Some(r)) if !how.packs.is_empty() => {
-                direct_lanes::sample_all_lights_packed(
-                    scene, s, bsdf, r, wo, sampler, scratch, how.packs,
-                )
+impl DirectLighting {
+    /// `simd` allows the four-lane packs (which give the same image).
+    pub fn new(settings: &DirectLightingSettings, scene: &RenderScene, simd: bool) -> DirectLighting {
+        DirectLighting {
+            settings: *settings,
+            // pbrt-v3's directlighting chooses uniformly for strategy "one".
+            lights: light_sampler(LightSampleStrategy::Uniform, scene),
+            n_light_samples: Vec::new(),
+            packs: match settings.strategy {
+                DirectStrategy::All if simd => {
+                    pack_triangle_lights(&scene.lights).unwrap_or_default()
+                }
+                _ => Vec::new(),
+            },
+            uniform: Vec::new(),
+        }
+    }
+}
+
+impl Integrate for DirectLighting {
+    /// Strategy `all`: the sample counts of every light, and two arrays
+    /// per light and depth (pbrt-v3's Preprocess); the packs are dropped
+    /// unless every light has one sample.
+    fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
+        if self.settings.strategy != DirectStrategy::All {
+            return;
+        }
+        self.n_light_samples = scene
+            .lights
+            .iter()
+            .map(|l| sampler.round_count(l.n_samples()))
+            .collect();
+        if self.n_light_samples.iter().any(|&n| n != 1) {
+            self.packs.clear();
+        }
+        self.uniform = self
+            .packs
+            .iter()
+            .flat_map(|p| (0..p.count).map(|lane| p.uniform(lane)))
+            .collect();
+        for _ in 0..self.settings.max_depth {
+            for &n in &self.n_light_samples {
+                sampler.request_2d_array(n);
+                sampler.request_2d_array(n);
             }
-            (DirectStrategy::All, _) => {
-                sample_all_lights(scene, s, bsdf, wo, sampler, scratch, how.n_light_samples)
+        }
+    }
+
+    fn notes(&self) -> Vec<String> {
+        if self.packs.is_empty() {
+            return Vec::new();
+        }
+        vec![format!(
+            "directlighting \"all\": {} triangle lights in {} four-lane packs (Lambertian vertices sample four lights at once)",
+            self.packs.iter().map(|p| p.count).sum::<usize>(),
+            self.packs.len()
+        )]
+    }
+
+    fn light_sampler(&self) -> Option<&LightSampler> {
+        Some(&self.lights)
+    }
+
+    #[inline]
+    fn li(
+        &self,
+        ray: Ray,
+        time: f32,
+        diff: Option<RayDiff>,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
+        tree_li(self, ray, time, diff, scene, sampler, scratch)
+    }
+
+    /// With room for the batch's Lambertian camera vertices when the
+    /// lights are packed.
+    fn batch(&self, lanes: usize, sampler: &Sampler) -> Batch {
+        let mut b = Batch::new(lanes, sampler);
+        if !self.uniform.is_empty() {
+            let d = &mut b.direct;
+            d.lanes.reserve(lanes);
+            d.verts.reserve(lanes);
+            d.emitted.reserve(lanes);
+            d.sums.reserve(lanes);
+            d.u.reserve(lanes * 2 * self.uniform.len());
+        }
+        b
+    }
+
+    /// The camera rays first; then the Lambertian camera vertices four at a
+    /// time when the lights are packed ([`DirectLighting::direct_batch`]),
+    /// else the specular tree lane by lane.
+    fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
+        trace_camera_rays(b, scene);
+        if self.uniform.is_empty() {
+            tree_lanes(self, b, scene, scratch);
+        } else {
+            self.direct_batch(b, scene, scratch);
+        }
+    }
+}
+
+impl SpecularTree for DirectLighting {
+    fn max_depth(&self) -> u32 {
+        self.settings.max_depth
+    }
+
+    /// The direct light at `s` by the strategy (nothing without lights).
+    #[inline(always)]
+    fn add_direct(
+        &self,
+        local: &mut Vec3,
+        scene: &RenderScene,
+        s: &SurfaceHit,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) {
+        if !scene.lights.is_empty() {
+            *local += match (self.settings.strategy, bsdf.single_lambertian()) {
+                (DirectStrategy::All, Some(r)) if !self.packs.is_empty() => {
+                    direct_lanes::sample_all_lights_packed(
+                        scene,
+                        s,
+                        bsdf,
+                        r,
+                        wo,
+                        sampler,
+                        scratch,
+                        &self.packs,
+                    )
+                }
+                (DirectStrategy::All, _) => sample_all_lights(
+                    scene,
+                    s,
+                    bsdf,
+                    wo,
+                    sampler,
+                    scratch,
+                    &self.n_light_samples,
+                ),
+                (DirectStrategy::One, _) => {
+                    sample_one_light(scene, s, bsdf, wo, sampler, scratch, &self.lights)
+                }
+            };
+        }
+    }
+}
+
+impl DirectLighting {
+    /// directlighting (strategy "all", triangle lights) for a batch whose
+    /// camera rays are traced: camera vertices whose BSDF is one
+    /// Lambertian are shaded and their samples drawn lane by lane, then
+    /// their light estimates are computed four vertices at a time
+    /// ([`direct_lanes::sample_all_lights_lanes`]); the other lanes go
+    /// through [`specular_tree_li`] from their shaded vertex.
+    /// Lane by lane the same values, samples and rays as `li`.
+    fn direct_batch<'a>(
+        &self,
+        b: &mut Batch,
+        scene: &'a RenderScene,
+        scratch: &mut Scratch,
+    ) {
+        let (settings, packs, uniform) = (&self.settings, &self.packs, &self.uniform);
+        let d = &mut b.direct;
+        d.clear();
+        let mut bsdf = Bsdf::empty();
+        for j in 0..b.len {
+            // The differentials are copied only where they are read (a
+            // copy of every lane's stalled on the camera stage's stores).
+            let (ray, time, diff) = (b.rays[j], b.times[j], &b.diffs[j]);
+            let sampler = &mut b.samplers[j];
+            b.l[j] = Vec3::ZERO;
+            // The scalar loop's test: a NaN weight gets no radiance.
+            if b.weights[j].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
             }
-            (DirectStrategy::One, _) => {
-                sample_one_light(scene, s, bsdf, wo, sampler, scratch, how.lights)
+            let mut go_on = |first: First, bsdf: &mut Bsdf<'a>| {
+                specular_tree_li(self, ray, first, time, *diff, scene, sampler, scratch, bsdf)
+            };
+            let Some(hit) = b.hits[j] else {
+                b.l[j] = go_on(First::Hit(None), &mut bsdf);
+                continue;
+            };
+            let mut s = scene.geometry.surface_at(&hit, time);
+            let material = &scene.materials[s.material as usize];
+            if material.is_none() {
+                b.l[j] = go_on(First::Hit(Some(hit)), &mut bsdf);
+                continue;
             }
-        };
+            // specular_tree_li's shading of its first vertex.
+            let geom = diff
+                .as_ref()
+                .filter(|_| scene.material_needs_geom[s.material as usize])
+                .map(|dd| with_diff(scene, &hit, &s, dd));
+            shade_geom(
+                scene,
+                &hit,
+                &mut s,
+                material,
+                false,
+                geom.as_ref(),
+                &mut bsdf,
+            );
+            let Some(r) = bsdf.single_lambertian() else {
+                b.l[j] = go_on(First::Shaded { hit, s, geom }, &mut bsdf);
+                continue;
+            };
+            // What specular_tree_li does at a Lambertian first vertex: the
+            // vertex counted, the light samples drawn, and no specular
+            // children (their samples skipped).
+            scratch.counts.closest += 1;
+            let wo = -ray.d;
+            for pack in packs {
+                d.u.extend_from_slice(&direct_lanes::draw_samples(sampler, pack.count));
+            }
+            if 1 < settings.max_depth {
+                sampler.skip_2d();
+                sampler.skip_2d();
+            }
+            d.lanes.push(j as u32);
+            d.emitted.push(emitted(scene, &s, wo));
+            d.verts
+                .push(direct_lanes::LambertVertex::new(&s, &bsdf, r, wo));
+            d.sums.push(Vec3::ZERO);
+        }
+        direct_lanes::sample_all_lights_lanes(scene, &d.verts, &d.u, uniform, &mut d.sums, scratch);
+        for ((&j, &e), &sum) in d.lanes.iter().zip(&d.emitted).zip(&d.sums) {
+            // specular_tree_li's sums: local = emitted + estimate, then
+            // l += beta · local with l = 0 and beta = 1.
+            let local = e + sum;
+            b.l[j as usize] = Vec3::ZERO + Vec3::ONE * local;
+        }
     }
 }
 
@@ -153,7 +372,7 @@ pub(super) fn sample_one_light(
         return Vec3::ZERO;
     };
     let u_scatter = sampler.get_2d();
-    estimate_direct(scene, s, bsdf, wo, light, u_light, u_scatter, scratch) / pmf
+    estimate_direct(scene, s, bsdf, wo, light, u_light, u_scatter, sampler, scratch) / pmf
 }
 
 /// pbrt-v3's UniformSampleAllLights with per-pixel sample arrays.
@@ -177,13 +396,13 @@ pub(super) fn sample_all_lights(
         let ld = if got_light && got_scatter {
             let mut sum = Vec3::ZERO;
             for (&ul, &us) in u_light.iter().zip(&u_scatter) {
-                sum += estimate_direct(scene, s, bsdf, wo, light, ul, us, scratch);
+                sum += estimate_direct(scene, s, bsdf, wo, light, ul, us, sampler, scratch);
             }
             sum / n as f32
         } else {
             let ul = sampler.get_2d();
             let us = sampler.get_2d();
-            estimate_direct(scene, s, bsdf, wo, light, ul, us, scratch)
+            estimate_direct(scene, s, bsdf, wo, light, ul, us, sampler, scratch)
         };
         l += ld;
     }
@@ -204,20 +423,28 @@ pub(super) fn estimate_direct(
     light_index: u32,
     u_light: Vec2,
     u_scatter: Vec2,
+    sampler: &mut Sampler,
     scratch: &mut Scratch,
 ) -> Vec3 {
     let light = &scene.lights[light_index as usize];
     let geom = &scene.geometry;
     let ns = s.point.ns;
+    let scatter = SurfaceScatter {
+        bsdf,
+        ns,
+        flags: BxdfFlags::NON_SPECULAR,
+    };
     let mut ld = light_strategy(
         scene,
-        s,
-        bsdf,
+        &s.point,
+        s.time,
+        &scatter,
         wo,
         light_index,
         u_light,
         1.0,
-        BxdfFlags::NON_SPECULAR,
+        Unoccluded,
+        sampler,
         scratch,
     );
     if !light.is_delta() {
@@ -230,18 +457,7 @@ pub(super) fn estimate_direct(
                     return ld;
                 }
                 let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
-                scratch.counts.closest += 1;
-                let li = match geom.intersect_at(&ray, s.time) {
-                    Some(h) => {
-                        let hs = geom.surface_at(&h, s.time);
-                        if hs.light == Some(light_index) {
-                            light.emitted(hs.point.n, -bs.wi)
-                        } else {
-                            Vec3::ZERO
-                        }
-                    }
-                    None => light.le(bs.wi),
-                };
+                let li = light_along(scene, &ray, bs.wi, s.time, light_index, scratch);
                 ld += f * li * weight / bs.pdf;
             }
         }

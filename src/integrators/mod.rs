@@ -1,48 +1,46 @@
 //! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
 //! power-heuristic MIS, Russian roulette), `volpath` (the same with
-//! participating media, in [`volpath`]), `directlighting` (strategy all or
-//! one, specular lobes followed recursively) and `whitted`.
+//! participating media), `directlighting` (strategy all or one, specular
+//! lobes followed recursively) and `whitted`.
 //!
-//! One file per integrator: [`path`], [`volpath`], [`directlighting`] and
+//! One file per integrator: [`path`] (with the per-vertex step `path` and
+//! `volpath` share, over the medium the path is in), [`volpath`] (the
+//! medium tracking and transmittance of that step), [`directlighting`] and
 //! [`whitted`]; the recursive specular tree that directlighting and
 //! whitted share ([`specular`]); the batch of samples a thread renders
-//! together ([`batch`]); directlighting's four-lane estimate
-//! ([`direct_lanes`]); and what several of them share, written once
-//! ([`common`]: shading, emission, light choice and sampling, MIS weights,
-//! Russian roulette; [`subsurface`]: the BSSRDF exit of path and volpath).
+//! together ([`batch`]: `path` and `volpath` one vertex of every lane at a
+//! time); directlighting's four-lane estimate ([`direct_lanes`]); and what
+//! several of them share, written once ([`common`]: shading, emission,
+//! light choice and sampling, MIS weights, Russian roulette;
+//! [`subsurface`]: the BSSRDF exit of path and volpath).
 //!
 //! [`INTEGRATORS`] is the table of kinds the loader, `--check`,
 //! `grammar/REFERENCE.md` and the tests read; a kind's builder gives its
-//! settings (one struct per kind, [`IntegratorSettings`] the enum that only
-//! delegates), which the scene description holds; [`Integrator::new`] makes
-//! the runtime integrator from them.
+//! settings (one struct per kind), which the scene description holds;
+//! [`Integrator::new`] makes the runtime integrator from them (one struct
+//! per kind, built from its settings and the scene, implementing
+//! [`Integrate`]). The `integrators!` macro declares the kinds' modules
+//! and generates both enums, [`IntegratorSettings`] and [`Integrator`],
+//! which only delegate (a `match`, no dynamic dispatch). A new kind is its
+//! file, its row of [`INTEGRATORS`] and its line of `integrators!`.
 
 use crate::geometry::{Ray, RayDiff};
-use crate::lights::{pack_triangle_lights, LightSampler, LightSamplerKind, TriangleLightPack};
-use crate::materials::Bsdf;
+use crate::lights::LightSampler;
 use crate::samplers::Sampler;
 use crate::scene::kind::{Kind, Report, Support};
-use crate::scene::{DirectStrategy, LightSampleStrategy, ParamSpec, ParamValues};
+use crate::scene::{ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
 
 mod batch;
 mod common;
 mod direct_lanes;
-mod directlighting;
-mod path;
 mod render_scene;
 mod specular;
 mod subsurface;
-mod volpath;
-mod whitted;
 
 pub use batch::Batch;
-pub use directlighting::DirectLightingSettings;
-pub use path::PathSettings;
 pub use render_scene::{RenderScene, SurfaceMedia};
-use specular::{First, Work};
-pub use volpath::VolPathSettings;
-pub use whitted::WhittedSettings;
+use specular::Work;
 
 /// Rays traced, counted per tile and summed at the end (no shared counters).
 #[derive(Clone, Copy, Debug, Default)]
@@ -149,11 +147,72 @@ fn max_depth(p: &ParamValues, r: &mut dyn Report) -> u32 {
     }
 }
 
-/// The integrator's settings, one variant per kind pbrs renders: made by
-/// the kind's builder, held by the scene description and by the runtime
-/// [`Integrator`]. Its methods only delegate to the kinds' files.
+/// What a runtime integrator does; each kind's struct implements it (only
+/// `li` is required) and [`Integrator`] delegates to it.
+pub trait Integrate {
+    /// Requests the sampler arrays the integrator uses (pbrt-v3's
+    /// Preprocess).
+    fn prepare_sampler(&mut self, _scene: &RenderScene, _sampler: &mut Sampler) {}
+
+    /// What the integrator built beyond the light distribution.
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// The light distribution, for kinds that choose lights.
+    fn light_sampler(&self) -> Option<&LightSampler> {
+        None
+    }
+
+    /// Radiance arriving at the camera along `ray` at scene time `time`
+    /// (every ray of the path is traced at it), with its differentials if
+    /// it has them.
+    fn li(
+        &self,
+        ray: Ray,
+        time: f32,
+        diff: Option<RayDiff>,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3;
+
+    /// A batch of `lanes` lanes for [`Integrate::li_batch`], each with a
+    /// copy of `sampler`, with room for what the kind keeps per lane.
+    fn batch(&self, lanes: usize, sampler: &Sampler) -> Batch {
+        Batch::new(lanes, sampler)
+    }
+
+    /// [`Integrate::li`] for the camera rays of a batch of samples, lane by
+    /// lane the same values bit for bit. Each lane has its own sampler,
+    /// positioned at its sample; lanes of weight 0 get no radiance. Unless
+    /// the kind does better, lane by lane.
+    fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
+        for j in 0..b.len {
+            let (ray, time, diff) = (b.rays[j], b.times[j], b.diffs[j]);
+            // The scalar loop's test: a NaN weight gets no radiance.
+            b.l[j] = if b.weights[j] > 0.0 {
+                self.li(ray, time, diff, scene, &mut b.samplers[j], scratch)
+            } else {
+                Vec3::ZERO
+            };
+        }
+    }
+}
+
+/// The kinds pbrs renders, each `Variant(Settings) => module::Runtime`:
+/// declares the kinds' modules and generates the settings enum
+/// ([`IntegratorSettings`], made by the kind's builder and held by the
+/// scene description) and the runtime enum ([`Integrator`], made from the
+/// settings and the scene), whose methods only delegate to the kinds'
+/// files.
 macro_rules! integrators {
-    ($($variant:ident($settings:ident) in $module:ident),* $(,)?) => {
+    ($($variant:ident($settings:ident) => $module:ident::$runtime:ident),* $(,)?) => {
+        $(
+            mod $module;
+            pub use $module::$settings;
+        )*
+
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub enum IntegratorSettings {
             $($variant($settings),)*
@@ -207,201 +266,90 @@ macro_rules! integrators {
                 }
             }
         }
+
+        /// The runtime integrator: one variant per kind, each the kind's
+        /// struct (its settings and what it builds from the scene).
+        pub enum Integrator {
+            $($variant($module::$runtime),)*
+        }
+
+        impl Integrator {
+            /// Builds the kind's integrator from its settings and the
+            /// scene; `simd` allows the four-lane paths (which give the
+            /// same image).
+            pub fn new(settings: &IntegratorSettings, scene: &RenderScene, simd: bool) -> Integrator {
+                match settings {
+                    $(IntegratorSettings::$variant(s) => {
+                        Integrator::$variant($module::$runtime::new(s, scene, simd))
+                    })*
+                }
+            }
+
+            /// See [`Integrate::prepare_sampler`].
+            pub fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
+                match self {
+                    $(Integrator::$variant(i) => i.prepare_sampler(scene, sampler),)*
+                }
+            }
+
+            /// See [`Integrate::notes`].
+            pub fn notes(&self) -> Vec<String> {
+                match self {
+                    $(Integrator::$variant(i) => i.notes(),)*
+                }
+            }
+
+            /// See [`Integrate::light_sampler`].
+            pub fn light_sampler(&self) -> Option<&LightSampler> {
+                match self {
+                    $(Integrator::$variant(i) => i.light_sampler(),)*
+                }
+            }
+
+            /// See [`Integrate::li`].
+            #[inline]
+            pub fn li(
+                &self,
+                ray: Ray,
+                time: f32,
+                diff: Option<RayDiff>,
+                scene: &RenderScene,
+                sampler: &mut Sampler,
+                scratch: &mut Scratch,
+            ) -> Vec3 {
+                match self {
+                    $(Integrator::$variant(i) => i.li(ray, time, diff, scene, sampler, scratch),)*
+                }
+            }
+
+            /// See [`Integrate::batch`].
+            pub fn batch(&self, lanes: usize, sampler: &Sampler) -> Batch {
+                match self {
+                    $(Integrator::$variant(i) => i.batch(lanes, sampler),)*
+                }
+            }
+
+            /// See [`Integrate::li_batch`].
+            #[inline]
+            pub fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
+                match self {
+                    $(Integrator::$variant(i) => i.li_batch(b, scene, scratch),)*
+                }
+            }
+        }
     };
 }
 
 integrators! {
-    Path(PathSettings) in path,
-    VolPath(VolPathSettings) in volpath,
-    DirectLighting(DirectLightingSettings) in directlighting,
-    Whitted(WhittedSettings) in whitted,
+    Path(PathSettings) => path::Path,
+    VolPath(VolPathSettings) => volpath::VolPath,
+    DirectLighting(DirectLightingSettings) => directlighting::DirectLighting,
+    Whitted(WhittedSettings) => whitted::Whitted,
 }
 
 /// Without an `Integrator` statement: `path` with pbrt-v3's defaults.
 impl Default for IntegratorSettings {
     fn default() -> IntegratorSettings {
         IntegratorSettings::Path(PathSettings::default())
-    }
-}
-
-/// The runtime integrator: a kind's settings and what it builds from the
-/// scene (its light distribution, directlighting's sample counts and
-/// four-lane light packs).
-pub enum Integrator {
-    Path {
-        settings: PathSettings,
-        lights: LightSampler,
-    },
-    Direct {
-        settings: DirectLightingSettings,
-        lights: LightSampler,
-        n_light_samples: Vec<u32>,
-        /// The lights four to a pack, for strategy "all" when every light is
-        /// a triangle of constant normal with one sample (else empty).
-        packs: Vec<TriangleLightPack>,
-        /// Light `i` of `packs` in all four lanes, for the camera vertices
-        /// of a batch (one light at four vertices).
-        uniform: Vec<TriangleLightPack>,
-    },
-    Whitted {
-        settings: WhittedSettings,
-    },
-    VolPath {
-        settings: VolPathSettings,
-        lights: LightSampler,
-    },
-}
-
-/// The light distribution a `lightsamplestrategy` names.
-fn light_sampler_kind(s: LightSampleStrategy) -> LightSamplerKind {
-    match s {
-        LightSampleStrategy::Uniform => LightSamplerKind::Uniform,
-        LightSampleStrategy::Power => LightSamplerKind::Power,
-        LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
-        LightSampleStrategy::Bvh => LightSamplerKind::Bvh,
-    }
-}
-
-impl Integrator {
-    /// Builds the integrator and only the light distribution it uses;
-    /// `simd` allows the four-lane paths (which give the same image).
-    pub fn new(settings: &IntegratorSettings, scene: &RenderScene, simd: bool) -> Integrator {
-        let lights = |strategy: LightSampleStrategy| {
-            let kind = light_sampler_kind(strategy);
-            LightSampler::new(kind, &scene.lights, &scene.geometry)
-        };
-        match *settings {
-            IntegratorSettings::Path(settings) => Integrator::Path {
-                settings,
-                lights: lights(settings.light_sample_strategy),
-            },
-            IntegratorSettings::DirectLighting(settings) => Integrator::Direct {
-                settings,
-                // pbrt-v3's directlighting chooses uniformly for strategy "one".
-                lights: lights(LightSampleStrategy::Uniform),
-                n_light_samples: Vec::new(),
-                packs: match settings.strategy {
-                    DirectStrategy::All if simd => {
-                        pack_triangle_lights(&scene.lights).unwrap_or_default()
-                    }
-                    _ => Vec::new(),
-                },
-                uniform: Vec::new(),
-            },
-            IntegratorSettings::Whitted(settings) => Integrator::Whitted { settings },
-            IntegratorSettings::VolPath(settings) => Integrator::VolPath {
-                settings,
-                lights: lights(settings.light_sample_strategy),
-            },
-        }
-    }
-
-    /// Requests the sampler arrays the integrator uses (pbrt-v3's Preprocess).
-    pub fn prepare_sampler(&mut self, scene: &RenderScene, sampler: &mut Sampler) {
-        if let Integrator::Direct {
-            settings:
-                DirectLightingSettings {
-                    max_depth,
-                    strategy: DirectStrategy::All,
-                },
-            n_light_samples,
-            packs,
-            uniform,
-            ..
-        } = self
-        {
-            *n_light_samples = scene
-                .lights
-                .iter()
-                .map(|l| sampler.round_count(l.n_samples()))
-                .collect();
-            if n_light_samples.iter().any(|&n| n != 1) {
-                packs.clear();
-            }
-            *uniform = packs
-                .iter()
-                .flat_map(|p| (0..p.count).map(|lane| p.uniform(lane)))
-                .collect();
-            for _ in 0..*max_depth {
-                for &n in n_light_samples.iter() {
-                    sampler.request_2d_array(n);
-                    sampler.request_2d_array(n);
-                }
-            }
-        }
-    }
-
-    /// What the integrator built beyond the light distribution.
-    pub fn notes(&self) -> Vec<String> {
-        match self {
-            Integrator::Direct { packs, .. } if !packs.is_empty() => vec![format!(
-                "directlighting \"all\": {} triangle lights in {} four-lane packs (Lambertian vertices sample four lights at once)",
-                packs.iter().map(|p| p.count).sum::<usize>(),
-                packs.len()
-            )],
-            _ => Vec::new(),
-        }
-    }
-
-    pub fn light_sampler(&self) -> Option<&LightSampler> {
-        match self {
-            Integrator::Path { lights, .. }
-            | Integrator::Direct { lights, .. }
-            | Integrator::VolPath { lights, .. } => Some(lights),
-            Integrator::Whitted { .. } => None,
-        }
-    }
-
-    /// Radiance arriving at the camera along `ray` at scene time `time`
-    /// (every ray of the path is traced at it), with its differentials if it
-    /// has them.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    pub fn li(
-        &self,
-        ray: Ray,
-        time: f32,
-        diff: Option<RayDiff>,
-        scene: &RenderScene,
-        sampler: &mut Sampler,
-        scratch: &mut Scratch,
-    ) -> Vec3 {
-        match self {
-            Integrator::Path { settings, lights } => path::path_li(
-                ray,
-                time,
-                diff,
-                scene,
-                sampler,
-                scratch,
-                settings.max_depth,
-                settings.rr_threshold,
-                lights,
-            ),
-            Integrator::VolPath { settings, lights } => volpath::volpath_li(
-                ray,
-                time,
-                diff,
-                scene,
-                sampler,
-                scratch,
-                settings.max_depth,
-                settings.rr_threshold,
-                lights,
-            ),
-            Integrator::Direct { .. } | Integrator::Whitted { .. } => {
-                let mut bsdf = Bsdf::empty();
-                self.specular_tree_li(
-                    ray,
-                    First::Trace,
-                    time,
-                    diff,
-                    scene,
-                    sampler,
-                    scratch,
-                    &mut bsdf,
-                )
-            }
-        }
     }
 }

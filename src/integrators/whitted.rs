@@ -6,11 +6,14 @@
 //! | `maxdepth` | integer | 5 | maximum depth of the specular tree (≥ 0) |
 //! | `pixelbounds` | | | ignored, with a warning |
 
-use super::{IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
+use super::batch::{trace_camera_rays, Batch};
+use super::specular::{tree_lanes, tree_li, SpecularTree};
+use super::{Integrate, IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
 use crate::accel::SurfaceHit;
-use crate::integrators::RenderScene;
+use crate::geometry::{Ray, RayDiff};
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
+use crate::integrators::RenderScene;
 use crate::scene::kind::{Report, Support};
 use crate::scene::{ParamSpec, ParamValues};
 use glam::Vec3;
@@ -56,32 +59,72 @@ impl WhittedSettings {
     }
 }
 
-/// Adds to `local` the light of every light at `s`: one sample each, its
-/// shadow ray traced, no MIS.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-pub(super) fn add_direct(
-    local: &mut Vec3,
-    scene: &RenderScene,
-    s: &SurfaceHit,
-    bsdf: &Bsdf,
-    wo: Vec3,
-    sampler: &mut Sampler,
-    scratch: &mut Scratch,
-) {
-    for light in &scene.lights {
-        let u = sampler.get_2d();
-        let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else {
-            continue;
-        };
-        if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
-            continue;
+/// The runtime `whitted`: its settings.
+pub struct Whitted {
+    settings: WhittedSettings,
+}
+
+impl Whitted {
+    pub fn new(settings: &WhittedSettings, _scene: &RenderScene, _simd: bool) -> Whitted {
+        Whitted {
+            settings: *settings,
         }
-        let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
-        if f != Vec3::ZERO {
-            scratch.counts.shadow += 1;
-            if !scene.geometry.occluded_at(&ls.shadow, s.time) {
-                *local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
+    }
+}
+
+impl Integrate for Whitted {
+    #[inline]
+    fn li(
+        &self,
+        ray: Ray,
+        time: f32,
+        diff: Option<RayDiff>,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
+        tree_li(self, ray, time, diff, scene, sampler, scratch)
+    }
+
+    /// The camera rays first, then the specular tree lane by lane.
+    fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
+        trace_camera_rays(b, scene);
+        tree_lanes(self, b, scene, scratch);
+    }
+}
+
+impl SpecularTree for Whitted {
+    fn max_depth(&self) -> u32 {
+        self.settings.max_depth
+    }
+
+    /// Adds to `local` the light of every light at `s`: one sample each, its
+    /// shadow ray traced, no MIS.
+    #[inline(always)]
+    fn add_direct(
+        &self,
+        local: &mut Vec3,
+        scene: &RenderScene,
+        s: &SurfaceHit,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) {
+        for light in &scene.lights {
+            let u = sampler.get_2d();
+            let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else {
+                continue;
+            };
+            if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
+                continue;
+            }
+            let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
+            if f != Vec3::ZERO {
+                scratch.counts.shadow += 1;
+                if !scene.geometry.occluded_at(&ls.shadow, s.time) {
+                    *local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
+                }
             }
         }
     }
