@@ -40,6 +40,11 @@ const CASES: &[Case] = &[
         params: "\"integer maxdepth\" 2",
         summary: "whitted, maxdepth 2",
     },
+    Case {
+        kind: "ambientocclusion",
+        params: "\"integer nsamples\" 8 \"bool cossample\" \"false\"",
+        summary: "ambientocclusion, nsamples 8, uniform sampling",
+    },
 ];
 
 /// A small scene lit by a point light and an area light: a matte floor, a
@@ -124,6 +129,53 @@ fn unsupported_kinds_are_path_with_their_maxdepth() {
         );
         assert!(!w.contains("visualizestrategies"), "{w}");
         assert_eq!(loaded.scene.integrator.name(), "path");
-        assert_eq!(loaded.scene.integrator.max_depth(), 2);
+        let pbrs::scene::IntegratorSettings::Path(p) = loaded.scene.integrator else {
+            panic!("not path")
+        };
+        assert_eq!(p.max_depth, 2);
+    }
+}
+
+/// Ambient occlusion against closed forms: each unoccluded direction adds
+/// cos θ / (pdf · n), so an open hemisphere gives π (exactly, by cosine
+/// sampling; on average, uniformly), and a point at the foot of a wall
+/// that fills half the hemisphere π/2 on average.
+#[test]
+fn ambient_occlusion_closed_forms() {
+    let ao = |cos: bool, wall: bool| {
+        let wall = if wall {
+            // The wall x = 0, from the floor up: the camera sees the floor
+            // just beside it (x slightly above 0), half of whose hemisphere
+            // (x < 0) it closes.
+            "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point P\" [0 0 -10  0 0 10  0 10 10  0 10 -10]"
+        } else {
+            ""
+        };
+        let text = format!(
+            r#"LookAt 0.001 1 0  0.001 0 0  0 0 1
+Camera "orthographic" "float screenwindow" [-0.0001 0.0001 -0.0001 0.0001]
+Film "image" "integer xresolution" 4 "integer yresolution" 4
+Sampler "random" "integer pixelsamples" 64
+Integrator "ambientocclusion" "integer nsamples" 16 "bool cossample" "{cos}"
+WorldBegin
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-10 0 -10  10 0 -10  10 0 10  -10 0 10]
+{wall}
+WorldEnd
+"#
+        );
+        let (img, _) = render_at(load_text(&text).scene, 4, 64, Some(1));
+        img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len() as f64
+    };
+    let pi = std::f64::consts::PI;
+    let open = ao(true, false);
+    assert!((open - pi).abs() < 1e-5, "open, cosine: {open}");
+    let open = ao(false, false);
+    assert!((open - pi).abs() < 0.02 * pi, "open, uniform: {open}");
+    for cos in [true, false] {
+        let half = ao(cos, true);
+        assert!(
+            (half - pi / 2.0).abs() < 0.03 * pi,
+            "wall, cosine {cos}: {half}"
+        );
     }
 }

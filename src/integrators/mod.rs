@@ -93,13 +93,13 @@ pub static INTEGRATORS: &[IntegratorKind] = &[
     volpath::KIND,
     directlighting::KIND,
     whitted::KIND,
+    ambientocclusion::KIND,
     unsupported("bdpt", "bidirectional path tracing is not implemented"),
     unsupported("mlt", "Metropolis light transport is not implemented"),
     unsupported(
         "sppm",
         "stochastic progressive photon mapping is not implemented",
     ),
-    unsupported("ambientocclusion", "ambient occlusion is not implemented"),
 ];
 
 /// `maxdepth`, which every integrator reads.
@@ -231,19 +231,6 @@ macro_rules! integrators {
                 self.kind().name
             }
 
-            pub fn max_depth(&self) -> u32 {
-                match self {
-                    $(IntegratorSettings::$variant(s) => s.max_depth,)*
-                }
-            }
-
-            /// Sets `maxdepth` (the command line's and the tests' override).
-            pub fn set_max_depth(&mut self, d: u32) {
-                match self {
-                    $(IntegratorSettings::$variant(s) => s.max_depth = d,)*
-                }
-            }
-
             /// The kind and its settings in a line, for `--check` and `--stats`.
             pub fn summary(&self) -> String {
                 let settings = match self {
@@ -345,6 +332,7 @@ integrators! {
     VolPath(VolPathSettings) => volpath::VolPath,
     DirectLighting(DirectLightingSettings) => directlighting::DirectLighting,
     Whitted(WhittedSettings) => whitted::Whitted,
+    AmbientOcclusion(AmbientOcclusionSettings) => ambientocclusion::AmbientOcclusion,
 }
 
 /// Without an `Integrator` statement: `path` with pbrt-v3's defaults.

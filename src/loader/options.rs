@@ -190,7 +190,11 @@ pub fn integrator(ctx: &mut Ctx, s: Ent) -> IntegratorSettings {
     let settings = (read.kind.build)(&read.params, &mut report);
     if read.kind.unsupported().is_some() {
         p.mark_all_used();
-        ctx.warn(name.loc, format!("integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth {}", name.value, settings.max_depth()), "substituted by path");
+        let depth = match &settings {
+            IntegratorSettings::Path(p) => p.max_depth,
+            _ => unreachable!("pbrs substitutes path for the integrators it does not render"),
+        };
+        ctx.warn(name.loc, format!("integrator \"{}\" is not supported by pbrs: substituted by \"path\" with maxdepth {depth}", name.value), "substituted by path");
     }
     kinds::report_unused(ctx, &family, &read, name, p);
     settings

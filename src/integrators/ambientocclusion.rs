@@ -1,0 +1,176 @@
+//! `ambientocclusion`: pbrt-v3's AOIntegrator. At the first surface with a
+//! BSDF the camera ray meets (surfaces of `Material "none"` are crossed),
+//! `nsamples` directions of the hemisphere around the geometric normal
+//! turned towards the camera are sampled, by cosine or uniformly, and each
+//! unoccluded one adds cos θ / (pdf · nsamples): the image is the fraction
+//! of the hemisphere, cosine-weighted, that is open. Lights, materials'
+//! colours and media play no part; rays that meet nothing are black.
+//!
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `cossample` | bool | true | sample by cosine (else uniformly over the hemisphere) |
+//! | `nsamples` | integer | 64 | directions per camera ray (≥ 1), one 2D sampler array |
+//! | `pixelbounds` | | | ignored, with a warning |
+//!
+//! As pbrt-v3, the hemisphere's frame is (dp/du normalised, n × dp/du, n
+//! turned towards the camera), from the surface's geometric dp/du and normal.
+
+use super::{Integrate, IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH, PIXEL_BOUNDS};
+use crate::geometry::{face_forward, spawn_ray, Ray, RayDiff};
+use crate::integrators::RenderScene;
+use crate::samplers::Sampler;
+use crate::sampling::{
+    cosine_hemisphere_pdf, cosine_sample_hemisphere, uniform_hemisphere_pdf,
+    uniform_sample_hemisphere,
+};
+use crate::scene::kind::{Report, Support};
+use crate::scene::{ParamSpec, ParamValues};
+use glam::Vec3;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::boolean(
+        "cossample",
+        true,
+        "sample directions by cosine (false: uniformly over the hemisphere)",
+    ),
+    ParamSpec::int("nsamples", 64, "directions sampled per camera ray (≥ 1)"),
+    PIXEL_BOUNDS,
+];
+
+pub const KIND: IntegratorKind = IntegratorKind {
+    name: "ambientocclusion",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "ambient occlusion: the cosine-weighted open fraction of the hemisphere at the first surface, from nsamples directions",
+    build: |p, r| IntegratorSettings::AmbientOcclusion(AmbientOcclusionSettings::read(p, r)),
+};
+
+/// Ambient occlusion sees no media and no subsurface scattering.
+pub const RENDERS_MEDIA: bool = false;
+pub const SAMPLES_SUBSURFACE: bool = false;
+
+/// `ambientocclusion`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AmbientOcclusionSettings {
+    pub cos_sample: bool,
+    pub n_samples: u32,
+}
+
+impl Default for AmbientOcclusionSettings {
+    fn default() -> Self {
+        AmbientOcclusionSettings {
+            cos_sample: true,
+            n_samples: 64,
+        }
+    }
+}
+
+impl AmbientOcclusionSettings {
+    /// The settings of a statement's parameters; `nsamples` below 1 is an
+    /// error (pbrt-v3 would divide by zero) and 64 is used.
+    pub fn read(p: &ParamValues, r: &mut dyn Report) -> Self {
+        let n = p.int("nsamples");
+        let n_samples = if n < 1 {
+            r.error(
+                Some("nsamples"),
+                format!("\"nsamples\" is {n}: it must be ≥ 1"),
+                "no samples",
+            );
+            64
+        } else {
+            n as u32
+        };
+        AmbientOcclusionSettings {
+            cos_sample: p.boolean("cossample"),
+            n_samples,
+        }
+    }
+
+    pub fn summary(&self) -> String {
+        format!(
+            "nsamples {}, {} sampling",
+            self.n_samples,
+            if self.cos_sample { "cosine" } else { "uniform" }
+        )
+    }
+}
+
+/// The runtime `ambientocclusion`: its settings and the size of its
+/// sampler array.
+pub struct AmbientOcclusion {
+    settings: AmbientOcclusionSettings,
+    n: u32,
+}
+
+impl AmbientOcclusion {
+    pub fn new(settings: &AmbientOcclusionSettings, _scene: &RenderScene, _simd: bool) -> Self {
+        AmbientOcclusion {
+            settings: *settings,
+            n: settings.n_samples,
+        }
+    }
+}
+
+impl Integrate for AmbientOcclusion {
+    /// One 2D array of `nsamples` (rounded as the sampler wants).
+    fn prepare_sampler(&mut self, _scene: &RenderScene, sampler: &mut Sampler) {
+        self.n = sampler.round_count(self.settings.n_samples);
+        sampler.request_2d_array(self.n);
+    }
+
+    fn li(
+        &self,
+        mut ray: Ray,
+        time: f32,
+        _diff: Option<RayDiff>,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
+        let mut crossed = 0;
+        let (hit, s) = loop {
+            scratch.counts.closest += 1;
+            let Some(hit) = scene.geometry.intersect_at(&ray, time) else {
+                return Vec3::ZERO;
+            };
+            let s = scene.geometry.surface_at(&hit, time);
+            if !scene.materials[s.material as usize].is_none() {
+                break (hit, s);
+            }
+            crossed += 1;
+            if crossed > MAX_PASS_THROUGH {
+                return Vec3::ZERO;
+            }
+            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+        };
+        let n = face_forward(s.point.n, -ray.d);
+        let dpdu = scene.geometry.diff_geom(&hit, &s).dpdu;
+        let sx = dpdu.normalize();
+        let t = s.point.n.cross(sx);
+        let Some(u) = sampler.get_2d_array(self.n) else {
+            return Vec3::ZERO;
+        };
+        let count = self.n as f32;
+        let mut l = 0.0f32;
+        for &u in u {
+            let (w, pdf) = if self.settings.cos_sample {
+                let w = cosine_sample_hemisphere(u);
+                (w, cosine_hemisphere_pdf(w.z.abs()))
+            } else {
+                (uniform_sample_hemisphere(u), uniform_hemisphere_pdf())
+            };
+            let wi = Vec3::new(
+                sx.x * w.x + t.x * w.y + n.x * w.z,
+                sx.y * w.x + t.y * w.y + n.y * w.z,
+                sx.z * w.x + t.z * w.y + n.z * w.z,
+            );
+            scratch.counts.shadow += 1;
+            let shadow = spawn_ray(s.point.p, s.point.p_error, s.point.n, wi);
+            if !scene.geometry.occluded_at(&shadow, time) {
+                l += wi.dot(n) / (pdf * count);
+            }
+        }
+        Vec3::splat(l)
+    }
+}
