@@ -15,7 +15,9 @@
 //!   line is a cubic in the distance, which 3-point Gauss–Legendre
 //!   integrates exactly);
 //! - rendered: a box of constant-density grid under the transforms gives
-//!   the image of the same box holding the equivalent homogeneous medium.
+//!   the image of the same box holding the equivalent homogeneous medium;
+//!   a smoke box scaled 1.1 1.2 1.1 the image of the scale folded into the
+//!   box and the grid's p0…p1.
 //!
 //! Each estimate is checked against its closed form within a tolerance
 //! from the estimator's own sample variance, ray by ray and summed over the
@@ -622,7 +624,9 @@ fn constant_grid_box_renders_as_the_homogeneous_medium_under_transforms() {
 /// a box scaled 1.1 1.2 1.1 after a rotation (issue 34's scene): the same
 /// image as the smoke with the scale folded into the box's vertices and
 /// the grid's p0…p1 (the same medium in world space, placed by the
-/// rotation only).
+/// rotation only). This checks that the CTM at `MakeNamedMedium` and
+/// p0…p1 make one placement, for the box and the grid alike; the
+/// closed-form tests above check the distances along rays.
 #[test]
 fn scaled_smoke_box_renders_as_the_scale_folded_into_the_box() {
     let n = 8;
