@@ -104,7 +104,7 @@ pub struct AmbientOcclusion {
 }
 
 impl AmbientOcclusion {
-    pub fn new(settings: &AmbientOcclusionSettings, _scene: &RenderScene, _simd: bool) -> Self {
+    pub fn new(settings: &AmbientOcclusionSettings, _scene: &RenderScene, _scalar: bool) -> Self {
         AmbientOcclusion {
             settings: *settings,
             n: settings.n_samples,

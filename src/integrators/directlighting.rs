@@ -117,15 +117,15 @@ pub struct DirectLighting {
 }
 
 impl DirectLighting {
-    /// `simd` allows the four-lane packs (which give the same image).
-    pub fn new(settings: &DirectLightingSettings, scene: &RenderScene, simd: bool) -> DirectLighting {
+    /// `scalar` (the options' switch) leaves out the four-lane packs (which give the same image).
+    pub fn new(settings: &DirectLightingSettings, scene: &RenderScene, scalar: bool) -> DirectLighting {
         DirectLighting {
             settings: *settings,
             // pbrt-v3's directlighting chooses uniformly for strategy "one".
             lights: light_sampler(LightSampleStrategy::Uniform, scene),
             n_light_samples: Vec::new(),
             packs: match settings.strategy {
-                DirectStrategy::All if simd => {
+                DirectStrategy::All if !scalar => {
                     pack_triangle_lights(&scene.lights).unwrap_or_default()
                 }
                 _ => Vec::new(),

@@ -262,12 +262,12 @@ macro_rules! integrators {
 
         impl Integrator {
             /// Builds the kind's integrator from its settings and the
-            /// scene; `simd` allows the four-lane paths (which give the
-            /// same image).
-            pub fn new(settings: &IntegratorSettings, scene: &RenderScene, simd: bool) -> Integrator {
+            /// scene; `scalar` (`RenderOptions::scalar`) leaves out the
+            /// four-lane paths (which give the same image).
+            pub fn new(settings: &IntegratorSettings, scene: &RenderScene, scalar: bool) -> Integrator {
                 match settings {
                     $(IntegratorSettings::$variant(s) => {
-                        Integrator::$variant($module::$runtime::new(s, scene, simd))
+                        Integrator::$variant($module::$runtime::new(s, scene, scalar))
                     })*
                 }
             }

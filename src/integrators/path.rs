@@ -127,7 +127,7 @@ pub struct Path {
 }
 
 impl Path {
-    pub fn new(settings: &PathSettings, scene: &RenderScene, _simd: bool) -> Path {
+    pub fn new(settings: &PathSettings, scene: &RenderScene, _scalar: bool) -> Path {
         Path {
             settings: *settings,
             lights: light_sampler(settings.light_sample_strategy, scene),

@@ -68,7 +68,7 @@ pub struct VolPath {
 }
 
 impl VolPath {
-    pub fn new(settings: &VolPathSettings, scene: &RenderScene, _simd: bool) -> VolPath {
+    pub fn new(settings: &VolPathSettings, scene: &RenderScene, _scalar: bool) -> VolPath {
         VolPath {
             settings: *settings,
             lights: light_sampler(settings.light_sample_strategy, scene),

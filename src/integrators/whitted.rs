@@ -65,7 +65,7 @@ pub struct Whitted {
 }
 
 impl Whitted {
-    pub fn new(settings: &WhittedSettings, _scene: &RenderScene, _simd: bool) -> Whitted {
+    pub fn new(settings: &WhittedSettings, _scene: &RenderScene, _scalar: bool) -> Whitted {
         Whitted {
             settings: *settings,
         }

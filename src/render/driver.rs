@@ -92,7 +92,7 @@ impl Renderer {
         let t0 = Instant::now();
         check_film_memory(desc)?;
         let scene = RenderScene::new(desc);
-        let mut integrator = Integrator::new(&desc.integrator, &scene, !opts.scalar);
+        let mut integrator = Integrator::new(&desc.integrator, &scene, opts.scalar);
         let film = Film::new(&desc.film, &desc.filter);
         let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
         integrator.prepare_sampler(&scene, &mut sampler);
