@@ -5,7 +5,7 @@
 
 use pbrs::loader::load_scene_str;
 use pbrs::render::shapes::{kind_name, SHAPES};
-use pbrs::scene::Geometry;
+use pbrs::scene::Surface;
 use std::path::{Path, PathBuf};
 
 /// One kind's case: a good statement, what it builds (kind name, triangle
@@ -175,10 +175,10 @@ fn every_shape_kind_has_a_case_and_builds() {
         assert!(warnings.is_empty(), "{}: {warnings:?}", k.name);
         let shapes = &loaded.scene.shapes;
         assert_eq!(shapes.len(), 1, "{}", k.name);
-        let g = &shapes[0].geometry;
+        let g = &shapes[0].surface;
         assert_eq!(kind_name(g), c.builds, "{}", k.name);
         let tris = match g {
-            Geometry::TriangleMesh(m) => m.triangle_count(),
+            Surface::TriangleMesh(m) => m.triangle_count(),
             _ => 0,
         };
         assert_eq!(tris, c.triangles, "{}", k.name);

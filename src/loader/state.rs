@@ -785,8 +785,8 @@ impl<'s, 'c> Builder<'s, 'c> {
             params.mark_all_used();
             return None;
         }
-        let geometry = super::shapes::geometry(self.ctx, name, params, &mut self.meshes);
-        let Some(geometry) = geometry else {
+        let surface = super::shapes::surface(self.ctx, name, params, &mut self.meshes);
+        let Some(surface) = surface else {
             // Otherwise an error or an empty-shape warning was reported.
             if super::shapes::is_unsupported_shape(&name.value) {
                 self.unsupported_shapes += 1;
@@ -797,9 +797,9 @@ impl<'s, 'c> Builder<'s, 'c> {
         // pbrt-v3 reads alpha textures for triangle meshes only (and passes
         // none to the meshes it refines from other shapes).
         let refined = crate::loader::refine::REFINED_SHAPES.contains(&name.value.as_str());
-        let (alpha, shadow_alpha) = match geometry {
-            Geometry::TriangleMesh(_) if refined => (None, None),
-            Geometry::TriangleMesh(_) => (
+        let (alpha, shadow_alpha) = match surface {
+            Surface::TriangleMesh(_) if refined => (None, None),
+            Surface::TriangleMesh(_) => (
                 texture::shape_alpha(self.ctx, params, "alpha", &g.textures),
                 texture::shape_alpha(self.ctx, params, "shadowalpha", &g.textures),
             ),
@@ -807,7 +807,7 @@ impl<'s, 'c> Builder<'s, 'c> {
         };
         let material = self.material_for_shape(&g.material, params, &g.textures);
         let mut area_light = area.and_then(|a| self.area_light(a));
-        if matches!(geometry, Geometry::Curve(_)) && area_light.is_some() {
+        if matches!(surface, Surface::Curve(_)) && area_light.is_some() {
             // pbrt-v3 aborts when it samples one (`Curve::Sample`).
             self.ctx.warn(stmts[i].loc, "an area light on a curve is not supported by pbrs (pbrt-v3 cannot sample curves): the curve does not emit", "this curve is not emissive");
             area_light = None;
@@ -825,7 +825,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             return None;
         }
         Some(ShapeDesc {
-            geometry,
+            surface,
             object_to_world: ctm,
             motion: self.animated(ctms),
             reverse_orientation: g.reverse,

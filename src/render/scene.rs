@@ -7,7 +7,7 @@ use crate::render::camera::Camera;
 use crate::render::lights::{AreaShape, DiffuseEmission, DiffuseLight, Light};
 use crate::render::materials::{link_materials, Material};
 use crate::render::media::Medium;
-use crate::render::shapes::{AlphaMask, Curve, CurveCommon, Quadric, TriangleMesh};
+use crate::render::shapes::{AlphaMask, AnalyticShape, Curve, CurveCommon, TriangleMesh};
 use crate::scene::{self, MediumInterfaceDesc, SceneDescription, ShapeDesc};
 use glam::{DMat3, DMat4, Vec3};
 use std::collections::HashMap;
@@ -77,8 +77,8 @@ impl RenderScene {
 
         let mut add_shape = |s: &ShapeDesc, to_world: DMat4| {
             let emit = s.area_light.filter(|a| a.l.max_element() > 0.0);
-            match &s.geometry {
-                scene::Geometry::TriangleMesh(m) => {
+            match &s.surface {
+                scene::Surface::TriangleMesh(m) => {
                     let mesh_index = meshes.len() as u32;
                     let mut tm = world_mesh(m, to_world, s, slots.of(s));
                     if let Some(a) = emit {
@@ -96,16 +96,16 @@ impl RenderScene {
                     meshes.push(tm);
                 }
                 // Curves never emit (the loader warned).
-                scene::Geometry::Curve(c) => {
+                scene::Surface::Curve(c) => {
                     quadrics.extend(curve_pieces(c, to_world, s, slots.of(s)))
                 }
                 g => {
-                    let Some(mut q) = quadric(g, to_world, s, slots.of(s)) else {
+                    let Some(mut q) = placed_analytic(g, to_world, s, slots.of(s)) else {
                         return;
                     };
                     if let Some(a) = emit {
                         q.set_light(Some(area.len() as u32));
-                        area.push((AreaShape::Quadric(quadrics.len() as u32), a));
+                        area.push((AreaShape::Analytic(quadrics.len() as u32), a));
                     }
                     quadrics.push(q);
                 }
@@ -325,10 +325,10 @@ fn object(shapes: &[ShapeDesc], to_object: impl Fn(&ShapeDesc) -> DMat4, slots: 
     for s in shapes {
         let m4 = to_object(s);
         let material = slots.of(s);
-        match &s.geometry {
-            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s, material)),
-            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, m4, s, material)),
-            g => quadrics.extend(quadric(g, m4, s, material)),
+        match &s.surface {
+            scene::Surface::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s, material)),
+            scene::Surface::Curve(c) => quadrics.extend(curve_pieces(c, m4, s, material)),
+            g => quadrics.extend(placed_analytic(g, m4, s, material)),
         }
     }
     Object::new(meshes, quadrics)
@@ -341,7 +341,7 @@ fn curve_pieces<'a>(
     to_world: DMat4,
     s: &ShapeDesc,
     material: u32,
-) -> impl Iterator<Item = Quadric> + 'a {
+) -> impl Iterator<Item = AnalyticShape> + 'a {
     let reverse = s.reverse_orientation;
     c.segments.iter().flat_map(move |seg| {
         let common = Arc::new(CurveCommon::new(
@@ -352,16 +352,21 @@ fn curve_pieces<'a>(
             to_world,
             reverse,
         ));
-        Curve::pieces(common, c.split_depth, material).map(Quadric::Curve)
+        Curve::pieces(common, c.split_depth, material).map(AnalyticShape::Curve)
     })
 }
 
 /// An analytic shape in the space `to_world` maps to (`None` for meshes and
 /// curves).
-fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc, material: u32) -> Option<Quadric> {
-    match g {
-        scene::Geometry::Quadric(q) => Some(q.placed(to_world, s.reverse_orientation, material)),
-        scene::Geometry::TriangleMesh(_) | scene::Geometry::Curve(_) => None,
+fn placed_analytic(
+    surface: &scene::Surface,
+    to_world: DMat4,
+    s: &ShapeDesc,
+    material: u32,
+) -> Option<AnalyticShape> {
+    match surface {
+        scene::Surface::Analytic(a) => Some(a.placed(to_world, s.reverse_orientation, material)),
+        scene::Surface::TriangleMesh(_) | scene::Surface::Curve(_) => None,
     }
 }
 
