@@ -1,6 +1,7 @@
 //! Scene building: graphics state to a plain scene description.
 //!
-//! - [`state`]: the walk over statements with pbrt-v3's graphics state.
+//! - [`state`]: the walk over statements with pbrt-v3's graphics state
+//!   (`state/shape.rs`: a `Shape` statement with the state current at it).
 //! - [`entities`]: cameras, film, filters, samplers, integrators, materials,
 //!   textures, lights and shapes from their parameters, with pbrt-v3's defaults.
 //! - [`color`]: spectra to linear RGB against the CIE table [`cie1931`];
