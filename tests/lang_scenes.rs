@@ -233,7 +233,7 @@ fn library_loads_with_expected_counts() {
         );
         for sh in &loaded.scene.shapes {
             assert!((sh.material.0 as usize) < loaded.scene.materials.len());
-            if let Geometry::TriangleMesh(m) = &sh.geometry {
+            if let Surface::TriangleMesh(m) = &sh.surface {
                 assert!(m.indices.iter().all(|&i| (i as usize) < m.positions.len()));
             }
         }
@@ -266,7 +266,7 @@ fn cornell_path_details() {
     let boxes: Vec<_> = s
         .shapes
         .iter()
-        .filter(|sh| matches!(&sh.geometry, Geometry::TriangleMesh(m) if m.triangle_count() == 12))
+        .filter(|sh| matches!(&sh.surface, Surface::TriangleMesh(m) if m.triangle_count() == 12))
         .collect();
     assert_eq!(boxes.len(), 2);
     let c = boxes[0].object_to_world.transform_point3(glam::DVec3::ZERO);
@@ -281,8 +281,8 @@ fn dragon_mesh_is_loaded_once_and_shared() {
     let dragon = s
         .shapes
         .iter()
-        .find_map(|sh| match &sh.geometry {
-            Geometry::TriangleMesh(m) if m.triangle_count() > 1000 => Some(m.clone()),
+        .find_map(|sh| match &sh.surface {
+            Surface::TriangleMesh(m) if m.triangle_count() > 1000 => Some(m.clone()),
             _ => None,
         })
         .unwrap();

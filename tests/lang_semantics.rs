@@ -8,7 +8,7 @@ use pbrs::cameras::Projection;
 use pbrs::filters::{BoxFilter, Filter, Gaussian, LanczosSinc, Mitchell, Triangle};
 use pbrs::loader::{load_scene, load_scene_str, LoadedScene};
 use pbrs::scene::*;
-use pbrs::shapes::Quadric;
+use pbrs::shapes::AnalyticShape;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -458,8 +458,8 @@ fn film_crop_and_options() {
 #[test]
 fn triangle_mesh_details() {
     let s = load("WorldBegin\nShape \"trianglemesh\" \"point P\" [0 0 0 1 0 0 0 1 0] \"float uv\" [0 0 1 0 0 1]\nShape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1 0] \"normal N\" [0 0 1] \"point2 st\" [0 0 1 0 0 1] \"float alpha\" 0.5\nWorldEnd");
-    let mesh = |i: usize| match &s.scene.shapes[i].geometry {
-        Geometry::TriangleMesh(m) => m.clone(),
+    let mesh = |i: usize| match &s.scene.shapes[i].surface {
+        Surface::TriangleMesh(m) => m.clone(),
         g => panic!("{g:?}"),
     };
     assert_eq!(mesh(0).indices, vec![0, 1, 2]);
@@ -480,11 +480,11 @@ fn triangle_mesh_details() {
 #[test]
 fn sphere_parameters() {
     let s = load("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float zmin\" 5 \"float zmax\" -1 \"float phimax\" 400\nWorldEnd");
-    let Geometry::Quadric(Quadric::Sphere(sp)) = &s.scene.shapes[0].geometry else {
+    let Surface::Analytic(AnalyticShape::Sphere(sp)) = &s.scene.shapes[0].surface else {
         panic!()
     };
     // As the kind built it: zmin and zmax ordered and clamped, phimax clamped.
-    assert_eq!(sp.args, (2.0, -1.0, 2.0, 360.0));
+    assert_eq!(sp.at.args, (2.0, -1.0, 2.0, 360.0));
     assert_eq!((sp.radius, sp.z_min, sp.z_max), (2.0, -1.0, 2.0));
 }
 
@@ -494,8 +494,8 @@ fn sphere_parameters() {
 fn disk_parameters_and_bad_disks() {
     let s = load("WorldBegin\nShape \"disk\"\nShape \"disk\" \"float radius\" 2 \"float innerradius\" 3\nShape \"disk\" \"float innerradius\" -1 \"float height\" 0.5 \"float phimax\" 400\nWorldEnd");
     assert_eq!(s.scene.shapes.len(), 2);
-    let disk = |i: usize| match &s.scene.shapes[i].geometry {
-        Geometry::Quadric(Quadric::Disk(d)) => d.args,
+    let disk = |i: usize| match &s.scene.shapes[i].surface {
+        Surface::Analytic(AnalyticShape::Disk(d)) => d.at.args,
         _ => panic!(),
     };
     assert_eq!(disk(0), (0.0, 1.0, 0.0, 360.0));
@@ -606,7 +606,7 @@ fn include_splices_and_resolves_against_the_top_level_directory() {
     )
     .unwrap();
     let s = load_scene(&d.join("main.pbrt")).unwrap_or_else(|f| panic!("{f:?}"));
-    let Geometry::Quadric(Quadric::Sphere(sp)) = &s.scene.shapes[0].geometry else {
+    let Surface::Analytic(AnalyticShape::Sphere(sp)) = &s.scene.shapes[0].surface else {
         panic!()
     };
     assert_eq!(sp.radius, 3.0);
@@ -639,8 +639,8 @@ fn ply_meshes_are_shared() {
     let s = load_scene_str(text, &d.join("scene.pbrt"))
         .unwrap_or_else(|f| panic!("{f:?}"))
         .scene;
-    let (Geometry::TriangleMesh(a), Geometry::TriangleMesh(b)) =
-        (&s.shapes[0].geometry, &s.shapes[1].geometry)
+    let (Surface::TriangleMesh(a), Surface::TriangleMesh(b)) =
+        (&s.shapes[0].surface, &s.shapes[1].surface)
     else {
         panic!()
     };

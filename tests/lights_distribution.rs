@@ -31,7 +31,7 @@ fn expected_power(l: &Light) -> f64 {
     match *l {
         Light::Point(p) => 4.0 * PI * p.intensity.x as f64,
         Light::Diffuse(DiffuseLight {
-            shape: AreaShape::Quadric(_),
+            shape: AreaShape::Analytic(_),
             ..
         }) => 4.0 * (4.0 * PI * 0.25) * PI,
         Light::Diffuse(DiffuseLight {
@@ -202,7 +202,7 @@ fn area_light_sampling_matches_its_density() {
         matches!(
             l,
             Light::Diffuse(DiffuseLight {
-                shape: AreaShape::Quadric(_),
+                shape: AreaShape::Analytic(_),
                 ..
             })
         )

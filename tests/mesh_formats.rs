@@ -153,8 +153,8 @@ fn render_text(text: &str, dir: &Path) -> Image {
             .scene
             .shapes
             .iter()
-            .map(|s| match &s.geometry {
-                pbrs::scene::Geometry::TriangleMesh(m) => m.triangle_count(),
+            .map(|s| match &s.surface {
+                pbrs::scene::Surface::TriangleMesh(m) => m.triangle_count(),
                 _ => 0,
             })
             .max(),

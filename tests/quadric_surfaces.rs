@@ -17,7 +17,8 @@ use pbrs::loader::load_scene_str;
 use pbrs::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
 use pbrs::sampling::Pcg32;
 use pbrs::shapes::{
-    hyperboloid_coefficients, Cone, Hyperboloid, Paraboloid, Quadric, SurfacePoint,
+    hyperboloid_coefficients, Analytic, AnalyticShape, Cone, Hyperboloid, Paraboloid, Placed,
+    SurfacePoint,
 };
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -30,24 +31,22 @@ fn moved() -> DMat4 {
 
 /// Radius 0.5, height 2, φmax 300°.
 fn cone() -> Cone {
-    Cone::new(0.5, 2.0, 300.0, moved(), false, 0)
+    Cone::new(Placed::new((0.5, 2.0, 300.0), moved(), false, 0))
 }
 
 /// Radius 1 at zmax 2, z from 0.5, φmax 300°: 2 (x² + y²) = z.
 fn paraboloid() -> Paraboloid {
-    Paraboloid::new(1.0, 0.5, 2.0, 300.0, moved(), false, 0)
+    Paraboloid::new(Placed::new((1.0, 0.5, 2.0, 300.0), moved(), false, 0))
 }
 
 /// The line from (1, −1, −1) to (1, 1, 1): x² + y² − z² = 1, φmax 300°.
 fn hyperboloid() -> Hyperboloid {
-    Hyperboloid::new(
-        Vec3::new(1.0, -1.0, -1.0),
-        Vec3::new(1.0, 1.0, 1.0),
-        300.0,
+    Hyperboloid::new(Placed::new(
+        (Vec3::new(1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), 300.0),
         moved(),
         false,
         0,
-    )
+    ))
 }
 
 fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
@@ -56,7 +55,7 @@ fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
 
 #[test]
 fn cone_hits_where_the_cone_says() {
-    let c = Quadric::from(cone());
+    let c = AnalyticShape::from(cone());
     // Along −x at z = 1 (radius 0.25 there), y = 0.
     let (t, p) = c
         .intersect(OFF + Vec3::new(5.0, 0.0, 1.0), -Vec3::X, f32::INFINITY)
@@ -104,7 +103,7 @@ fn cone_hits_where_the_cone_says() {
 
 #[test]
 fn paraboloid_hits_where_the_paraboloid_says() {
-    let q = Quadric::from(paraboloid());
+    let q = AnalyticShape::from(paraboloid());
     // Along −x at z = 1.28: radius 0.8.
     let (t, p) = q
         .intersect(OFF + Vec3::new(5.0, 0.0, 1.28), -Vec3::X, f32::INFINITY)
@@ -156,7 +155,7 @@ fn hyperboloid_fits_the_line_and_hits_where_it_says() {
     // The line meets the axis (pbrt-v3's defaults, a cone) or is horizontal.
     assert!(hyperboloid_coefficients(DVec3::ZERO, DVec3::ONE).is_none());
     assert!(hyperboloid_coefficients(DVec3::X, DVec3::Y).is_none());
-    let h = Quadric::from(hyperboloid());
+    let h = AnalyticShape::from(hyperboloid());
     // The waist: along −x at z = 0, y = 0 hits x = 1 (φ from the line's
     // point (1, 0, 0) is 0, v = 1/2).
     let (t, p) = h
@@ -204,14 +203,14 @@ fn similarity() -> DMat4 {
 /// The three shapes with full or partial φ, and the analytic object area
 /// element dA/(dz dφ) as a function of z, with their z range.
 /// Name, shape, z range, φmax, analytic dA/(dz dφ).
-type Case = (&'static str, Quadric, f64, f64, f64, fn(f64) -> f64);
+type Case = (&'static str, AnalyticShape, f64, f64, f64, fn(f64) -> f64);
 
 fn cases() -> Vec<Case> {
     let m = similarity();
     vec![
         (
             "cone",
-            Quadric::from(Cone::new(0.5, 2.0, 360.0, m, false, 0)),
+            AnalyticShape::from(Cone::new(Placed::new((0.5, 2.0, 360.0), m, false, 0))),
             0.0,
             2.0,
             TAU,
@@ -220,7 +219,12 @@ fn cases() -> Vec<Case> {
         ),
         (
             "partial paraboloid",
-            Quadric::from(Paraboloid::new(1.0, 0.5, 2.0, 200.0, m, false, 0)),
+            AnalyticShape::from(Paraboloid::new(Placed::new(
+                (1.0, 0.5, 2.0, 200.0),
+                m,
+                false,
+                0,
+            ))),
             0.5,
             2.0,
             200f64.to_radians(),
@@ -229,14 +233,12 @@ fn cases() -> Vec<Case> {
         ),
         (
             "hyperboloid",
-            Quadric::from(Hyperboloid::new(
-                Vec3::new(1.0, -1.0, -1.0),
-                Vec3::new(1.0, 1.0, 1.0),
-                360.0,
+            AnalyticShape::from(Hyperboloid::new(Placed::new(
+                (Vec3::new(1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), 360.0),
                 m,
                 false,
                 0,
-            )),
+            ))),
             -1.0,
             1.0,
             TAU,
@@ -245,11 +247,11 @@ fn cases() -> Vec<Case> {
     ]
 }
 
-fn sample_area(q: &Quadric, u: Vec2) -> (SurfacePoint, f32) {
+fn sample_area(q: &AnalyticShape, u: Vec2) -> (SurfacePoint, f32) {
     let s = match q {
-        Quadric::Cone(c) => c.sample_area(u),
-        Quadric::Paraboloid(c) => c.sample_area(u),
-        Quadric::Hyperboloid(c) => c.sample_area(u),
+        AnalyticShape::Cone(c) => c.sample_area(u).expect("a sample"),
+        AnalyticShape::Paraboloid(c) => c.sample_area(u).expect("a sample"),
+        AnalyticShape::Hyperboloid(c) => c.sample_area(u).expect("a sample"),
         _ => unreachable!(),
     };
     (s.point, s.pdf)
@@ -341,16 +343,19 @@ fn rays_leaving_the_surfaces_do_not_rehit_them_at_any_scale() {
             * DMat4::from_rotation_x(-1.1)
             * DMat4::from_scale(DVec3::splat(scale));
         let shapes = [
-            Quadric::from(Cone::new(0.5, 2.0, 360.0, m, false, 0)),
-            Quadric::from(Paraboloid::new(1.0, 0.0, 2.0, 360.0, m, false, 0)),
-            Quadric::from(Hyperboloid::new(
-                Vec3::new(1.0, -1.0, -1.0),
-                Vec3::new(1.0, 1.0, 1.0),
-                360.0,
+            AnalyticShape::from(Cone::new(Placed::new((0.5, 2.0, 360.0), m, false, 0))),
+            AnalyticShape::from(Paraboloid::new(Placed::new(
+                (1.0, 0.0, 2.0, 360.0),
                 m,
                 false,
                 0,
-            )),
+            ))),
+            AnalyticShape::from(Hyperboloid::new(Placed::new(
+                (Vec3::new(1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), 360.0),
+                m,
+                false,
+                0,
+            ))),
         ];
         for (k, q) in shapes.iter().enumerate() {
             let hyper = k == 2;
@@ -397,9 +402,9 @@ fn rays_leaving_the_surfaces_do_not_rehit_them_at_any_scale() {
 fn grazing_rays_give_finite_hits() {
     let mut rng = Pcg32::with_sequence(3);
     let shapes = [
-        Quadric::from(cone()),
-        Quadric::from(paraboloid()),
-        Quadric::from(hyperboloid()),
+        AnalyticShape::from(cone()),
+        AnalyticShape::from(paraboloid()),
+        AnalyticShape::from(hyperboloid()),
     ];
     for q in &shapes {
         for _ in 0..20_000 {

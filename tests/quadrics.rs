@@ -20,21 +20,18 @@ use pbrs::integrators::RenderScene;
 use pbrs::lights::{AreaShape, DiffuseLight, Light};
 use pbrs::loader::load_scene_str;
 use pbrs::sampling::Pcg32;
-use pbrs::shapes::{Cylinder, Disk, SurfacePoint};
+use pbrs::shapes::{Analytic, Cylinder, Disk, Placed, SurfacePoint};
 use std::f64::consts::PI;
 use std::path::Path;
 
 /// Height 0.5, radius 2, inner radius 0.5, φmax 270°, moved by (1, 2, 3).
 fn ring() -> Disk {
-    Disk::new(
-        0.5,
-        2.0,
-        0.5,
-        270.0,
+    Disk::new(Placed::new(
+        (0.5, 2.0, 0.5, 270.0),
         DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0)),
         false,
         0,
-    )
+    ))
 }
 
 #[test]
@@ -49,7 +46,7 @@ fn disk_hits_where_the_plane_and_the_annulus_say() {
     let o = off + Vec3::new(x, y, 5.0);
     let (t, p) = d.intersect(o, -Vec3::Z, f32::INFINITY).expect("hit");
     assert!((t - 4.5).abs() < 1e-5, "t {t}");
-    assert_eq!(p.z, 0.5);
+    assert_eq!(p.point_and_error().0.z, 0.5);
     let sp = d.surface_point(p);
     assert!((sp.p - (off + Vec3::new(x, y, 0.5))).length() < 1e-5);
     assert_eq!(sp.n, Vec3::Z);
@@ -89,7 +86,7 @@ fn disk_hits_where_the_plane_and_the_annulus_say() {
     // the normal follows pbrt-v3's rules (the handedness flip), which make it
     // the cross product of the world-space dp/du and dp/dv.
     let m = DMat4::from_rotation_x(0.7) * DMat4::from_scale(DVec3::new(-2.0, 3.0, 1.0));
-    let d2 = Disk::new(0.0, 1.0, 0.0, 360.0, m, false, 0);
+    let d2 = Disk::new(Placed::new((0.0, 1.0, 0.0, 360.0), m, false, 0));
     assert!((d2.area() as f64 - 6.0 * PI).abs() < 1e-5 * 6.0 * PI);
     let (_, p) = d2
         .intersect(Vec3::new(0.1, 3.0, 0.1), -Vec3::Y, f32::INFINITY)
@@ -115,10 +112,10 @@ fn rays_leaving_a_disk_do_not_rehit_it_at_any_scale() {
             * DMat4::from_rotation_y(0.4)
             * DMat4::from_rotation_x(-1.1)
             * DMat4::from_scale(DVec3::splat(scale));
-        let d = Disk::new(0.25, 1.0, 0.1, 360.0, m, false, 0);
+        let d = Disk::new(Placed::new((0.25, 1.0, 0.1, 360.0), m, false, 0));
         for i in 0..4000 {
             let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-            let s = d.sample_area(u).point;
+            let s = d.sample_area(u).expect("a sample").point;
             // A direction at a random grazing-to-normal angle on either side.
             let f = Frame::from_normal(s.n);
             let side = if i % 2 == 0 { 1.0 } else { -1.0 };
@@ -172,7 +169,7 @@ fn the_light(sc: &RenderScene) -> &Light {
     assert!(matches!(
         l,
         Light::Diffuse(DiffuseLight {
-            shape: AreaShape::Quadric(_),
+            shape: AreaShape::Analytic(_),
             ..
         })
     ));
@@ -287,15 +284,12 @@ fn disk_light_over_a_plane_gives_the_analytic_irradiance() {
 
 /// Radius 0.5, z in [-1, 2], φmax 300°, moved by (1, 2, 3).
 fn tube() -> Cylinder {
-    Cylinder::new(
-        0.5,
-        -1.0,
-        2.0,
-        300.0,
+    Cylinder::new(Placed::new(
+        (0.5, -1.0, 2.0, 300.0),
         DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0)),
         false,
         0,
-    )
+    ))
 }
 
 #[test]
@@ -346,10 +340,10 @@ fn rays_leaving_a_cylinder_do_not_rehit_it_at_any_scale() {
             * DMat4::from_rotation_y(0.4)
             * DMat4::from_rotation_x(-1.1)
             * DMat4::from_scale(DVec3::splat(scale));
-        let c = Cylinder::new(1.0, -0.5, 0.5, 360.0, m, false, 0);
+        let c = Cylinder::new(Placed::new((1.0, -0.5, 0.5, 360.0), m, false, 0));
         for i in 0..4000 {
             let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-            let s = c.sample_area(u).point;
+            let s = c.sample_area(u).expect("a sample").point;
             // Outwards (any angle) must miss; inwards must hit the far side,
             // never this side again (t well above the error bound).
             let f = Frame::from_normal(s.n);

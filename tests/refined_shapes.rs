@@ -12,7 +12,7 @@ use common::*;
 use glam::{DVec3, Vec3};
 use pbrs::image::compare::mean_rgb;
 use pbrs::loader::load_scene_str;
-use pbrs::scene::{Geometry, MeshData};
+use pbrs::scene::{MeshData, Surface};
 use std::sync::Arc;
 
 fn load_text(text: &str) -> Result<pbrs::loader::LoadedScene, pbrs::loader::LoadFailure> {
@@ -25,8 +25,8 @@ fn mesh_w(shape: &str) -> (Arc<MeshData>, Vec<String>) {
         .unwrap_or_else(|f| panic!("{shape}: {f:?}"));
     assert_eq!(s.scene.shapes.len(), 1, "{shape}");
     let warnings = s.warnings.iter().map(|w| format!("{w}")).collect();
-    match &s.scene.shapes[0].geometry {
-        Geometry::TriangleMesh(m) => (m.clone(), warnings),
+    match &s.scene.shapes[0].surface {
+        Surface::TriangleMesh(m) => (m.clone(), warnings),
         g => panic!("not a mesh: {g:?}"),
     }
 }
@@ -635,7 +635,7 @@ fn refined_once_per_object_and_no_alpha() {
     assert_eq!(s.scene.objects[0].shapes.len(), 1);
     assert_eq!(s.scene.instances.len(), 3);
     let sh = &s.scene.objects[0].shapes[0];
-    assert!(matches!(&sh.geometry, Geometry::TriangleMesh(m) if m.triangle_count() == 8 * 16));
+    assert!(matches!(&sh.surface, Surface::TriangleMesh(m) if m.triangle_count() == 8 * 16));
     // pbrt-v3 gives refined meshes no alpha: the parameter is unused.
     assert!(sh.alpha.is_none());
     let w: Vec<String> = s.warnings.iter().map(|w| format!("{w}")).collect();

@@ -4,7 +4,7 @@
 //! parameter. A kind of the table without a case here fails.
 
 use pbrs::loader::load_scene_str;
-use pbrs::scene::Geometry;
+use pbrs::scene::Surface;
 use pbrs::shapes::{kind_name, SHAPES};
 use std::path::{Path, PathBuf};
 
@@ -175,10 +175,10 @@ fn every_shape_kind_has_a_case_and_builds() {
         assert!(warnings.is_empty(), "{}: {warnings:?}", k.name);
         let shapes = &loaded.scene.shapes;
         assert_eq!(shapes.len(), 1, "{}", k.name);
-        let g = &shapes[0].geometry;
+        let g = &shapes[0].surface;
         assert_eq!(kind_name(g), c.builds, "{}", k.name);
         let tris = match g {
-            Geometry::TriangleMesh(m) => m.triangle_count(),
+            Surface::TriangleMesh(m) => m.triangle_count(),
             _ => 0,
         };
         assert_eq!(tris, c.triangles, "{}", k.name);

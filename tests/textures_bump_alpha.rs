@@ -9,7 +9,7 @@ use pbrs::geometry::Ray;
 use pbrs::integrators::RenderScene;
 use pbrs::materials::{BsdfContext, Material};
 use pbrs::render::driver::{render, RenderOptions};
-use pbrs::scene::Geometry;
+use pbrs::scene::Surface;
 use tex_common::*;
 
 /// The material of `Material {decl}` (with texture statements `textures`
@@ -252,8 +252,8 @@ fn alpha_in_instances_and_constant_alphas() {
         &MemFiles::default(),
     );
     assert!(matches!(
-        s.scene.shapes[0].geometry,
-        Geometry::TriangleMesh(_)
+        s.scene.shapes[0].surface,
+        Surface::TriangleMesh(_)
     ));
     assert!(s
         .summary

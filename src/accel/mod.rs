@@ -21,7 +21,7 @@ pub use bvh4::BuildWork;
 use crate::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
 use crate::scene::AnimatedTransform;
 use crate::shapes::{
-    intersect_triangle, DiffGeom, Quadric, QuadricHit, SurfacePoint, TriangleMesh,
+    intersect_triangle, AnalyticHit, AnalyticShape, DiffGeom, SurfacePoint, TriangleMesh,
 };
 use bvh4::{Bvh4, Closest};
 use glam::{DMat3, DMat4, DVec3, Mat3, Vec3};
@@ -87,7 +87,7 @@ const MOVING_BIT: u32 = 1 << 31;
 #[derive(Clone, Copy, Debug)]
 enum HitLocal {
     Bary([f32; 3]),
-    Quadric(QuadricHit),
+    Analytic(AnalyticHit),
 }
 
 /// Everything a surface hit needs for shading.
@@ -116,13 +116,13 @@ struct Level {
 /// An object definition, built once and shared by all its instances.
 pub struct Object {
     meshes: Vec<TriangleMesh>,
-    quadrics: Vec<Quadric>,
+    quadrics: Vec<AnalyticShape>,
     level: Level,
 }
 
 impl Object {
     /// Builds the object's BVH over its shapes (given in object space).
-    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<Quadric>) -> Object {
+    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<AnalyticShape>) -> Object {
         let level = Level::build(&meshes, &quadrics, &[], &[]);
         Object {
             meshes,
@@ -370,7 +370,7 @@ impl Level {
     /// out; an empty level builds no BVH at all.
     fn build(
         meshes: &[TriangleMesh],
-        quadrics: &[Quadric],
+        quadrics: &[AnalyticShape],
         extra: &[Bounds3],
         moving: &[Bounds3],
     ) -> Level {
@@ -446,7 +446,7 @@ impl Level {
 struct Shapes<'a> {
     level: &'a Level,
     meshes: &'a [TriangleMesh],
-    quadrics: &'a [Quadric],
+    quadrics: &'a [AnalyticShape],
 }
 
 impl Shapes<'_> {
@@ -472,7 +472,7 @@ impl Shapes<'_> {
                     t,
                     prim,
                     instance: NO_INSTANCE,
-                    local: HitLocal::Quadric(p),
+                    local: HitLocal::Analytic(p),
                 })
             } else if prim.mesh == MOVING_TAG {
                 moving_hit(prim.index, t_max)
@@ -544,7 +544,7 @@ impl Shapes<'_> {
     fn diff_geom(&self, prim: PrimRef, local: HitLocal, ns: Vec3) -> DiffGeom {
         match local {
             HitLocal::Bary(b) => self.meshes[prim.mesh as usize].diff_geom(prim.index, b, ns),
-            HitLocal::Quadric(p) => self.quadrics[prim.index as usize].diff_geom(p),
+            HitLocal::Analytic(p) => self.quadrics[prim.index as usize].diff_geom(p),
         }
     }
 
@@ -563,7 +563,7 @@ impl Shapes<'_> {
                     m.n.is_some(),
                 )
             }
-            HitLocal::Quadric(p) => {
+            HitLocal::Analytic(p) => {
                 let s = &self.quadrics[prim.index as usize];
                 (
                     SurfaceHit {
@@ -584,7 +584,7 @@ pub struct Geometry {
     /// World-space meshes (lights refer to their triangles by index).
     pub meshes: Vec<TriangleMesh>,
     /// World-space quadrics (spheres, disks).
-    pub quadrics: Vec<Quadric>,
+    pub quadrics: Vec<AnalyticShape>,
     top: Level,
     instances: Vec<Instance>,
     /// Instances and shapes with animated transforms (empty, and never
@@ -603,7 +603,7 @@ pub struct Geometry {
 
 impl Geometry {
     /// Builds the scene-level BVH over world-space shapes alone.
-    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<Quadric>) -> Geometry {
+    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<AnalyticShape>) -> Geometry {
         Geometry::with_instances(meshes, quadrics, Vec::new())
     }
 
@@ -611,7 +611,7 @@ impl Geometry {
     /// objects were built before). Instances of empty objects are dropped.
     pub fn with_instances(
         meshes: Vec<TriangleMesh>,
-        quadrics: Vec<Quadric>,
+        quadrics: Vec<AnalyticShape>,
         instances: Vec<Instance>,
     ) -> Geometry {
         Geometry::with_motion(meshes, quadrics, instances, Vec::new())
@@ -621,7 +621,7 @@ impl Geometry {
     /// each one's motion bounds.
     pub fn with_motion(
         meshes: Vec<TriangleMesh>,
-        quadrics: Vec<Quadric>,
+        quadrics: Vec<AnalyticShape>,
         instances: Vec<Instance>,
         moving: Vec<MovingInstance>,
     ) -> Geometry {

@@ -2,7 +2,8 @@
 //!
 //! - [`lexer`]: bytes to tokens (pbrt-v3's tokenizer rules), and fast number parsing.
 //! - [`params`]: typed parameter lists (`"type name" value…`).
-//! - [`parser`]: tokens to [`parser::Stmt`]s; the directive table; Include splicing.
+//! - [`parser`]: tokens to [`parser::Stmt`]s; the directive table; Include splicing
+//!   (a directive's parameter list: `parser/param_list.rs`).
 //! - [`source`]: loaded files, locations, Include chains, located miette diagnostics.
 //!
 //! This part knows nothing about rendering; [`crate::loader`] gives the statements meaning.

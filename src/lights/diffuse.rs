@@ -100,7 +100,7 @@ impl DiffuseLight {
                 geom.meshes[mesh as usize].area(tri),
                 TriangleCache::new(geom, mesh, tri),
             ),
-            AreaShape::Quadric(i) => (geom.quadrics[i as usize].area(), TriangleCache::default()),
+            AreaShape::Analytic(i) => (geom.quadrics[i as usize].area(), TriangleCache::default()),
         };
         DiffuseLight {
             shape,
@@ -172,7 +172,7 @@ impl LightModel for DiffuseLight {
                 let s = geom.meshes[mesh as usize].sample_area(tri, u);
                 crate::shapes::to_solid_angle(r.p, s)?
             }
-            AreaShape::Quadric(i) => {
+            AreaShape::Analytic(i) => {
                 geom.quadrics[i as usize].sample_from(r.p, r.p_error, r.n, u)?
             }
         };
@@ -206,7 +206,9 @@ impl LightModel for DiffuseLight {
     fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Geometry) -> f32 {
         match self.shape {
             AreaShape::Triangle { .. } => self.tri.hit_pdf(ray),
-            AreaShape::Quadric(i) => geom.quadrics[i as usize].pdf_from(r.p, r.p_error, r.n, ray.d),
+            AreaShape::Analytic(i) => {
+                geom.quadrics[i as usize].pdf_from(r.p, r.p_error, r.n, ray.d)
+            }
         }
     }
 
@@ -226,7 +228,7 @@ impl LightModel for DiffuseLight {
                     (bounds, Vec3::Z, -1.0)
                 }
             }
-            AreaShape::Quadric(i) => (geom.quadrics[i as usize].bounds(), Vec3::Z, -1.0),
+            AreaShape::Analytic(i) => (geom.quadrics[i as usize].bounds(), Vec3::Z, -1.0),
         };
         Some(LightBounds {
             bounds,
@@ -247,7 +249,7 @@ pub enum AreaShape {
         tri: u32,
     },
     /// A sphere, disk or other analytic shape of `Geometry::quadrics`.
-    Quadric(u32),
+    Analytic(u32),
 }
 
 /// World-space vertices of a triangle light, cached so that sampling it does

@@ -310,111 +310,12 @@ pub fn read_params_as(
     let mut refs = Vec::new();
     for s in specs {
         let value = match s.kind {
-            ParamKind::FloatTexture(def) => match l.float(ctx, s.name) {
-                Some((FloatTex::Constant(v), loc)) => {
-                    Some(FloatTex::Constant(check_range(ctx, s, v, loc)))
-                }
-                Some((t, _)) => Some(t),
-                None => def.map(FloatTex::Constant),
-            }
-            .map(ParamValue::FloatTexture),
-            ParamKind::SameTexture(def) if same_is_float => Some(ParamValue::FloatTexture(
-                l.float(ctx, s.name)
-                    .map(|(t, _)| t)
-                    .unwrap_or(FloatTex::Constant(def)),
-            )),
-            ParamKind::SameTexture(def) => Some(ParamValue::SpectrumTexture(
-                l.spectrum(ctx, s.name)
-                    .map(|(t, _)| t)
-                    .unwrap_or(SpectrumTex::Constant(Vec3::splat(def))),
-            )),
-            ParamKind::SameValue(def) if same_is_float => {
-                let v = l
-                    .plain(s.name, ParamType::Float)
-                    .map(|q| q.nums()[0] as f32)
-                    .unwrap_or(def);
-                Some(ParamValue::FloatTexture(FloatTex::Constant(v)))
-            }
-            ParamKind::SameValue(def) => {
-                let v = l
-                    .lists()
-                    .find_map(|list| find_spectrum(list, s.name))
-                    .and_then(|q| spectrum_value(ctx, q))
-                    .unwrap_or(Vec3::splat(def));
-                Some(ParamValue::SpectrumTexture(SpectrumTex::Constant(v)))
-            }
-            ParamKind::Int(def) => Some(ParamValue::Int(
-                l.plain(s.name, ParamType::Integer)
-                    .map(|q| q.nums()[0].clamp(i32::MIN as f64, i32::MAX as f64) as i32)
-                    .unwrap_or(def),
-            )),
-            ParamKind::Vector3(def) => Some(ParamValue::Vector(
-                l.plain(s.name, ParamType::Vector3)
-                    .map(|q| {
-                        let v = q.nums();
-                        Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
-                    })
-                    .unwrap_or(Vec3::from_array(def)),
-            )),
-            ParamKind::BoolOpt => l
-                .plain(s.name, ParamType::Bool)
-                .map(|q| ParamValue::Bool(q.bools()[0])),
-            ParamKind::Choice { default, options } => {
-                let v = match l.plain(s.name, ParamType::String) {
-                    Some(q) => {
-                        let v = q.strs()[0].clone();
-                        if options.contains(&v.as_str()) {
-                            v
-                        } else {
-                            let hint = match closest_name(&v, options) {
-                                Some(c) => format!("did you mean \"{c}\"?"),
-                                None => format!(
-                                    "one of {}",
-                                    options
-                                        .iter()
-                                        .map(|o| format!("\"{o}\""))
-                                        .collect::<Vec<_>>()
-                                        .join(", ")
-                                ),
-                            };
-                            ctx.warn(q.values_loc, format!("\"{}\" is \"{v}\", which pbrt-v3 does not know ({hint}): \"{default}\" is used (as pbrt-v3)", s.name), "unknown value");
-                            default.to_string()
-                        }
-                    }
-                    None => default.to_string(),
-                };
-                Some(ParamValue::String(v))
-            }
-            // As written: the image reader resolves it against the scene
-            // file's directory.
-            ParamKind::Filename => Some(ParamValue::String(
-                l.plain(s.name, ParamType::String)
-                    .map(|q| q.strs()[0].clone())
-                    .unwrap_or_default(),
-            )),
-            ParamKind::SpectrumTexture(def) => match l.spectrum(ctx, s.name) {
-                Some((t, _)) => Some(t),
-                None => def.map(|d| SpectrumTex::Constant(spectrum_default(d))),
-            }
-            .map(ParamValue::SpectrumTexture),
-            ParamKind::Float(def) => Some(ParamValue::Float(
-                l.plain(s.name, ParamType::Float)
-                    .map(|q| check_range(ctx, s, q.nums()[0] as f32, q.values_loc))
-                    .unwrap_or(def),
-            )),
-            ParamKind::FloatOpt => l
-                .plain(s.name, ParamType::Float)
-                .map(|q| ParamValue::Float(check_range(ctx, s, q.nums()[0] as f32, q.values_loc))),
-            ParamKind::Bool(def) => Some(ParamValue::Bool(
-                l.plain(s.name, ParamType::Bool)
-                    .map(|q| q.bools()[0])
-                    .unwrap_or(def),
-            )),
-            ParamKind::String(def) => Some(ParamValue::String(
-                l.plain(s.name, ParamType::String)
-                    .map(|q| q.strs()[0].clone())
-                    .unwrap_or_else(|| def.to_string()),
-            )),
+            ParamKind::FloatTexture(_)
+            | ParamKind::SameTexture(_)
+            | ParamKind::SameValue(_)
+            | ParamKind::SpectrumTexture(_)
+            | ParamKind::Spectrum(_)
+            | ParamKind::SpectrumOrFloat(_) => texture_or_spectrum(ctx, s, l, same_is_float),
             ParamKind::NamedMaterial => {
                 let (name, loc) = match l.plain(s.name, ParamType::String) {
                     Some(q) => (q.strs()[0].clone(), q.values_loc),
@@ -427,13 +328,6 @@ pub fn read_params_as(
                 });
                 None
             }
-            // pbrt-v3's FindFilename: an empty name is no name; a missing
-            // one is reported by `material` (which knows the statement).
-            ParamKind::FourierFile => l
-                .plain(s.name, ParamType::String)
-                .filter(|q| !q.strs()[0].is_empty())
-                .and_then(|q| fourier_table(ctx, &q.strs()[0], q.values_loc))
-                .map(ParamValue::Fourier),
             ParamKind::Unsupported(why) => {
                 for list in l.lists() {
                     if let Some(q) = list.get(s.name) {
@@ -443,61 +337,7 @@ pub fn read_params_as(
                 }
                 None
             }
-            ParamKind::Spectrum(def) => Some(ParamValue::Spectrum(
-                l.lists()
-                    .find_map(|list| find_spectrum(list, s.name))
-                    .and_then(|q| spectrum_value(ctx, q))
-                    .unwrap_or(Vec3::from_array(def)),
-            )),
-            ParamKind::Point3(def) => Some(ParamValue::Point(
-                l.plain(s.name, ParamType::Point3)
-                    .map(|q| {
-                        let v = q.nums();
-                        glam::DVec3::new(v[0], v[1], v[2])
-                    })
-                    .unwrap_or(Vec3::from_array(def).as_dvec3()),
-            )),
-            ParamKind::Floats => l
-                .lists()
-                .find_map(|list| {
-                    list.items
-                        .iter()
-                        .find(|q| q.name == s.name && q.ty == ParamType::Float)
-                })
-                .map(|q| {
-                    q.used.set(true);
-                    ParamValue::Floats(Arc::from(q.nums()))
-                }),
-            ParamKind::SpectrumOrFloat(def) => Some(ParamValue::Spectrum(
-                match l.plain(s.name, ParamType::Float) {
-                    Some(q) => Vec3::splat(q.nums()[0] as f32),
-                    None => l
-                        .lists()
-                        .find_map(|list| find_spectrum(list, s.name))
-                        .and_then(|q| spectrum_value(ctx, q))
-                        .unwrap_or(Vec3::from_array(def)),
-                },
-            )),
-            ParamKind::IntOpt => l.plain(s.name, ParamType::Integer).map(|q| {
-                ParamValue::Int(q.nums()[0].clamp(i32::MIN as f64, i32::MAX as f64) as i32)
-            }),
-            // pbrt-v3 reads no image for an empty name.
-            ParamKind::Image(decode) => l
-                .plain(s.name, ParamType::String)
-                .filter(|q| !q.strs()[0].is_empty())
-                .and_then(|q| super::image::load_image(ctx, q.values_loc, &q.strs()[0], decode))
-                .map(ParamValue::Image),
-            ParamKind::List(e) => l
-                .lists()
-                .find_map(|list| {
-                    list.items
-                        .iter()
-                        .find(|q| q.name == s.name && elem_accepts(e, q.ty))
-                })
-                .map(|q| {
-                    q.used.set(true);
-                    ParamValue::Floats(Arc::from(q.nums()))
-                }),
+            _ => plain_value(ctx, s, l),
         };
         if let Some(v) = value {
             out.set(s.name, v);
@@ -508,6 +348,205 @@ pub fn read_params_as(
         }
     }
     (out, refs)
+}
+
+/// A texture or spectrum parameter: its texture or constant, pbrt-v3's
+/// default, or for `SameTexture`/`SameValue` the texture's own type.
+fn texture_or_spectrum(
+    ctx: &mut Ctx,
+    s: &ParamSpec,
+    l: &Lookup,
+    same_is_float: bool,
+) -> Option<ParamValue> {
+    match s.kind {
+        ParamKind::FloatTexture(def) => match l.float(ctx, s.name) {
+            Some((FloatTex::Constant(v), loc)) => {
+                Some(FloatTex::Constant(check_range(ctx, s, v, loc)))
+            }
+            Some((t, _)) => Some(t),
+            None => def.map(FloatTex::Constant),
+        }
+        .map(ParamValue::FloatTexture),
+        ParamKind::SameTexture(def) if same_is_float => Some(ParamValue::FloatTexture(
+            l.float(ctx, s.name)
+                .map(|(t, _)| t)
+                .unwrap_or(FloatTex::Constant(def)),
+        )),
+        ParamKind::SameTexture(def) => Some(ParamValue::SpectrumTexture(
+            l.spectrum(ctx, s.name)
+                .map(|(t, _)| t)
+                .unwrap_or(SpectrumTex::Constant(Vec3::splat(def))),
+        )),
+        ParamKind::SameValue(def) if same_is_float => {
+            let v = l
+                .plain(s.name, ParamType::Float)
+                .map(|q| q.nums()[0] as f32)
+                .unwrap_or(def);
+            Some(ParamValue::FloatTexture(FloatTex::Constant(v)))
+        }
+        ParamKind::SameValue(def) => {
+            let v = l
+                .lists()
+                .find_map(|list| find_spectrum(list, s.name))
+                .and_then(|q| spectrum_value(ctx, q))
+                .unwrap_or(Vec3::splat(def));
+            Some(ParamValue::SpectrumTexture(SpectrumTex::Constant(v)))
+        }
+        ParamKind::SpectrumTexture(def) => match l.spectrum(ctx, s.name) {
+            Some((t, _)) => Some(t),
+            None => def.map(|d| SpectrumTex::Constant(spectrum_default(d))),
+        }
+        .map(ParamValue::SpectrumTexture),
+        ParamKind::Spectrum(def) => Some(ParamValue::Spectrum(
+            l.lists()
+                .find_map(|list| find_spectrum(list, s.name))
+                .and_then(|q| spectrum_value(ctx, q))
+                .unwrap_or(Vec3::from_array(def)),
+        )),
+        ParamKind::SpectrumOrFloat(def) => Some(ParamValue::Spectrum(
+            match l.plain(s.name, ParamType::Float) {
+                Some(q) => Vec3::splat(q.nums()[0] as f32),
+                None => l
+                    .lists()
+                    .find_map(|list| find_spectrum(list, s.name))
+                    .and_then(|q| spectrum_value(ctx, q))
+                    .unwrap_or(Vec3::from_array(def)),
+            },
+        )),
+        _ => unreachable!("not a texture or spectrum parameter"),
+    }
+}
+
+/// A parameter of a plain type (numbers, booleans, strings, files, lists):
+/// its value or its default.
+fn plain_value(ctx: &mut Ctx, s: &ParamSpec, l: &Lookup) -> Option<ParamValue> {
+    match s.kind {
+        ParamKind::Int(def) => Some(ParamValue::Int(
+            l.plain(s.name, ParamType::Integer)
+                .map(|q| q.nums()[0].clamp(i32::MIN as f64, i32::MAX as f64) as i32)
+                .unwrap_or(def),
+        )),
+        ParamKind::Vector3(def) => Some(ParamValue::Vector(
+            l.plain(s.name, ParamType::Vector3)
+                .map(|q| {
+                    let v = q.nums();
+                    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+                })
+                .unwrap_or(Vec3::from_array(def)),
+        )),
+        ParamKind::BoolOpt => l
+            .plain(s.name, ParamType::Bool)
+            .map(|q| ParamValue::Bool(q.bools()[0])),
+        ParamKind::Choice { default, options } => {
+            Some(ParamValue::String(read_choice(ctx, s, l, default, options)))
+        }
+        // As written: the image reader resolves it against the scene
+        // file's directory.
+        ParamKind::Filename => Some(ParamValue::String(
+            l.plain(s.name, ParamType::String)
+                .map(|q| q.strs()[0].clone())
+                .unwrap_or_default(),
+        )),
+        ParamKind::Float(def) => Some(ParamValue::Float(
+            l.plain(s.name, ParamType::Float)
+                .map(|q| check_range(ctx, s, q.nums()[0] as f32, q.values_loc))
+                .unwrap_or(def),
+        )),
+        ParamKind::FloatOpt => l
+            .plain(s.name, ParamType::Float)
+            .map(|q| ParamValue::Float(check_range(ctx, s, q.nums()[0] as f32, q.values_loc))),
+        ParamKind::Bool(def) => Some(ParamValue::Bool(
+            l.plain(s.name, ParamType::Bool)
+                .map(|q| q.bools()[0])
+                .unwrap_or(def),
+        )),
+        ParamKind::String(def) => Some(ParamValue::String(
+            l.plain(s.name, ParamType::String)
+                .map(|q| q.strs()[0].clone())
+                .unwrap_or_else(|| def.to_string()),
+        )),
+        // pbrt-v3's FindFilename: an empty name is no name; a missing
+        // one is reported by `material` (which knows the statement).
+        ParamKind::FourierFile => l
+            .plain(s.name, ParamType::String)
+            .filter(|q| !q.strs()[0].is_empty())
+            .and_then(|q| fourier_table(ctx, &q.strs()[0], q.values_loc))
+            .map(ParamValue::Fourier),
+        ParamKind::Point3(def) => Some(ParamValue::Point(
+            l.plain(s.name, ParamType::Point3)
+                .map(|q| {
+                    let v = q.nums();
+                    glam::DVec3::new(v[0], v[1], v[2])
+                })
+                .unwrap_or(Vec3::from_array(def).as_dvec3()),
+        )),
+        ParamKind::Floats => l
+            .lists()
+            .find_map(|list| {
+                list.items
+                    .iter()
+                    .find(|q| q.name == s.name && q.ty == ParamType::Float)
+            })
+            .map(|q| {
+                q.used.set(true);
+                ParamValue::Floats(Arc::from(q.nums()))
+            }),
+        ParamKind::IntOpt => l
+            .plain(s.name, ParamType::Integer)
+            .map(|q| ParamValue::Int(q.nums()[0].clamp(i32::MIN as f64, i32::MAX as f64) as i32)),
+        // pbrt-v3 reads no image for an empty name.
+        ParamKind::Image(decode) => l
+            .plain(s.name, ParamType::String)
+            .filter(|q| !q.strs()[0].is_empty())
+            .and_then(|q| super::image::load_image(ctx, q.values_loc, &q.strs()[0], decode))
+            .map(ParamValue::Image),
+        ParamKind::List(e) => l
+            .lists()
+            .find_map(|list| {
+                list.items
+                    .iter()
+                    .find(|q| q.name == s.name && elem_accepts(e, q.ty))
+            })
+            .map(|q| {
+                q.used.set(true);
+                ParamValue::Floats(Arc::from(q.nums()))
+            }),
+        _ => unreachable!("read by read_params_as"),
+    }
+}
+
+/// A `Choice` parameter: its value if pbrt-v3 knows it, else (with a
+/// warning and a hint) the default.
+fn read_choice(
+    ctx: &mut Ctx,
+    s: &ParamSpec,
+    l: &Lookup,
+    default: &str,
+    options: &[&str],
+) -> String {
+    match l.plain(s.name, ParamType::String) {
+        Some(q) => {
+            let v = q.strs()[0].clone();
+            if options.contains(&v.as_str()) {
+                v
+            } else {
+                let hint = match closest_name(&v, options) {
+                    Some(c) => format!("did you mean \"{c}\"?"),
+                    None => format!(
+                        "one of {}",
+                        options
+                            .iter()
+                            .map(|o| format!("\"{o}\""))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                };
+                ctx.warn(q.values_loc, format!("\"{}\" is \"{v}\", which pbrt-v3 does not know ({hint}): \"{default}\" is used (as pbrt-v3)", s.name), "unknown value");
+                default.to_string()
+            }
+        }
+        None => default.to_string(),
+    }
 }
 
 /// The parameter types a [`ParamKind::List`] of `e` takes.

@@ -106,65 +106,8 @@ pub fn read_gltf(
     // first; the rest runs under `catch_unwind` as a last guard.
     let gltf = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| format!("not a valid glTF file: {e}"))?;
-    let root = gltf.document.as_json();
-    for (mi, mesh) in root.meshes.iter().enumerate() {
-        for prim in &mesh.primitives {
-            let accessors = prim.attributes.values().chain(prim.indices.as_ref());
-            for a in accessors {
-                if a.value() >= root.accessors.len() {
-                    return Err(format!(
-                        "mesh {mi} refers to accessor {}, but the file has {}",
-                        a.value(),
-                        root.accessors.len()
-                    ));
-                }
-            }
-        }
-    }
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        use gltf::json::validation::Validate;
-        let mut errors = Vec::new();
-        root.validate(root, gltf::json::Path::new, &mut |path, e| {
-            errors.push(format!("{}: {e}", path()))
-        });
-        errors
-    }))
-    .map_err(|_| "the glTF file failed validation".to_string())
-    .and_then(|errors| match errors.first() {
-        None => Ok(()),
-        Some(e) => Err(format!("not a valid glTF file: {e}")),
-    })?;
-    let mut buffers: Vec<Vec<u8>> = Vec::new();
-    for b in gltf.document.buffers() {
-        let data = match b.source() {
-            gltf::buffer::Source::Bin => gltf
-                .blob
-                .clone()
-                .ok_or("a buffer refers to the GLB binary chunk, which is missing")?,
-            gltf::buffer::Source::Uri(uri) => {
-                if let Some(rest) = uri.strip_prefix("data:") {
-                    let (_, b64) = rest
-                        .split_once(";base64,")
-                        .ok_or_else(|| "a data: URI that is not base64".to_string())?;
-                    base64_decode(b64).ok_or("a data: URI with bad base64")?
-                } else {
-                    let path = dir.join(percent_decode(uri));
-                    load(&path).map_err(|e| {
-                        format!("cannot read glTF buffer \"{}\": {e}", path.display())
-                    })?
-                }
-            }
-        };
-        if data.len() < b.length() {
-            return Err(format!(
-                "buffer {} has {} bytes but declares {}",
-                b.index(),
-                data.len(),
-                b.length()
-            ));
-        }
-        buffers.push(data);
-    }
+    validate(&gltf)?;
+    let buffers = read_buffers(&gltf, dir, load)?;
     let scene = gltf
         .document
         .default_scene()
@@ -261,6 +204,80 @@ pub fn read_gltf(
         return Err("the default scene has no triangle primitives".into());
     }
     finish(out, normals, uvs)
+}
+
+/// The gltf crate's validation, after checking the accessor indices it
+/// reads without a bounds check.
+fn validate(gltf: &gltf::Gltf) -> Result<(), String> {
+    let root = gltf.document.as_json();
+    for (mi, mesh) in root.meshes.iter().enumerate() {
+        for prim in &mesh.primitives {
+            let accessors = prim.attributes.values().chain(prim.indices.as_ref());
+            for a in accessors {
+                if a.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "mesh {mi} refers to accessor {}, but the file has {}",
+                        a.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        use gltf::json::validation::Validate;
+        let mut errors = Vec::new();
+        root.validate(root, gltf::json::Path::new, &mut |path, e| {
+            errors.push(format!("{}: {e}", path()))
+        });
+        errors
+    }))
+    .map_err(|_| "the glTF file failed validation".to_string())
+    .and_then(|errors| match errors.first() {
+        None => Ok(()),
+        Some(e) => Err(format!("not a valid glTF file: {e}")),
+    })
+}
+
+/// The file's buffers: the GLB binary chunk, base64 `data:` URIs, or files
+/// read by `load` relative to `dir`.
+fn read_buffers(
+    gltf: &gltf::Gltf,
+    dir: &Path,
+    load: &dyn Fn(&Path) -> Result<Vec<u8>, String>,
+) -> Result<Vec<Vec<u8>>, String> {
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in gltf.document.buffers() {
+        let data = match b.source() {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or("a buffer refers to the GLB binary chunk, which is missing")?,
+            gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, b64) = rest
+                        .split_once(";base64,")
+                        .ok_or_else(|| "a data: URI that is not base64".to_string())?;
+                    base64_decode(b64).ok_or("a data: URI with bad base64")?
+                } else {
+                    let path = dir.join(percent_decode(uri));
+                    load(&path).map_err(|e| {
+                        format!("cannot read glTF buffer \"{}\": {e}", path.display())
+                    })?
+                }
+            }
+        };
+        if data.len() < b.length() {
+            return Err(format!(
+                "buffer {} has {} bytes but declares {}",
+                b.index(),
+                data.len(),
+                b.length()
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
 }
 
 fn base64_decode(s: &str) -> Option<Vec<u8>> {

@@ -1,6 +1,7 @@
 //! Scene building: graphics state to a plain scene description.
 //!
-//! - [`state`]: the walk over statements with pbrt-v3's graphics state.
+//! - [`state`]: the walk over statements with pbrt-v3's graphics state
+//!   (`state/shape.rs`: a `Shape` statement with the state current at it).
 //! - [`kinds`]: any family's statement read through its kind's table and
 //!   built by the kind's builder; [`options`]: the camera, film, filter,
 //!   sampler and integrator statements; [`lights`], [`material`],

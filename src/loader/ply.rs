@@ -262,108 +262,12 @@ pub fn read_ply(data: &[u8]) -> Result<PlyMesh, String> {
         if min > 0 && el.count > r.left() / min {
             return Err(format!("element `{}` claims {} entries, more than the {} bytes left can hold (truncated or corrupt file)", el.name, el.count, r.left()));
         }
-        let idx = |n: &str| {
-            el.props
-                .iter()
-                .position(|p| p.name == n && p.list.is_none())
-        };
         if el.name == "vertex" {
-            let (Some(x), Some(y), Some(z)) = (idx("x"), idx("y"), idx("z")) else {
-                return Err("the vertex element has no x, y, z properties".into());
-            };
-            let normal = match (idx("nx"), idx("ny"), idx("nz")) {
-                (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-                _ => None,
-            };
-            let uv = [
-                ("u", "v"),
-                ("s", "t"),
-                ("texture_u", "texture_v"),
-                ("texture_s", "texture_t"),
-            ]
-            .iter()
-            .find_map(|(a, b)| Some([idx(a)?, idx(b)?]));
-            // Positions as read (f32 ×3), then the render's copy, normals and uvs.
-            let per =
-                24 + if normal.is_some() { 24 } else { 0 } + if uv.is_some() { 16 } else { 0 };
-            crate::scene::memory::check_budget(
-                &format!("the mesh's {} vertices", el.count),
-                (el.count as u64).saturating_mul(per),
-            )?;
-            mesh.positions.reserve(el.count);
-            let mut normals = Vec::with_capacity(if normal.is_some() { el.count } else { 0 });
-            let mut uvs = Vec::with_capacity(if uv.is_some() { el.count } else { 0 });
-            let mut vals = vec![0.0f64; el.props.len()];
-            for _ in 0..el.count {
-                for (k, p) in el.props.iter().enumerate() {
-                    vals[k] = read_prop(&mut r, p)?.unwrap_or(0.0);
-                }
-                mesh.positions
-                    .push(Vec3::new(vals[x] as f32, vals[y] as f32, vals[z] as f32));
-                if let Some([a, b, c]) = normal {
-                    normals.push(Vec3::new(vals[a] as f32, vals[b] as f32, vals[c] as f32));
-                }
-                if let Some([a, b]) = uv {
-                    uvs.push(Vec2::new(vals[a] as f32, vals[b] as f32));
-                }
-            }
-            if normal.is_some() {
-                mesh.normals = Some(normals);
-            }
-            if uv.is_some() {
-                mesh.uvs = Some(uvs);
-            }
+            read_vertices(&mut r, el, &mut mesh)?;
             have_vertices = true;
         } else if el.name == "face" {
             faces_seen = true;
-            let li = el.props.iter().position(|p| {
-                p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
-            });
-            if li.is_none() {
-                return Err("the face element has no `vertex_indices` list".into());
-            }
-            if li.is_some_and(|i| !el.props[i].ty.is_integer()) {
-                return Err("`vertex_indices` is not a list of integers".into());
-            }
-            mesh.indices
-                .reserve(el.count.saturating_mul(3).min(r.left()));
-            let nverts = mesh.positions.len();
-            let mut poly: Vec<f64> = Vec::with_capacity(8);
-            for f in 0..el.count {
-                for (k, p) in el.props.iter().enumerate() {
-                    if Some(k) == li {
-                        poly.clear();
-                        let n = r.read(p.list.expect("list"))?;
-                        if n < 0.0 || n > r.left() as f64 {
-                            return Err(format!("face {f} has a bad vertex count {n}"));
-                        }
-                        if n == 0.0 {
-                            return Err(format!("face {f} has no vertex indices"));
-                        }
-                        for _ in 0..n as usize {
-                            poly.push(r.read(p.ty)?);
-                        }
-                    } else {
-                        read_prop(&mut r, p)?;
-                    }
-                }
-                if !have_vertices {
-                    return Err("faces come before the vertex element".into());
-                }
-                for &v in &poly {
-                    if v < 0.0 || v >= nverts as f64 {
-                        return Err(format!("face {f} has vertex index {v}, out of range (the file has {nverts} vertices)"));
-                    }
-                }
-                let p: Vec<u32> = poly.iter().map(|&v| v as u32).collect();
-                match p.len() {
-                    3 => mesh.indices.extend_from_slice(&p),
-                    4 => mesh
-                        .indices
-                        .extend_from_slice(&[p[0], p[1], p[2], p[0], p[2], p[3]]),
-                    _ => skipped_polys += 1,
-                }
-            }
+            skipped_polys += read_faces(&mut r, el, have_vertices, &mut mesh)?;
         } else if !el.props.is_empty() {
             for _ in 0..el.count {
                 for p in &el.props {
@@ -384,6 +288,124 @@ pub fn read_ply(data: &[u8]) -> Result<PlyMesh, String> {
         ));
     }
     Ok(PlyMesh { mesh, notes })
+}
+
+/// The vertex element: positions, and normals and uvs where the element has
+/// them (pbrt-v3's property names).
+fn read_vertices(r: &mut Reader, el: &Element, mesh: &mut MeshData) -> Result<(), String> {
+    let idx = |n: &str| {
+        el.props
+            .iter()
+            .position(|p| p.name == n && p.list.is_none())
+    };
+    let (Some(x), Some(y), Some(z)) = (idx("x"), idx("y"), idx("z")) else {
+        return Err("the vertex element has no x, y, z properties".into());
+    };
+    let normal = match (idx("nx"), idx("ny"), idx("nz")) {
+        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+        _ => None,
+    };
+    let uv = [
+        ("u", "v"),
+        ("s", "t"),
+        ("texture_u", "texture_v"),
+        ("texture_s", "texture_t"),
+    ]
+    .iter()
+    .find_map(|(a, b)| Some([idx(a)?, idx(b)?]));
+    // Positions as read (f32 ×3), then the render's copy, normals and uvs.
+    let per = 24 + if normal.is_some() { 24 } else { 0 } + if uv.is_some() { 16 } else { 0 };
+    crate::scene::memory::check_budget(
+        &format!("the mesh's {} vertices", el.count),
+        (el.count as u64).saturating_mul(per),
+    )?;
+    mesh.positions.reserve(el.count);
+    let mut normals = Vec::with_capacity(if normal.is_some() { el.count } else { 0 });
+    let mut uvs = Vec::with_capacity(if uv.is_some() { el.count } else { 0 });
+    let mut vals = vec![0.0f64; el.props.len()];
+    for _ in 0..el.count {
+        for (k, p) in el.props.iter().enumerate() {
+            vals[k] = read_prop(r, p)?.unwrap_or(0.0);
+        }
+        mesh.positions
+            .push(Vec3::new(vals[x] as f32, vals[y] as f32, vals[z] as f32));
+        if let Some([a, b, c]) = normal {
+            normals.push(Vec3::new(vals[a] as f32, vals[b] as f32, vals[c] as f32));
+        }
+        if let Some([a, b]) = uv {
+            uvs.push(Vec2::new(vals[a] as f32, vals[b] as f32));
+        }
+    }
+    if normal.is_some() {
+        mesh.normals = Some(normals);
+    }
+    if uv.is_some() {
+        mesh.uvs = Some(uvs);
+    }
+    Ok(())
+}
+
+/// The face element: triangles, and quads split in two (as pbrt-v3); the
+/// number of other polygons, skipped.
+fn read_faces(
+    r: &mut Reader,
+    el: &Element,
+    have_vertices: bool,
+    mesh: &mut MeshData,
+) -> Result<usize, String> {
+    let mut skipped = 0;
+    let li = el
+        .props
+        .iter()
+        .position(|p| p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index"));
+    if li.is_none() {
+        return Err("the face element has no `vertex_indices` list".into());
+    }
+    if li.is_some_and(|i| !el.props[i].ty.is_integer()) {
+        return Err("`vertex_indices` is not a list of integers".into());
+    }
+    mesh.indices
+        .reserve(el.count.saturating_mul(3).min(r.left()));
+    let nverts = mesh.positions.len();
+    let mut poly: Vec<f64> = Vec::with_capacity(8);
+    for f in 0..el.count {
+        for (k, p) in el.props.iter().enumerate() {
+            if Some(k) == li {
+                poly.clear();
+                let n = r.read(p.list.expect("list"))?;
+                if n < 0.0 || n > r.left() as f64 {
+                    return Err(format!("face {f} has a bad vertex count {n}"));
+                }
+                if n == 0.0 {
+                    return Err(format!("face {f} has no vertex indices"));
+                }
+                for _ in 0..n as usize {
+                    poly.push(r.read(p.ty)?);
+                }
+            } else {
+                read_prop(r, p)?;
+            }
+        }
+        if !have_vertices {
+            return Err("faces come before the vertex element".into());
+        }
+        for &v in &poly {
+            if v < 0.0 || v >= nverts as f64 {
+                return Err(format!(
+                    "face {f} has vertex index {v}, out of range (the file has {nverts} vertices)"
+                ));
+            }
+        }
+        let p: Vec<u32> = poly.iter().map(|&v| v as u32).collect();
+        match p.len() {
+            3 => mesh.indices.extend_from_slice(&p),
+            4 => mesh
+                .indices
+                .extend_from_slice(&[p[0], p[1], p[2], p[0], p[2], p[3]]),
+            _ => skipped += 1,
+        }
+    }
+    Ok(skipped)
 }
 
 /// Reads one property (a scalar, or a list whose values are discarded).

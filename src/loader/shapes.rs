@@ -10,7 +10,7 @@ use super::ply::{read_ply, PlyMesh};
 use super::Ctx;
 use crate::lang::params::ParamList;
 use crate::lang::parser::Name;
-use crate::scene::{kind, Geometry, MeshData, Report};
+use crate::scene::{kind, MeshData, Report, Surface};
 use crate::shapes::{MeshFormat, ShapeBuild, ShapeInput, SHAPES};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -32,15 +32,15 @@ pub fn is_unsupported_shape(name: &str) -> bool {
     kind::find(SHAPES, name).is_none()
 }
 
-/// The geometry of a `Shape`, or `None` (unknown: warning; invalid: error
+/// The surface of a `Shape`, or `None` (unknown: warning; invalid: error
 /// or warning, from its kind's builder). Unused parameters are left to the
 /// caller (the material may still read some).
-pub fn geometry(
+pub fn surface(
     ctx: &mut Ctx,
     name: &Name,
     p: &ParamList,
     meshes: &mut MeshCache,
-) -> Option<Geometry> {
+) -> Option<Surface> {
     let r = kinds::read(ctx, &FAMILY, name, p)?;
     let mut input = Input {
         report: StatementReport {

@@ -15,7 +15,7 @@ pub struct Summary {
     pub integrator: String,
     /// Shapes placed directly in the world.
     pub shapes: usize,
-    /// Shapes by geometry type (`trianglemesh`, `sphere`), world shapes only.
+    /// Shapes by kind (`trianglemesh`, `sphere`), world shapes only.
     pub shapes_by_type: BTreeMap<&'static str, usize>,
     /// Triangles of world shapes.
     pub triangles: usize,
@@ -104,9 +104,9 @@ impl Summary {
         for sh in &scene.shapes {
             s.shapes += 1;
             *s.shapes_by_type
-                .entry(crate::shapes::kind_name(&sh.geometry))
+                .entry(crate::shapes::kind_name(&sh.surface))
                 .or_default() += 1;
-            s.triangles += triangles(&sh.geometry);
+            s.triangles += triangles(&sh.surface);
             s.area_lights += usize::from(sh.area_light.is_some());
             s.alpha_shapes += usize::from(sh.alpha.is_some() || sh.shadow_alpha.is_some());
         }
@@ -125,7 +125,7 @@ impl Summary {
             s.object_triangles += o
                 .shapes
                 .iter()
-                .map(|sh| triangles(&sh.geometry))
+                .map(|sh| triangles(&sh.surface))
                 .sum::<usize>();
         }
         s.instances = scene.instances.len();
@@ -150,9 +150,9 @@ pub enum DeclaredKind {
     Unknown(String),
 }
 
-fn triangles(g: &Geometry) -> usize {
+fn triangles(g: &Surface) -> usize {
     match g {
-        Geometry::TriangleMesh(m) => m.triangle_count(),
+        Surface::TriangleMesh(m) => m.triangle_count(),
         _ => 0,
     }
 }

@@ -10,7 +10,7 @@ use crate::lights::{AreaShape, DiffuseEmission, DiffuseLight, Light};
 use crate::materials::{link_materials, Material};
 use crate::media::Medium;
 use crate::scene::{self, MediumInterfaceDesc, SceneDescription, ShapeDesc};
-use crate::shapes::{AlphaMask, Curve, CurveCommon, Quadric, TriangleMesh};
+use crate::shapes::{AlphaMask, AnalyticShape, Curve, CurveCommon, TriangleMesh};
 use glam::{DMat3, DMat4, Vec3};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -33,66 +33,14 @@ impl Slots {
 impl RenderScene {
     pub fn new(desc: &SceneDescription) -> RenderScene {
         let (materials, surface_media, slots) = material_slots(desc);
-        let mut meshes = Vec::new();
-        let mut quadrics = Vec::new();
-        let mut area: Vec<(AreaShape, DiffuseEmission)> = Vec::new();
         let mut notes = Vec::new();
-
-        let mut add_shape = |s: &ShapeDesc, to_world: DMat4| {
-            let emit = s.area_light.filter(|a| a.l.max_element() > 0.0);
-            match &s.geometry {
-                scene::Geometry::TriangleMesh(m) => {
-                    let mesh_index = meshes.len() as u32;
-                    let mut tm = world_mesh(m, to_world, s, slots.of(s));
-                    if let Some(a) = emit {
-                        tm.first_light = Some(area.len() as u32);
-                        for tri in 0..tm.triangle_count() {
-                            area.push((
-                                AreaShape::Triangle {
-                                    mesh: mesh_index,
-                                    tri,
-                                },
-                                a,
-                            ));
-                        }
-                    }
-                    meshes.push(tm);
-                }
-                // Curves never emit (the loader warned).
-                scene::Geometry::Curve(c) => {
-                    quadrics.extend(curve_pieces(c, to_world, s, slots.of(s)))
-                }
-                g => {
-                    let Some(mut q) = quadric(g, to_world, s, slots.of(s)) else {
-                        return;
-                    };
-                    if let Some(a) = emit {
-                        q.set_light(Some(area.len() as u32));
-                        area.push((AreaShape::Quadric(quadrics.len() as u32), a));
-                    }
-                    quadrics.push(q);
-                }
-            }
-        };
-        // An animated shape becomes a one-shape object in its own space
-        // placed by a moving instance, as pbrt-v3 builds it with the identity
-        // transform inside a `TransformedPrimitive` (never emissive: the
-        // loader dropped its area light, as pbrt-v3 does).
-        let mut moving = Vec::new();
-        let mut singular_moving = 0usize;
-        for s in &desc.shapes {
-            match &s.motion {
-                None => add_shape(s, s.object_to_world),
-                Some(m) => {
-                    let obj =
-                        Arc::new(object(std::slice::from_ref(s), |_| DMat4::IDENTITY, &slots));
-                    match MovingInstance::new(obj, m.clone()) {
-                        Some(i) => moving.push(i),
-                        None => singular_moving += 1,
-                    }
-                }
-            }
-        }
+        let WorldShapes {
+            meshes,
+            quadrics,
+            area,
+            mut moving,
+            mut singular_moving,
+        } = world_shapes(desc, &slots);
         let (objects, instances, singular) =
             place_instances(desc, &slots, &mut moving, &mut singular_moving);
         if singular > 0 {
@@ -129,19 +77,7 @@ impl RenderScene {
             notes.push("no geometry: no BVH built".into());
         }
 
-        let mut lights: Vec<Light> = area
-            .iter()
-            .map(|&(shape, a)| DiffuseLight::new(a, shape, &geometry).into())
-            .collect();
-        let mut infinite_lights = Vec::new();
-        for l in &desc.lights {
-            let mut light = l.clone();
-            light.preprocess(&geometry);
-            if light.is_infinite() {
-                infinite_lights.push(lights.len() as u32);
-            }
-            lights.push(light);
-        }
+        let (lights, infinite_lights) = scene_lights(desc, &area, &geometry);
         let zero = lights.iter().filter(|l| l.power() <= 0.0).count();
         if zero > 0 {
             notes.push(format!("{zero} lights of zero power are never sampled"));
@@ -204,6 +140,108 @@ impl RenderScene {
             has_pass_through,
         }
     }
+}
+
+/// The world's shapes placed for the render core: triangle meshes, analytic
+/// shapes (curve pieces included), the emitting ones' area lights, and the
+/// animated shapes as moving one-shape objects.
+struct WorldShapes {
+    meshes: Vec<TriangleMesh>,
+    quadrics: Vec<AnalyticShape>,
+    area: Vec<(AreaShape, DiffuseEmission)>,
+    moving: Vec<MovingInstance>,
+    /// Animated shapes left out for a singular start or end transform.
+    singular_moving: usize,
+}
+
+fn world_shapes(desc: &SceneDescription, slots: &Slots) -> WorldShapes {
+    let mut meshes = Vec::new();
+    let mut quadrics = Vec::new();
+    let mut area: Vec<(AreaShape, DiffuseEmission)> = Vec::new();
+
+    let mut add_shape = |s: &ShapeDesc, to_world: DMat4| {
+        let emit = s.area_light.filter(|a| a.l.max_element() > 0.0);
+        match &s.surface {
+            scene::Surface::TriangleMesh(m) => {
+                let mesh_index = meshes.len() as u32;
+                let mut tm = world_mesh(m, to_world, s, slots.of(s));
+                if let Some(a) = emit {
+                    tm.first_light = Some(area.len() as u32);
+                    for tri in 0..tm.triangle_count() {
+                        area.push((
+                            AreaShape::Triangle {
+                                mesh: mesh_index,
+                                tri,
+                            },
+                            a,
+                        ));
+                    }
+                }
+                meshes.push(tm);
+            }
+            // Curves never emit (the loader warned).
+            scene::Surface::Curve(c) => quadrics.extend(curve_pieces(c, to_world, s, slots.of(s))),
+            g => {
+                let Some(mut q) = placed_analytic(g, to_world, s, slots.of(s)) else {
+                    return;
+                };
+                if let Some(a) = emit {
+                    q.set_light(Some(area.len() as u32));
+                    area.push((AreaShape::Analytic(quadrics.len() as u32), a));
+                }
+                quadrics.push(q);
+            }
+        }
+    };
+    // An animated shape becomes a one-shape object in its own space
+    // placed by a moving instance, as pbrt-v3 builds it with the identity
+    // transform inside a `TransformedPrimitive` (never emissive: the
+    // loader dropped its area light, as pbrt-v3 does).
+    let mut moving = Vec::new();
+    let mut singular_moving = 0usize;
+    for s in &desc.shapes {
+        match &s.motion {
+            None => add_shape(s, s.object_to_world),
+            Some(m) => {
+                let obj = Arc::new(object(std::slice::from_ref(s), |_| DMat4::IDENTITY, slots));
+                match MovingInstance::new(obj, m.clone()) {
+                    Some(i) => moving.push(i),
+                    None => singular_moving += 1,
+                }
+            }
+        }
+    }
+    WorldShapes {
+        meshes,
+        quadrics,
+        area,
+        moving,
+        singular_moving,
+    }
+}
+
+/// The area lights of the emitting shapes, then the description's lights
+/// (preprocessed for the scene's bounds), and the indices of the infinite
+/// ones.
+fn scene_lights(
+    desc: &SceneDescription,
+    area: &[(AreaShape, DiffuseEmission)],
+    geometry: &Geometry,
+) -> (Vec<Light>, Vec<u32>) {
+    let mut lights: Vec<Light> = area
+        .iter()
+        .map(|&(shape, a)| DiffuseLight::new(a, shape, geometry).into())
+        .collect();
+    let mut infinite_lights = Vec::new();
+    for l in &desc.lights {
+        let mut light = l.clone();
+        light.preprocess(geometry);
+        if light.is_infinite() {
+            infinite_lights.push(lights.len() as u32);
+        }
+        lights.push(light);
+    }
+    (lights, infinite_lights)
 }
 
 /// The materials, one per description material plus one per (material,
@@ -288,10 +326,10 @@ fn object(shapes: &[ShapeDesc], to_object: impl Fn(&ShapeDesc) -> DMat4, slots: 
     for s in shapes {
         let m4 = to_object(s);
         let material = slots.of(s);
-        match &s.geometry {
-            scene::Geometry::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s, material)),
-            scene::Geometry::Curve(c) => quadrics.extend(curve_pieces(c, m4, s, material)),
-            g => quadrics.extend(quadric(g, m4, s, material)),
+        match &s.surface {
+            scene::Surface::TriangleMesh(m) => meshes.push(world_mesh(m, m4, s, material)),
+            scene::Surface::Curve(c) => quadrics.extend(curve_pieces(c, m4, s, material)),
+            g => quadrics.extend(placed_analytic(g, m4, s, material)),
         }
     }
     Object::new(meshes, quadrics)
@@ -304,7 +342,7 @@ fn curve_pieces<'a>(
     to_world: DMat4,
     s: &ShapeDesc,
     material: u32,
-) -> impl Iterator<Item = Quadric> + 'a {
+) -> impl Iterator<Item = AnalyticShape> + 'a {
     let reverse = s.reverse_orientation;
     c.segments.iter().flat_map(move |seg| {
         let common = Arc::new(CurveCommon::new(
@@ -315,16 +353,21 @@ fn curve_pieces<'a>(
             to_world,
             reverse,
         ));
-        Curve::pieces(common, c.split_depth, material).map(Quadric::Curve)
+        Curve::pieces(common, c.split_depth, material).map(AnalyticShape::Curve)
     })
 }
 
 /// An analytic shape in the space `to_world` maps to (`None` for meshes and
 /// curves).
-fn quadric(g: &scene::Geometry, to_world: DMat4, s: &ShapeDesc, material: u32) -> Option<Quadric> {
-    match g {
-        scene::Geometry::Quadric(q) => Some(q.placed(to_world, s.reverse_orientation, material)),
-        scene::Geometry::TriangleMesh(_) | scene::Geometry::Curve(_) => None,
+fn placed_analytic(
+    surface: &scene::Surface,
+    to_world: DMat4,
+    s: &ShapeDesc,
+    material: u32,
+) -> Option<AnalyticShape> {
+    match surface {
+        scene::Surface::Analytic(a) => Some(a.placed(to_world, s.reverse_orientation, material)),
+        scene::Surface::TriangleMesh(_) | scene::Surface::Curve(_) => None,
     }
 }
 

@@ -194,7 +194,7 @@ impl MaterialDesc {
 
 #[derive(Clone, Debug)]
 pub struct ShapeDesc {
-    pub geometry: Geometry,
+    pub surface: Surface,
     pub object_to_world: DMat4,
     /// Object-to-world over time when the shape's start and end CTMs differ
     /// (`object_to_world` is then the start transform). `None` for every
@@ -221,7 +221,7 @@ pub struct ShapeDesc {
 /// space; the render core places it (once per instance for shapes inside
 /// `ObjectBegin`).
 #[derive(Clone, Debug)]
-pub enum Geometry {
+pub enum Surface {
     /// Vertices in object space (`trianglemesh`, the mesh files and the
     /// refined shapes).
     TriangleMesh(Arc<MeshData>),
@@ -229,9 +229,9 @@ pub enum Geometry {
     /// input already converted); placed as 2^splitdepth pieces per segment.
     Curve(Arc<CurveData>),
     /// A sphere, disk, cylinder, cone, paraboloid or hyperboloid: the
-    /// render core's own shape, built at the origin (identity transform)
-    /// and placed with `Quadric::placed`.
-    Quadric(crate::shapes::Quadric),
+    /// render core's own analytic shape, built at the origin (identity
+    /// transform) and placed with `AnalyticShape::placed`.
+    Analytic(crate::shapes::AnalyticShape),
 }
 
 /// pbrt-v3's curve types.

@@ -19,9 +19,13 @@
 //! a cone area light is a pbrs extension: uniform by area (v = 1 − √(1 − ξ)),
 //! with the exact world-area density.
 
-use super::quadric::{Analytic, QuadricHit};
-use super::{at_origin, check_floats, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use super::analytic::{pbrt_closest, phi_f32, phi_of, Analytic, AnalyticHit, Placed};
+use super::{at_origin, check_floats, phi_max, ShapeInput, ShapeKind, Surface, PHIMAX};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::efloat::{quadratic, transform_ray, EFloat};
+use crate::geometry::{gamma, Bounds3};
 use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float("radius", 1.0, "radius of its base (> 0)"),
@@ -40,7 +44,7 @@ pub const KIND: ShapeKind = ShapeKind {
 
 /// pbrt-v3's checks: radius and height positive 32-bit floats (error),
 /// phimax > 0 (warning, skipped).
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let radius = p.float("radius");
     let height = p.float("height");
     if !check_floats(
@@ -51,73 +55,36 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         return None;
     }
     let phimax = phi_max("cone", p, r)?;
-    at_origin(Cone::new(radius, height, phimax, ORIGIN, false, 0))
+    at_origin(Cone::new(Placed::origin((radius, height, phimax))))
 }
-
-use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
-use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::geometry::efloat::{quadratic, transform_ray, EFloat};
-use crate::geometry::{gamma, Bounds3};
-use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Cone {
-    /// The arguments of [`Cone::new`] but the placement: the shape as its
-    /// kind built it, placed again by [`Analytic::placed`].
-    pub args: (f32, f32, f32),
+    /// Its parameters, placement, material and area light.
+    pub at: Placed<(f32, f32, f32)>,
     pub radius: f64,
     pub height: f64,
     /// Radians.
     pub phi_max: f64,
-    pub place: Placement,
-    pub material: u32,
-    pub light: Option<u32>,
     obj_area: f64,
     area: f32,
 }
 
 impl Cone {
-    pub fn new(
-        radius: f32,
-        height: f32,
-        phi_max_deg: f32,
-        object_to_world: DMat4,
-        reverse: bool,
-        material: u32,
-    ) -> Cone {
+    pub fn new(at: Placed<(f32, f32, f32)>) -> Cone {
+        let (radius, height, phi_max_deg) = at.args;
         let (r, h) = (radius.abs() as f64, height as f64);
         let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
-        let place = Placement::new(object_to_world, reverse);
+        let place = &at.place;
         let obj_area = r * (h * h + r * r).sqrt() * phi_max / 2.0;
         Cone {
-            args: (radius, height, phi_max_deg),
             radius: r,
             height: h,
             phi_max,
             area: place.world_area(obj_area),
-            place,
-            material,
-            light: None,
             obj_area,
+            at,
         }
-    }
-
-    pub fn area(&self) -> f32 {
-        self.area
-    }
-
-    pub fn is_valid(&self) -> bool {
-        self.place.is_valid()
-            && self.radius > 0.0
-            && self.height > 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
-    }
-
-    pub fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
-        self.place
-            .bounds(DVec3::new(-r, -r, 0.0), DVec3::new(r, r, self.height))
     }
 
     /// (radius/height)²: the cone is x² + y² = k (z − h)².
@@ -125,27 +92,6 @@ impl Cone {
     fn k(&self) -> f64 {
         let s = self.radius / self.height;
         s * s
-    }
-
-    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Cone::Intersect`
-    /// computes it (f32 with running error bounds): t, the object-space
-    /// point and its error bound.
-    #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, Vec3, Vec3)> {
-        let (o, d) = transform_ray(&self.place.world_to_object_f32, o, d);
-        let (r, h) = (self.radius as f32, self.height as f32);
-        let k = EFloat::exact(r) / EFloat::exact(h);
-        let k = k * k;
-        let [ox, oy, oz] = o;
-        let [dx, dy, dz] = d;
-        let ozh = oz - EFloat::exact(h);
-        let a = dx * dx + dy * dy - k * dz * dz;
-        let b = 2.0 * (dx * ox + dy * oy - k * dz * ozh);
-        let c = ox * ox + oy * oy - k * ozh * ozh;
-        let phi_max = self.phi_max as f32;
-        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
-            p.z < 0.0 || p.z > h || phi_f32(p) > phi_max
-        })
     }
 
     /// ∂p/∂u and ∂p/∂v (pbrt-v3's parametrisation).
@@ -179,66 +125,94 @@ impl Cone {
         }
     }
 
-    pub fn surface_point(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
-        self.place.surface_point(p_obj, self.normal_obj(p_obj), err)
+    fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
+        self.at
+            .place
+            .surface_point(p_obj, self.normal_obj(p_obj), err)
+    }
+}
+
+impl Analytic for Cone {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        Cone::new(self.at.again(to_world, reverse, material))
     }
 
-    pub fn diff_geom(&self, p: DVec3) -> DiffGeom {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn is_valid(&self) -> bool {
+        self.at.place.is_valid()
+            && self.radius > 0.0
+            && self.height > 0.0
+            && self.area > 0.0
+            && self.area.is_finite()
+    }
+
+    fn bounds(&self) -> Bounds3 {
+        let r = self.radius;
+        self.at
+            .place
+            .bounds(DVec3::new(-r, -r, 0.0), DVec3::new(r, r, self.height))
+    }
+
+    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Cone::Intersect`
+    /// computes it (f32 with running error bounds): t, the object-space
+    /// point and its error bound.
+    #[inline]
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (o, d) = transform_ray(&self.at.place.world_to_object_f32, o, d);
+        let (r, h) = (self.radius as f32, self.height as f32);
+        let k = EFloat::exact(r) / EFloat::exact(h);
+        let k = k * k;
+        let [ox, oy, oz] = o;
+        let [dx, dy, dz] = d;
+        let ozh = oz - EFloat::exact(h);
+        let a = dx * dx + dy * dy - k * dz * dz;
+        let b = 2.0 * (dx * ox + dy * oy - k * dz * ozh);
+        let c = ox * ox + oy * oy - k * ozh * ozh;
+        let phi_max = self.phi_max as f32;
+        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
+            p.z < 0.0 || p.z > h || phi_f32(p) > phi_max
+        })
+        .map(|(t, p, err)| (t, AnalyticHit::Bounded { p, err }))
+    }
+
+    #[inline]
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.point_at(p, err)
+    }
+
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        let p = h.point_and_error().0;
         let (h, pm) = (self.height, self.phi_max);
         let u = phi_of(p) / pm;
         let v = p.z / h;
         let (dpdu, dpdv) = self.tangents(p);
         let d2uu = -pm * pm * DVec3::new(p.x, p.y, 0.0);
         let d2uv = pm / (1.0 - v) * DVec3::new(p.y, -p.x, 0.0);
-        self.place
+        self.at
+            .place
             .diff_geom((u, v), dpdu, dpdv, [d2uu, d2uv, DVec3::ZERO])
     }
 
     /// Density by world area at an object point.
     #[inline]
-    pub fn area_density(&self, p_obj: DVec3) -> f32 {
-        (1.0 / (self.obj_area * self.place.area_scale(self.normal_obj(p_obj)))) as f32
+    fn area_density(&self, p_obj: DVec3) -> f32 {
+        (1.0 / (self.obj_area * self.at.place.area_scale(self.normal_obj(p_obj)))) as f32
     }
 
     /// Uniform by area: the radius fraction s = √(1 − ξ₁) has density 2s.
-    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let s = (1.0 - u.x as f64).max(0.0).sqrt();
         let phi = self.phi_max * u.y as f64;
         let rho = self.radius * s;
         let p_obj = DVec3::new(rho * phi.cos(), rho * phi.sin(), self.height * (1.0 - s));
-        ShapeSample {
-            point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
+        Some(ShapeSample {
+            point: self.point_at(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
-        }
-    }
-}
-
-impl Analytic for Cone {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Cone::new(a.0, a.1, a.2, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.is_valid()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        let (p, err) = h.point_and_error();
-        self.surface_point(p, err)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn density_at(&self, p_obj: DVec3) -> f32 {
-        self.area_density(p_obj)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
+        })
     }
 }

@@ -35,9 +35,9 @@
 //! hit (pbrt-v3 divides by its zero width). Curves cannot be area lights
 //! (pbrt-v3's `Curve::Sample` aborts); the loader warns.
 
-use super::quadric::{Analytic, QuadricHit};
+use super::analytic::{Analytic, AnalyticHit};
 use super::ShapeSample;
-use super::{Geometry, ShapeInput, ShapeKind};
+use super::{ShapeInput, ShapeKind, Surface};
 use crate::scene::{CurveData, CurveSegment, Elem, ParamSpec, ParamValues, Support};
 
 pub const PARAMS: &[ParamSpec] = &[
@@ -79,7 +79,7 @@ const MAX_CURVE_SEGMENTS: usize = 1 << 22;
 
 /// pbrt-v3's `CreateCurveShape`: the curve as cubic Bézier segments, with
 /// its checks (errors where pbrt-v3 reports an error and makes no shape).
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let width = p.float("width");
     let width0 = p.float_opt("width0").unwrap_or(width);
     let width1 = p.float_opt("width1").unwrap_or(width);
@@ -155,7 +155,7 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
             normals: normals.as_ref().map(|n: &Vec<Vec3>| [n[seg], n[seg + 1]]),
         });
     }
-    Some(Geometry::Curve(std::sync::Arc::new(CurveData {
+    Some(Surface::Curve(std::sync::Arc::new(CurveData {
         kind,
         segments: out,
         split_depth,
@@ -434,126 +434,6 @@ impl Curve {
             .max(self.common.width_at(self.u_max))
     }
 
-    pub fn is_valid(&self) -> bool {
-        let c = &self.common;
-        c.placement.is_valid()
-            && c.cp.iter().all(|p| p.is_finite())
-            && c.width.iter().all(|w| *w > 0.0 && w.is_finite())
-    }
-
-    /// World bounds: the control points' box grown by half the width.
-    pub fn bounds(&self) -> Bounds3 {
-        let cp = self.control_points();
-        let (mut lo, mut hi) = (cp[0], cp[0]);
-        for p in &cp[1..] {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        let r = Vec3::splat(self.max_width() * 0.5);
-        self.common
-            .placement
-            .bounds((lo - r).as_dvec3(), (hi + r).as_dvec3())
-    }
-
-    /// pbrt-v3's estimate: control polygon length times mean width (object
-    /// space), scaled to world area.
-    pub fn area(&self) -> f32 {
-        let cp = self.control_points();
-        let len: f32 = (0..3).map(|i| cp[i].distance(cp[i + 1])).sum();
-        let w = 0.5 * (self.common.width_at(self.u_min) + self.common.width_at(self.u_max));
-        self.common.placement.world_area((len * w) as f64)
-    }
-
-    /// Closest hit with 0 < t ≤ t_max (world ray; `t` is the same in object
-    /// space).
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, CurveHit)> {
-        let (o, d) = self.common.placement.ray_to_object(o, d);
-        let (o, d) = (o.as_vec3(), d.as_vec3());
-        let ray_len = d.length();
-        if !(ray_len > 0.0 && ray_len.is_finite()) {
-            return None;
-        }
-        let dir = d / ray_len;
-        let cp_obj = self.control_points();
-        // The frame's "up" is along the chord, so the projected curve lies
-        // roughly along x and its boxes are thin in y.
-        let mut up = dir.cross(cp_obj[3] - cp_obj[0]);
-        if up.length_squared() == 0.0 {
-            up = coordinate_system(dir).0;
-        }
-        let right = up.normalize().cross(dir);
-        if right.length_squared().is_nan() || right.length_squared() <= 0.0 || !right.is_finite() {
-            return None;
-        }
-        let right = right.normalize();
-        let new_up = dir.cross(right);
-        let to_ray = |p: Vec3| {
-            let q = p - o;
-            Vec3::new(q.dot(right), q.dot(new_up), q.dot(dir))
-        };
-        let cp = cp_obj.map(to_ray);
-        let z_max = ray_len * t_max;
-        if !overlaps(&cp, self.max_width(), z_max) {
-            return None;
-        }
-        // Subdivision depth from the curve's second differences (pbrt-v3's
-        // bound for a flatness within width / 20).
-        let mut l0 = 0.0f32;
-        for i in 0..2 {
-            let dd = (cp[i] - 2.0 * cp[i + 1] + cp[i + 2]).abs();
-            l0 = l0.max(dd.x.max(dd.y).max(dd.z));
-        }
-        let eps = self.common.width[0].max(self.common.width[1]) * 0.05;
-        let depth =
-            (log2_round(std::f32::consts::SQRT_2 * 6.0 * l0 / (8.0 * eps)) / 2).clamp(0, 10);
-        let mut best: Option<(f32, Leaf)> = None;
-        let mut z_best = z_max;
-        self.recurse(
-            &cp,
-            self.u_min,
-            self.u_max,
-            depth,
-            dir,
-            &mut z_best,
-            &mut best,
-        );
-        let (z, leaf) = best?;
-        let t = z / ray_len;
-        let p = o + d * t;
-        let c = &self.common;
-        let dpdu = bezier_derivative(&c.cp, leaf.u);
-        let dpdv = match c.kind {
-            CurveKind::Ribbon => leaf.n_ribbon.cross(dpdu).normalize() * leaf.width,
-            CurveKind::Flat | CurveKind::Cylinder => {
-                // Across the curve in the plane facing the ray.
-                let flat = dir.cross(dpdu).normalize() * leaf.width;
-                if c.kind == CurveKind::Flat {
-                    flat
-                } else {
-                    let theta = lerp(leaf.v, -90.0f32, 90.0).to_radians();
-                    rotate(flat, dpdu.normalize(), -theta)
-                }
-            }
-        };
-        let dpdv = if dpdv.is_finite() && dpdv.length_squared() > 0.0 {
-            dpdv
-        } else {
-            coordinate_system(dpdu.normalize()).0 * leaf.width
-        };
-        if !(t.is_finite() && p.is_finite() && dpdv.is_finite()) {
-            return None;
-        }
-        Some((
-            t,
-            CurveHit {
-                p,
-                err: 2.0 * leaf.width,
-                uv: Vec2::new(leaf.u, leaf.v),
-                dpdv,
-            },
-        ))
-    }
-
     #[allow(clippy::too_many_arguments)]
     fn recurse(
         &self,
@@ -635,33 +515,6 @@ impl Curve {
                 n_ribbon,
             },
         ))
-    }
-
-    /// World point, error bound and oriented normal n̂(dp/du × dp/dv).
-    pub fn surface_point(&self, h: CurveHit) -> SurfacePoint {
-        let dpdu = bezier_derivative(&self.common.cp, h.uv.x);
-        let mut n = dpdu.cross(h.dpdv).as_dvec3();
-        if n.length_squared().is_nan() || n.length_squared() <= 0.0 {
-            n = coordinate_system(h.dpdv.normalize()).0.as_dvec3();
-        }
-        self.common
-            .placement
-            .surface_point(h.p.as_dvec3(), n, DVec3::splat(h.err as f64))
-    }
-
-    /// uv and the tangents in world space; curves have no normal derivatives.
-    pub fn diff_geom(&self, h: CurveHit) -> DiffGeom {
-        let pl = &self.common.placement;
-        let dpdu = pl.vector(bezier_derivative(&self.common.cp, h.uv.x).as_dvec3());
-        let dpdv = pl.vector(h.dpdv.as_dvec3());
-        DiffGeom {
-            uv: h.uv,
-            dpdu,
-            dpdv,
-            shading_dpdu: dpdu,
-            shading_dpdv: dpdv,
-            ..DiffGeom::ZERO
-        }
     }
 }
 
@@ -760,45 +613,185 @@ impl Analytic for Curve {
     fn placed(&self, _: DMat4, _: bool, _: u32) -> Self {
         self.clone()
     }
-    fn valid(&self) -> bool {
-        self.is_valid()
+
+    fn is_valid(&self) -> bool {
+        let c = &self.common;
+        c.placement.is_valid()
+            && c.cp.iter().all(|p| p.is_finite())
+            && c.width.iter().all(|w| *w > 0.0 && w.is_finite())
     }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, h)| (t, QuadricHit::Curve(h)))
+
+    /// World bounds: the control points' box grown by half the width.
+    fn bounds(&self) -> Bounds3 {
+        let cp = self.control_points();
+        let (mut lo, mut hi) = (cp[0], cp[0]);
+        for p in &cp[1..] {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let r = Vec3::splat(self.max_width() * 0.5);
+        self.common
+            .placement
+            .bounds((lo - r).as_dvec3(), (hi + r).as_dvec3())
     }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        match h {
-            QuadricHit::Curve(h) => self.surface_point(h),
-            // (Never reached: a curve's hits are curve hits.)
-            _ => {
-                let (p, err) = h.point_and_error();
-                SurfacePoint {
-                    p: p.as_vec3(),
-                    p_error: err.as_vec3(),
-                    n: Vec3::Z,
-                    ns: Vec3::Z,
+
+    /// pbrt-v3's estimate: control polygon length times mean width (object
+    /// space), scaled to world area.
+    fn area(&self) -> f32 {
+        let cp = self.control_points();
+        let len: f32 = (0..3).map(|i| cp[i].distance(cp[i + 1])).sum();
+        let w = 0.5 * (self.common.width_at(self.u_min) + self.common.width_at(self.u_max));
+        self.common.placement.world_area((len * w) as f64)
+    }
+
+    /// Closest hit with 0 < t ≤ t_max (world ray; `t` is the same in object
+    /// space).
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (o, d) = self.common.placement.ray_to_object(o, d);
+        let (o, d) = (o.as_vec3(), d.as_vec3());
+        let ray_len = d.length();
+        if !(ray_len > 0.0 && ray_len.is_finite()) {
+            return None;
+        }
+        let dir = d / ray_len;
+        let cp_obj = self.control_points();
+        // The frame's "up" is along the chord, so the projected curve lies
+        // roughly along x and its boxes are thin in y.
+        let mut up = dir.cross(cp_obj[3] - cp_obj[0]);
+        if up.length_squared() == 0.0 {
+            up = coordinate_system(dir).0;
+        }
+        let right = up.normalize().cross(dir);
+        if right.length_squared().is_nan() || right.length_squared() <= 0.0 || !right.is_finite() {
+            return None;
+        }
+        let right = right.normalize();
+        let new_up = dir.cross(right);
+        let to_ray = |p: Vec3| {
+            let q = p - o;
+            Vec3::new(q.dot(right), q.dot(new_up), q.dot(dir))
+        };
+        let cp = cp_obj.map(to_ray);
+        let z_max = ray_len * t_max;
+        if !overlaps(&cp, self.max_width(), z_max) {
+            return None;
+        }
+        // Subdivision depth from the curve's second differences (pbrt-v3's
+        // bound for a flatness within width / 20).
+        let mut l0 = 0.0f32;
+        for i in 0..2 {
+            let dd = (cp[i] - 2.0 * cp[i + 1] + cp[i + 2]).abs();
+            l0 = l0.max(dd.x.max(dd.y).max(dd.z));
+        }
+        let eps = self.common.width[0].max(self.common.width[1]) * 0.05;
+        let depth =
+            (log2_round(std::f32::consts::SQRT_2 * 6.0 * l0 / (8.0 * eps)) / 2).clamp(0, 10);
+        let mut best: Option<(f32, Leaf)> = None;
+        let mut z_best = z_max;
+        self.recurse(
+            &cp,
+            self.u_min,
+            self.u_max,
+            depth,
+            dir,
+            &mut z_best,
+            &mut best,
+        );
+        let (z, leaf) = best?;
+        let t = z / ray_len;
+        let p = o + d * t;
+        let c = &self.common;
+        let dpdu = bezier_derivative(&c.cp, leaf.u);
+        let dpdv = match c.kind {
+            CurveKind::Ribbon => leaf.n_ribbon.cross(dpdu).normalize() * leaf.width,
+            CurveKind::Flat | CurveKind::Cylinder => {
+                // Across the curve in the plane facing the ray.
+                let flat = dir.cross(dpdu).normalize() * leaf.width;
+                if c.kind == CurveKind::Flat {
+                    flat
+                } else {
+                    let theta = lerp(leaf.v, -90.0f32, 90.0).to_radians();
+                    rotate(flat, dpdu.normalize(), -theta)
                 }
             }
+        };
+        let dpdv = if dpdv.is_finite() && dpdv.length_squared() > 0.0 {
+            dpdv
+        } else {
+            coordinate_system(dpdu.normalize()).0 * leaf.width
+        };
+        if !(t.is_finite() && p.is_finite() && dpdv.is_finite()) {
+            return None;
         }
+        Some((
+            t,
+            AnalyticHit::Curve(CurveHit {
+                p,
+                err: 2.0 * leaf.width,
+                uv: Vec2::new(leaf.u, leaf.v),
+                dpdv,
+            }),
+        ))
     }
+
+    /// World point, error bound and oriented normal n̂(dp/du × dp/dv).
     #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        match h {
-            QuadricHit::Curve(h) => self.diff_geom(h),
-            _ => DiffGeom::ZERO,
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        let AnalyticHit::Curve(h) = h else {
+            return not_a_curve_hit(h);
+        };
+        let dpdu = bezier_derivative(&self.common.cp, h.uv.x);
+        let mut n = dpdu.cross(h.dpdv).as_dvec3();
+        if n.length_squared().is_nan() || n.length_squared() <= 0.0 {
+            n = coordinate_system(h.dpdv.normalize()).0.as_dvec3();
+        }
+        self.common
+            .placement
+            .surface_point(h.p.as_dvec3(), n, DVec3::splat(h.err as f64))
+    }
+
+    /// uv and the tangents in world space; curves have no normal derivatives.
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        let AnalyticHit::Curve(h) = h else {
+            return DiffGeom::ZERO;
+        };
+        let pl = &self.common.placement;
+        let dpdu = pl.vector(bezier_derivative(&self.common.cp, h.uv.x).as_dvec3());
+        let dpdv = pl.vector(h.dpdv.as_dvec3());
+        DiffGeom {
+            uv: h.uv,
+            dpdu,
+            dpdv,
+            shading_dpdu: dpdu,
+            shading_dpdv: dpdv,
+            ..DiffGeom::ZERO
         }
     }
+
     /// Never a light (the scene leaves curves' emission out).
-    fn area_sample(&self, _: Vec2) -> Option<ShapeSample> {
+    fn sample_area(&self, _: Vec2) -> Option<ShapeSample> {
         None
     }
-    fn sample_toward(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec2) -> Option<ShapeSample> {
+
+    fn sample_from(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec2) -> Option<ShapeSample> {
         None
     }
-    fn pdf_toward(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec3) -> f32 {
+
+    fn pdf_from(&self, _: Vec3, _: Vec3, _: Vec3, _: Vec3) -> f32 {
         0.0
+    }
+}
+
+/// The point of a hit that is not a curve's (never reached: a curve's hits
+/// are curve hits).
+#[cold]
+fn not_a_curve_hit(h: AnalyticHit) -> SurfacePoint {
+    let (p, err) = h.point_and_error();
+    SurfacePoint {
+        p: p.as_vec3(),
+        p_error: err.as_vec3(),
+        n: Vec3::Z,
+        ns: Vec3::Z,
     }
 }

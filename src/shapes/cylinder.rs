@@ -14,9 +14,13 @@
 //! sampling is pbrt-v3's `Cylinder::Sample` (uniform in z and φ), density
 //! 1/(world area) (pbrt-v3 uses the object-space area).
 
-use super::quadric::{Analytic, QuadricHit};
-use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use super::analytic::{phi_of, Analytic, AnalyticHit, Placed};
+use super::{at_origin, ShapeInput, ShapeKind, Surface, PHIMAX};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::{gamma, Bounds3};
 use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::f64::consts::TAU;
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float("radius", 1.0, "radius (> 0)"),
@@ -36,7 +40,7 @@ pub const KIND: ShapeKind = ShapeKind {
 
 /// pbrt-v3's checks: a positive radius and finite ends (error), a
 /// non-empty extent (warning, skipped).
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let radius = p.float("radius");
     let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
     let phimax = p.float("phimax").clamp(0.0, 360.0);
@@ -63,104 +67,78 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    at_origin(Cylinder::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+    at_origin(Cylinder::new(Placed::origin((radius, z0, z1, phimax))))
 }
-
-use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::geometry::{gamma, Bounds3};
-use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
-use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Cylinder {
-    /// The arguments of [`Cylinder::new`] but the placement: the shape as its
-    /// kind built it, placed again by [`Analytic::placed`].
-    pub args: (f32, f32, f32, f32),
+    /// Its parameters, placement, material and area light.
+    pub at: Placed<(f32, f32, f32, f32)>,
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
     /// Radians.
     pub phi_max: f64,
-    pub object_to_world: DMat4,
-    pub world_to_object: DMat4,
-    normal_matrix: DMat3,
-    det_abs: f64,
-    pub flip_normal: bool,
-    pub material: u32,
-    pub light: Option<u32>,
     area: f32,
 }
 
 impl Cylinder {
-    pub fn new(
-        radius: f32,
-        z_min: f32,
-        z_max: f32,
-        phi_max_deg: f32,
-        object_to_world: DMat4,
-        reverse: bool,
-        material: u32,
-    ) -> Cylinder {
+    pub fn new(at: Placed<(f32, f32, f32, f32)>) -> Cylinder {
+        let (radius, z_min, z_max, phi_max_deg) = at.args;
         let r = radius.abs() as f64;
         let (zmin, zmax) = (z_min.min(z_max) as f64, z_min.max(z_max) as f64);
         let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
-        let lin = DMat3::from_mat4(object_to_world);
-        let det = lin.determinant();
+        let place = &at.place;
         // World area: exact for similarities, a volume-based estimate
         // otherwise (only light power reads it then; the density is exact).
-        let scale2 = det.abs().powf(2.0 / 3.0);
+        let scale2 = place.det_abs.powf(2.0 / 3.0);
         Cylinder {
-            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: zmin,
             z_max: zmax,
             phi_max,
-            object_to_world,
-            world_to_object: object_to_world.inverse(),
-            normal_matrix: lin.inverse().transpose(),
-            det_abs: det.abs(),
-            flip_normal: reverse ^ (det < 0.0),
-            material,
-            light: None,
             area: ((zmax - zmin) * r * phi_max * scale2) as f32,
+            at,
         }
     }
 
-    pub fn area(&self) -> f32 {
-        self.area
+    /// World-space surface point for an object-space point on the tube,
+    /// with pbrt-v3's object-space error bound γ3·|(x, y, 0)|.
+    fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
+        let obj_err = DVec3::new(p_obj.x.abs(), p_obj.y.abs(), 0.0) * gamma(3) as f64;
+        let n = self.at.place.normal(DVec3::new(p_obj.x, p_obj.y, 0.0));
+        self.at.place.exact_point(p_obj, obj_err, n)
+    }
+}
+
+impl Analytic for Cylinder {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        Cylinder::new(self.at.again(to_world, reverse, material))
     }
 
-    pub fn is_valid(&self) -> bool {
-        self.world_to_object.is_finite()
+    fn is_valid(&self) -> bool {
+        self.at.place.world_to_object.is_finite()
             && self.radius > 0.0
             && self.z_max > self.z_min
             && self.area > 0.0
             && self.area.is_finite()
     }
 
-    pub fn bounds(&self) -> Bounds3 {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn bounds(&self) -> Bounds3 {
         let r = self.radius;
-        let mut b = Bounds3::EMPTY;
-        for i in 0..8 {
-            let c = DVec3::new(
-                if i & 1 == 0 { -r } else { r },
-                if i & 2 == 0 { -r } else { r },
-                if i & 4 == 0 { self.z_min } else { self.z_max },
-            );
-            b = b.union_point(self.object_to_world.transform_point3(c).as_vec3());
-        }
-        let pad = (b.max.abs().max(b.min.abs())) * 4.0 * f32::EPSILON;
-        Bounds3 {
-            min: b.min - pad,
-            max: b.max + pad,
-        }
+        self.at
+            .place
+            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
     }
 
     /// Closest hit with 0 < t < t_max (pbrt-v3's `Cylinder::Intersect`).
     #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, DVec3)> {
-        let oo = self.world_to_object.transform_point3(o.as_dvec3());
-        let od = self.world_to_object.transform_vector3(d.as_dvec3());
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (oo, od) = self.at.place.ray_to_object(o, d);
         let a = od.x * od.x + od.y * od.y;
         if a == 0.0 {
             return None;
@@ -200,46 +178,27 @@ impl Cylinder {
             if self.phi_max < TAU && phi_of(p) > self.phi_max {
                 continue;
             }
-            return Some((t as f32, p));
+            return Some((t as f32, AnalyticHit::Exact(p)));
         }
         None
     }
 
-    pub fn surface_point(&self, p_obj: DVec3) -> SurfacePoint {
-        let pw = self.object_to_world.transform_point3(p_obj);
-        let p = pw.as_vec3();
-        let obj_err = DVec3::new(p_obj.x.abs(), p_obj.y.abs(), 0.0) * gamma(3) as f64;
-        let lin = DMat3::from_mat4(self.object_to_world);
-        let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
-        let err = abs_lin * obj_err
-            + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
-                * gamma(3) as f64;
-        let mut n = (self.normal_matrix * DVec3::new(p_obj.x, p_obj.y, 0.0))
-            .normalize()
-            .as_vec3();
-        if self.flip_normal {
-            n = -n;
-        }
-        SurfacePoint {
-            p,
-            p_error: err.as_vec3() + p.abs() * f32::EPSILON,
-            n,
-            ns: n,
-        }
+    #[inline]
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        self.point_at(h.point_and_error().0)
     }
 
     /// u = φ/φmax, v = (z − zmin)/(zmax − zmin); the Weingarten equations
     /// for a tube give dn/du = dp/du / radius and dn/dv = 0.
-    pub fn diff_geom(&self, p_obj: DVec3) -> DiffGeom {
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        let p_obj = h.point_and_error().0;
         let u = phi_of(p_obj) / self.phi_max;
         let v = (p_obj.z - self.z_min) / (self.z_max - self.z_min);
         let dpdu = DVec3::new(-self.phi_max * p_obj.y, self.phi_max * p_obj.x, 0.0);
         let dpdv = DVec3::new(0.0, 0.0, self.z_max - self.z_min);
-        let dndu_obj = dpdu / self.radius;
-        let lin = DMat3::from_mat4(self.object_to_world);
-        let (dpdu, dpdv) = ((lin * dpdu).as_vec3(), (lin * dpdv).as_vec3());
-        let dndu = (self.normal_matrix * dndu_obj).as_vec3();
-        let dndu = if dndu.is_finite() { dndu } else { Vec3::ZERO };
+        let dndu = self.at.place.normal_derivative(dpdu / self.radius);
+        let (dpdu, dpdv) = (self.at.place.vector(dpdu), self.at.place.vector(dpdv));
         DiffGeom {
             uv: Vec2::new(u as f32, v as f32),
             dpdu,
@@ -252,61 +211,23 @@ impl Cylinder {
         }
     }
 
+    /// dA_world / dA_obj = |det M| · |M^-T n_obj|.
+    #[inline]
+    fn area_density(&self, p_obj: DVec3) -> f32 {
+        let n_obj = DVec3::new(p_obj.x, p_obj.y, 0.0) / self.radius;
+        let obj_area = (self.z_max - self.z_min) * self.radius * self.phi_max;
+        let pl = &self.at.place;
+        (1.0 / (obj_area * pl.det_abs * (pl.normal_matrix * n_obj).length())) as f32
+    }
+
     /// Uniform in z and φ over the tube; density 1 / world area at the point.
-    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let z = self.z_min + (self.z_max - self.z_min) * u.x as f64;
         let phi = self.phi_max * u.y as f64;
         let p_obj = DVec3::new(self.radius * phi.cos(), self.radius * phi.sin(), z);
-        ShapeSample {
-            point: self.surface_point(p_obj),
+        Some(ShapeSample {
+            point: self.point_at(p_obj),
             pdf: self.area_density(p_obj),
-        }
-    }
-
-    /// dA_world / dA_obj = |det M| · |M^-T n_obj|.
-    #[inline]
-    pub fn area_density(&self, p_obj: DVec3) -> f32 {
-        let n_obj = DVec3::new(p_obj.x, p_obj.y, 0.0) / self.radius;
-        let obj_area = (self.z_max - self.z_min) * self.radius * self.phi_max;
-        (1.0 / (obj_area * self.det_abs * (self.normal_matrix * n_obj).length())) as f32
-    }
-}
-
-#[inline]
-fn phi_of(p: DVec3) -> f64 {
-    let phi = p.y.atan2(p.x);
-    if phi < 0.0 {
-        phi + TAU
-    } else {
-        phi
-    }
-}
-
-impl Analytic for Cylinder {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Cylinder::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.is_valid()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p)| (t, QuadricHit::Exact(p)))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        self.surface_point(h.point_and_error().0)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
-    }
-    fn density_at(&self, p_obj: DVec3) -> f32 {
-        self.area_density(p_obj)
+        })
     }
 }

@@ -21,9 +21,14 @@
 //! match. Unlike pbrt-v3, the area is the world area (the transform's
 //! Jacobian is constant for a plane), so scaled disk lights are unbiased.
 
-use super::quadric::{Analytic, QuadricHit};
-use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use super::analytic::{phi_of, Analytic, AnalyticHit, Placed};
+use super::{at_origin, ShapeInput, ShapeKind, Surface, PHIMAX};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::{offset_ray_origin, Bounds3};
+use crate::sampling::concentric_sample_disk;
 use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::f64::consts::TAU;
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float("height", 0.0, "z of its plane"),
@@ -47,7 +52,7 @@ pub const KIND: ShapeKind = ShapeKind {
 
 /// pbrt-v3's checks: a positive radius (error), a negative inner radius is
 /// 0 (warning), an empty annulus or sector is skipped (warning).
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let height = p.float("height");
     let radius = p.float("radius");
     let mut inner = p.float("innerradius");
@@ -81,116 +86,85 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    at_origin(Disk::new(height, radius, inner, phimax, ORIGIN, false, 0))
+    at_origin(Disk::new(Placed::origin((height, radius, inner, phimax))))
 }
-
-use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::geometry::{gamma, offset_ray_origin, Bounds3};
-use crate::sampling::concentric_sample_disk;
-use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
-use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Disk {
-    /// The arguments of [`Disk::new`] but the placement: the shape as its
-    /// kind built it, placed again by [`Analytic::placed`].
-    pub args: (f32, f32, f32, f32),
+    /// Its parameters, placement, material and area light.
+    pub at: Placed<(f32, f32, f32, f32)>,
     pub height: f64,
     pub radius: f64,
     pub inner_radius: f64,
     /// Radians.
     pub phi_max: f64,
-    pub object_to_world: DMat4,
-    pub world_to_object: DMat4,
     /// Oriented world-space unit normal (constant over the disk).
     n: Vec3,
-    pub flip_normal: bool,
-    pub material: u32,
-    pub light: Option<u32>,
     /// World area of the partial disk.
     area: f32,
 }
 
 impl Disk {
     /// `inner_radius` must be in [0, radius); the loader checks it.
-    pub fn new(
-        height: f32,
-        radius: f32,
-        inner_radius: f32,
-        phi_max_deg: f32,
-        object_to_world: DMat4,
-        reverse: bool,
-        material: u32,
-    ) -> Disk {
+    pub fn new(at: Placed<(f32, f32, f32, f32)>) -> Disk {
+        let (height, radius, inner_radius, phi_max_deg) = at.args;
         let r = radius.abs() as f64;
         let ri = (inner_radius as f64).clamp(0.0, r);
         let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
-        let lin = DMat3::from_mat4(object_to_world);
-        let det = lin.determinant();
-        let normal_matrix = lin.inverse().transpose();
-        let flip_normal = reverse ^ (det < 0.0);
-        let mut n = (normal_matrix * DVec3::Z).normalize().as_vec3();
-        if flip_normal {
-            n = -n;
-        }
-        // dA_world / dA_obj = |det M| · |M^-T z|, the same everywhere on a plane.
-        let jacobian = det.abs() * (normal_matrix * DVec3::Z).length();
+        let place = &at.place;
+        // dA_world / dA_obj, the same everywhere on a plane.
+        let jacobian = place.area_scale(DVec3::Z);
         let obj_area = 0.5 * phi_max * (r * r - ri * ri);
         Disk {
-            args: (height, radius, inner_radius, phi_max_deg),
             height: height as f64,
             radius: r,
             inner_radius: ri,
             phi_max,
-            object_to_world,
-            world_to_object: object_to_world.inverse(),
-            n,
-            flip_normal,
-            material,
-            light: None,
+            n: place.normal(DVec3::Z),
             area: (obj_area * jacobian) as f32,
+            at,
         }
     }
 
-    pub fn area(&self) -> f32 {
-        self.area
+    /// World-space surface point for an object-space point on the disk:
+    /// zero object-space error (z is exact; x, y are f64).
+    fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
+        self.at.place.exact_point(p_obj, DVec3::ZERO, self.n)
+    }
+}
+
+impl Analytic for Disk {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        Disk::new(self.at.again(to_world, reverse, material))
     }
 
     /// False for singular transforms and empty disks: left out of the scene.
-    pub fn is_valid(&self) -> bool {
-        self.world_to_object.is_finite()
+    fn is_valid(&self) -> bool {
+        self.at.place.world_to_object.is_finite()
             && self.radius > 0.0
             && self.area > 0.0
             && self.area.is_finite()
             && self.n.is_finite()
     }
 
-    pub fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
-        let mut b = Bounds3::EMPTY;
-        for i in 0..4 {
-            let c = DVec3::new(
-                if i & 1 == 0 { -r } else { r },
-                if i & 2 == 0 { -r } else { r },
-                self.height,
-            );
-            b = b.union_point(self.object_to_world.transform_point3(c).as_vec3());
-        }
-        // A few ulps of padding keep the f32 corners conservative (and give
-        // an axis-aligned disk's box some thickness).
-        let pad = (b.max.abs().max(b.min.abs())) * 4.0 * f32::EPSILON;
-        Bounds3 {
-            min: b.min - pad,
-            max: b.max + pad,
-        }
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// The padding of [`Placement::bounds`] also gives an axis-aligned
+    /// disk's box some thickness.
+    fn bounds(&self) -> Bounds3 {
+        let (r, h) = (self.radius, self.height);
+        self.at
+            .place
+            .bounds(DVec3::new(-r, -r, h), DVec3::new(r, r, h))
     }
 
     /// Closest hit with 0 < t < t_max (pbrt-v3's `Disk::Intersect`): t and
     /// the object-space point, on the plane exactly.
     #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, DVec3)> {
-        let oo = self.world_to_object.transform_point3(o.as_dvec3());
-        let od = self.world_to_object.transform_vector3(d.as_dvec3());
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (oo, od) = self.at.place.ray_to_object(o, d);
         if od.z == 0.0 {
             return None;
         }
@@ -207,30 +181,22 @@ impl Disk {
         if self.phi_max < TAU && phi_of(p) > self.phi_max {
             return None;
         }
-        Some((t as f32, DVec3::new(p.x, p.y, self.height)))
+        Some((
+            t as f32,
+            AnalyticHit::Exact(DVec3::new(p.x, p.y, self.height)),
+        ))
     }
 
-    /// World-space surface point for an object-space point on the disk.
-    pub fn surface_point(&self, p_obj: DVec3) -> SurfacePoint {
-        let pw = self.object_to_world.transform_point3(p_obj);
-        let p = pw.as_vec3();
-        // Zero object-space error (z is exact; x, y are f64): the transform's
-        // rounding as pbrt-v3 bounds it, plus the final rounding to f32.
-        let lin = DMat3::from_mat4(self.object_to_world);
-        let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
-        let err = (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
-            * gamma(3) as f64;
-        SurfacePoint {
-            p,
-            p_error: err.as_vec3() + p.abs() * f32::EPSILON,
-            n: self.n,
-            ns: self.n,
-        }
+    #[inline]
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        self.point_at(h.point_and_error().0)
     }
 
     /// pbrt-v3's parameterisation: u = φ/φmax, v = (radius − r)/(radius −
     /// innerradius); the normal does not change over the plane.
-    pub fn diff_geom(&self, p_obj: DVec3) -> DiffGeom {
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        let p_obj = h.point_and_error().0;
         let r_hit = (p_obj.x * p_obj.x + p_obj.y * p_obj.y).sqrt();
         let phi = phi_of(p_obj);
         let u = phi / self.phi_max;
@@ -243,8 +209,7 @@ impl Disk {
             DVec3::X
         };
         let dpdv = (self.inner_radius - self.radius) * radial;
-        let lin = DMat3::from_mat4(self.object_to_world);
-        let (dpdu, dpdv) = ((lin * dpdu).as_vec3(), (lin * dpdv).as_vec3());
+        let (dpdu, dpdv) = (self.at.place.vector(dpdu), self.at.place.vector(dpdv));
         DiffGeom {
             uv: Vec2::new(u as f32, v as f32),
             dpdu,
@@ -257,74 +222,29 @@ impl Disk {
 
     /// pbrt-v3's `Disk::Sample(u)`: concentric over the whole disk, density
     /// 1 / area (see the module notes for partial disks).
-    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let pd = concentric_sample_disk(u).as_dvec2() * self.radius;
         let p_obj = DVec3::new(pd.x, pd.y, self.height);
-        ShapeSample {
-            point: self.surface_point(p_obj),
+        Some(ShapeSample {
+            point: self.point_at(p_obj),
             pdf: 1.0 / self.area,
-        }
-    }
-
-    /// A point sampled by area, its density converted to solid angle at `p`.
-    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
-        super::to_solid_angle(p, self.sample_area(u))
+        })
     }
 
     /// pbrt-v3's `Shape::Pdf(ref, wi)`: the area density at the first hit
     /// of the ray spawned along `wi`, by solid angle.
-    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+    #[inline]
+    fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
         let o = offset_ray_origin(p, p_error, n, wi);
-        let Some((_, p_obj)) = self.intersect(o, wi, f32::INFINITY) else {
+        let Some((_, hit)) = self.intersect(o, wi, f32::INFINITY) else {
             return 0.0;
         };
-        let h = self.surface_point(p_obj);
+        let h = self.surface_point(hit);
         let pdf = h.p.distance_squared(p) / (self.area * h.n.dot(wi).abs());
         if pdf.is_finite() {
             pdf
         } else {
             0.0
         }
-    }
-}
-
-/// φ in [0, 2π) of an object-space point.
-#[inline]
-fn phi_of(p: DVec3) -> f64 {
-    let phi = p.y.atan2(p.x);
-    if phi < 0.0 {
-        phi + TAU
-    } else {
-        phi
-    }
-}
-
-impl Analytic for Disk {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Disk::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.is_valid()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p)| (t, QuadricHit::Exact(p)))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        self.surface_point(h.point_and_error().0)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
-    }
-    #[inline]
-    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-        self.pdf_from(p, p_error, n, wi)
     }
 }

@@ -5,7 +5,7 @@
 //! per statement, which then takes the triangle-mesh path. pbrt-v3 gives
 //! such meshes no `alpha`/`shadowalpha`, and neither does pbrs.
 
-use super::{Geometry, ShapeKind};
+use super::{ShapeKind, Surface};
 use crate::scene::{Elem, ParamSpec, Support};
 use std::sync::Arc;
 
@@ -23,6 +23,6 @@ pub const KIND: ShapeKind = ShapeKind {
     doc: "a height field over the unit square, refined to a triangle mesh. Refined at load as pbrt-v3 (`src/loader/refine/heightfield.rs`): vertex (i, j) at (i/(nu−1), j/(nv−1), Pz), the same uv, two triangles per cell, no normals. nu or nv < 2, wrong Pz count, non-finite height: error",
     build: |_, r| {
         r.refine(KIND.name)
-            .map(|m| Geometry::TriangleMesh(Arc::new(m)))
+            .map(|m| Surface::TriangleMesh(Arc::new(m)))
     },
 };

@@ -24,9 +24,14 @@
 //! `p2` only). pbrt-v3 cannot sample hyperboloids; a hyperboloid area light is
 //! a pbrs extension: uniform in z and φ, with its exact world-area density.
 
-use super::quadric::{Analytic, QuadricHit};
-use super::{at_origin, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use super::analytic::{pbrt_closest, Analytic, AnalyticHit, Placed};
+use super::{at_origin, phi_max, ShapeInput, ShapeKind, Surface, PHIMAX};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::efloat::{quadratic, transform_ray, EFloat};
+use crate::geometry::{gamma, Bounds3};
 use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::f64::consts::TAU;
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::point3("p1", [0.0, 0.0, 0.0], "a point of the line swept about z"),
@@ -47,7 +52,7 @@ pub const KIND: ShapeKind = ShapeKind {
 /// line that misses the z axis, and the fitted surface has points at every
 /// height between them (errors otherwise: pbrt-v3 divides by zero, loops
 /// forever or makes NaNs).
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let (p1, p2) = (p.point("p1"), p.point("p2"));
     let at = Some("p1");
     if !(p1.as_vec3().is_finite() && p2.as_vec3().is_finite()) {
@@ -81,21 +86,13 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         return None;
     }
     let phimax = phi_max("hyperboloid", p, r)?;
-    at_origin(Hyperboloid::new(p1, p2, phimax, ORIGIN, false, 0))
+    at_origin(Hyperboloid::new(Placed::origin((p1, p2, phimax))))
 }
-
-use super::quadric::{pbrt_closest, Placement};
-use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::geometry::efloat::{quadratic, transform_ray, EFloat};
-use crate::geometry::{gamma, Bounds3};
-use glam::{DMat4, DVec3, Vec2, Vec3};
-use std::f64::consts::TAU;
 
 #[derive(Clone, Debug)]
 pub struct Hyperboloid {
-    /// The arguments of [`Hyperboloid::new`] but the placement: the shape as its
-    /// kind built it, placed again by [`Analytic::placed`].
-    pub args: (Vec3, Vec3, f32),
+    /// Its parameters, placement, material and area light.
+    pub at: Placed<(Vec3, Vec3, f32)>,
     pub p1: DVec3,
     pub p2: DVec3,
     pub z_min: f64,
@@ -106,9 +103,6 @@ pub struct Hyperboloid {
     pub a: f64,
     pub c: f64,
     r_max: f64,
-    pub place: Placement,
-    pub material: u32,
-    pub light: Option<u32>,
     obj_area: f64,
     area: f32,
 }
@@ -147,15 +141,8 @@ pub fn hyperboloid_coefficients(p1: DVec3, p2: DVec3) -> Option<(f64, f64)> {
 impl Hyperboloid {
     /// The loader checks `hyperboloid_coefficients` and the radius over the
     /// z range first.
-    pub fn new(
-        p1: Vec3,
-        p2: Vec3,
-        phi_max_deg: f32,
-        object_to_world: DMat4,
-        reverse: bool,
-        material: u32,
-    ) -> Hyperboloid {
-        let args = (p1, p2, phi_max_deg);
+    pub fn new(at: Placed<(Vec3, Vec3, f32)>) -> Hyperboloid {
+        let (p1, p2, phi_max_deg) = at.args;
         let (mut p1, mut p2) = (p1.as_dvec3(), p2.as_dvec3());
         let (a, c) = hyperboloid_coefficients(p1, p2).unwrap_or((f64::NAN, f64::NAN));
         // pbrt-v3 swaps its points for the fit, and keeps them swapped (v
@@ -170,9 +157,7 @@ impl Hyperboloid {
         if z_min < 0.0 && z_max > 0.0 {
             r2 = r2.max(rho2(0.0));
         }
-        let place = Placement::new(object_to_world, reverse);
         let mut h = Hyperboloid {
-            args,
             p1,
             p2,
             z_min,
@@ -181,14 +166,12 @@ impl Hyperboloid {
             a,
             c,
             r_max: r2.sqrt(),
-            place,
-            material,
-            light: None,
             obj_area: 0.0,
             area: 0.0,
+            at,
         };
         h.obj_area = h.object_area();
-        h.area = h.place.world_area(h.obj_area);
+        h.area = h.at.place.world_area(h.obj_area);
         h
     }
 
@@ -217,26 +200,6 @@ impl Hyperboloid {
         self.phi_max * s * h / 3.0
     }
 
-    pub fn area(&self) -> f32 {
-        self.area
-    }
-
-    pub fn is_valid(&self) -> bool {
-        self.place.is_valid()
-            && self.a.is_finite()
-            && self.c.is_finite()
-            && self.z_max > self.z_min
-            && self.r_max.is_finite()
-            && self.area > 0.0
-            && self.area.is_finite()
-    }
-
-    pub fn bounds(&self) -> Bounds3 {
-        let r = self.r_max;
-        self.place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
-    }
-
     /// The line's point at height z (pbrt-v3's `pr`) and v.
     #[inline]
     fn line_at(&self, z: f64) -> (DVec3, f64) {
@@ -256,30 +219,6 @@ impl Hyperboloid {
         }
     }
 
-    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Hyperboloid::Intersect`
-    /// computes it (f32 with running error bounds).
-    #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, Vec3, Vec3)> {
-        let (o, d) = transform_ray(&self.place.world_to_object_f32, o, d);
-        let (ah, ch) = (self.a as f32, self.c as f32);
-        let [ox, oy, oz] = o;
-        let [dx, dy, dz] = d;
-        let a = ah * dx * dx + ah * dy * dy - ch * dz * dz;
-        let b = 2.0 * (ah * dx * ox + ah * dy * oy - ch * dz * oz);
-        let c = ah * ox * ox + ah * oy * oy - ch * oz * oz - EFloat::exact(1.0);
-        let (z0, z1, phi_max) = (self.z_min as f32, self.z_max as f32, self.phi_max as f32);
-        let (p1, p2) = (self.p1.as_vec3(), self.p2.as_vec3());
-        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
-            let v = (p.z - p1.z) / (p2.z - p1.z);
-            let pr = (1.0 - v) * p1 + v * p2;
-            let mut phi = (pr.x * p.y - p.x * pr.y).atan2(p.x * pr.x + p.y * pr.y);
-            if phi < 0.0 {
-                phi += std::f32::consts::TAU;
-            }
-            p.z < z0 || p.z > z1 || phi > phi_max
-        })
-    }
-
     /// The object normal ∂p/∂u × ∂p/∂v, as pbrt-v3 orients it.
     #[inline]
     fn normal_obj(&self, p: DVec3) -> DVec3 {
@@ -297,69 +236,102 @@ impl Hyperboloid {
         (dpdu, dpdv)
     }
 
-    pub fn surface_point(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
-        self.place.surface_point(p_obj, self.normal_obj(p_obj), err)
+    fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
+        self.at
+            .place
+            .surface_point(p_obj, self.normal_obj(p_obj), err)
+    }
+}
+
+impl Analytic for Hyperboloid {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        Hyperboloid::new(self.at.again(to_world, reverse, material))
     }
 
-    pub fn diff_geom(&self, p: DVec3) -> DiffGeom {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn is_valid(&self) -> bool {
+        self.at.place.is_valid()
+            && self.a.is_finite()
+            && self.c.is_finite()
+            && self.z_max > self.z_min
+            && self.r_max.is_finite()
+            && self.area > 0.0
+            && self.area.is_finite()
+    }
+
+    fn bounds(&self) -> Bounds3 {
+        let r = self.r_max;
+        self.at
+            .place
+            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+    }
+
+    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Hyperboloid::Intersect`
+    /// computes it (f32 with running error bounds).
+    #[inline]
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (o, d) = transform_ray(&self.at.place.world_to_object_f32, o, d);
+        let (ah, ch) = (self.a as f32, self.c as f32);
+        let [ox, oy, oz] = o;
+        let [dx, dy, dz] = d;
+        let a = ah * dx * dx + ah * dy * dy - ch * dz * dz;
+        let b = 2.0 * (ah * dx * ox + ah * dy * oy - ch * dz * oz);
+        let c = ah * ox * ox + ah * oy * oy - ch * oz * oz - EFloat::exact(1.0);
+        let (z0, z1, phi_max) = (self.z_min as f32, self.z_max as f32, self.phi_max as f32);
+        let (p1, p2) = (self.p1.as_vec3(), self.p2.as_vec3());
+        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
+            let v = (p.z - p1.z) / (p2.z - p1.z);
+            let pr = (1.0 - v) * p1 + v * p2;
+            let mut phi = (pr.x * p.y - p.x * pr.y).atan2(p.x * pr.x + p.y * pr.y);
+            if phi < 0.0 {
+                phi += std::f32::consts::TAU;
+            }
+            p.z < z0 || p.z > z1 || phi > phi_max
+        })
+        .map(|(t, p, err)| (t, AnalyticHit::Bounded { p, err }))
+    }
+
+    #[inline]
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.point_at(p, err)
+    }
+
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        let p = h.point_and_error().0;
         let pm = self.phi_max;
         let u = self.phi(p) / pm;
         let (_, v) = self.line_at(p.z);
         let (dpdu, dpdv) = self.tangents(p);
         let d2uu = -pm * pm * DVec3::new(p.x, p.y, 0.0);
         let d2uv = pm * DVec3::new(-dpdv.y, dpdv.x, 0.0);
-        self.place
+        self.at
+            .place
             .diff_geom((u, v), dpdu, dpdv, [d2uu, d2uv, DVec3::ZERO])
     }
 
     /// Density by world area of uniform (z, φ) sampling at an object point.
     #[inline]
-    pub fn area_density(&self, p_obj: DVec3) -> f32 {
+    fn area_density(&self, p_obj: DVec3) -> f32 {
         let per_obj_area =
             1.0 / (self.phi_max * (self.z_max - self.z_min) * self.area_element(p_obj.z));
-        (per_obj_area / self.place.area_scale(self.normal_obj(p_obj))) as f32
+        (per_obj_area / self.at.place.area_scale(self.normal_obj(p_obj))) as f32
     }
 
     /// Uniform in z and in φ from the line's point at that height.
-    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let z = self.z_min + (self.z_max - self.z_min) * u.x as f64;
         let (pr, _) = self.line_at(z);
         let phi = pr.y.atan2(pr.x) + self.phi_max * u.y as f64;
         let rho = self.rho2(z).max(0.0).sqrt();
         let p_obj = DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
-        ShapeSample {
-            point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
+        Some(ShapeSample {
+            point: self.point_at(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
-        }
-    }
-}
-
-impl Analytic for Hyperboloid {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Hyperboloid::new(a.0, a.1, a.2, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.is_valid()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        let (p, err) = h.point_and_error();
-        self.surface_point(p, err)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn density_at(&self, p_obj: DVec3) -> f32 {
-        self.area_density(p_obj)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
+        })
     }
 }

@@ -5,7 +5,7 @@
 //! per statement, which then takes the triangle-mesh path. pbrt-v3 gives
 //! such meshes no `alpha`/`shadowalpha`, and neither does pbrs.
 
-use super::{Geometry, ShapeKind};
+use super::{ShapeKind, Surface};
 use crate::scene::{Elem, ParamSpec, Support};
 use std::sync::Arc;
 
@@ -33,6 +33,6 @@ pub const KIND: ShapeKind = ShapeKind {
     doc: "a Loop subdivision surface, refined to a triangle mesh. Refined at load into a triangle mesh as pbrt-v3 (`src/loader/refine/loopsubdiv.rs`): Loop's even/odd and boundary rules, limit positions and pbrt-v3's limit normals, no uv. Index count not a multiple of 3, an index out of range, a face repeating a vertex, neighbouring faces not consistently oriented, a non-finite position, more than 2²² vertices after refinement: error. `levels` above 11: warning, capped. Vertices in no face: warning, left out",
     build: |_, r| {
         r.refine(KIND.name)
-            .map(|m| Geometry::TriangleMesh(Arc::new(m)))
+            .map(|m| Surface::TriangleMesh(Arc::new(m)))
     },
 };

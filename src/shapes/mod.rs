@@ -2,14 +2,20 @@
 //! each opening with its parameters and pbrt-v3's checks of them, and one
 //! table, [`SHAPES`], that the loader (parsing, "did you mean"), `--check`,
 //! `grammar/REFERENCE.md` and the tests read. A kind's builder makes the
-//! scene description's [`Geometry`] (object space); the render core places
-//! it in world space: triangle meshes, and the analytic shapes (quadrics and
-//! curve pieces) with intersection, surface interactions carrying error
-//! bounds, and sampling for area lights.
+//! scene description's [`Surface`] (object space); the render core places
+//! it in world space: triangle meshes, and the analytic shapes
+//! ([`AnalyticShape`]: quadrics and curve pieces, each kind answering
+//! [`Analytic`] in its own file and placed by the shared [`Placement`]) with
+//! intersection, surface interactions carrying error bounds, and sampling
+//! for area lights.
+//!
+//! A new analytic kind is its file, its `mod` line and row in [`SHAPES`]
+//! here, and its row in `analytic.rs`'s enum.
 //!
 //! Files are read by the loader, not here: a builder asks for a mesh file
 //! (or a refined shape's mesh) through [`ShapeInput`].
 
+mod analytic;
 mod cone;
 mod curve;
 mod cylinder;
@@ -22,18 +28,17 @@ mod nurbs;
 mod objmesh;
 mod paraboloid;
 mod plymesh;
-mod quadric;
 mod sphere;
 mod triangle;
 mod trianglemesh;
 
+pub use analytic::{Analytic, AnalyticHit, AnalyticShape, Placed, Placement};
 pub use cone::Cone;
 pub use curve::{Curve, CurveCommon, CurveHit, CurveKind};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use hyperboloid::{hyperboloid_coefficients, Hyperboloid};
 pub use paraboloid::Paraboloid;
-pub use quadric::{Placement, Quadric, QuadricHit};
 pub use sphere::Sphere;
 pub use sphere::{area_to_solid_angle, to_solid_angle};
 pub use triangle::{
@@ -41,8 +46,8 @@ pub use triangle::{
     TrianglePack, TriangleRay, TriangleRay4,
 };
 
-pub use crate::scene::{Geometry, MeshData};
 use crate::scene::{Kind, ParamSpec, ParamValues, Report};
+pub use crate::scene::{MeshData, Surface};
 use std::sync::Arc;
 
 /// What a shape's builder needs from the loader besides its parameters:
@@ -79,7 +84,7 @@ impl MeshFormat {
 
 /// What a shape kind builds from its parameters (`None`: skipped, after a
 /// warning or an error).
-pub type ShapeBuild = fn(&ParamValues, &mut dyn ShapeInput) -> Option<Geometry>;
+pub type ShapeBuild = fn(&ParamValues, &mut dyn ShapeInput) -> Option<Surface>;
 
 /// One shape kind: its pbrt-v3 name, its parameters, its builder.
 pub type ShapeKind = Kind<ShapeBuild>;
@@ -103,22 +108,19 @@ pub static SHAPES: &[ShapeKind] = &[
     heightfield::KIND,
 ];
 
-/// The name of the kind that builds `g` (for `--stats`: the refined and
+/// The name of the kind that builds `s` (for `--stats`: the refined and
 /// mesh-file kinds are triangle meshes once built).
-pub fn kind_name(g: &Geometry) -> &'static str {
-    match g {
-        Geometry::TriangleMesh(_) => trianglemesh::KIND.name,
-        Geometry::Curve(_) => curve::KIND.name,
-        Geometry::Quadric(q) => q.kind_name(),
+pub fn kind_name(s: &Surface) -> &'static str {
+    match s {
+        Surface::TriangleMesh(_) => trianglemesh::KIND.name,
+        Surface::Curve(_) => curve::KIND.name,
+        Surface::Analytic(a) => a.kind_name(),
     }
 }
 
-/// The transform a quadric kind builds its shape with: its object space.
-const ORIGIN: glam::DMat4 = glam::DMat4::IDENTITY;
-
-/// A quadric built at the origin, as the scene description holds it.
-fn at_origin(q: impl Into<Quadric>) -> Option<Geometry> {
-    Some(Geometry::Quadric(q.into()))
+/// An analytic shape built at the origin, as the scene description holds it.
+fn at_origin(a: impl Into<AnalyticShape>) -> Option<Surface> {
+    Some(Surface::Analytic(a.into()))
 }
 
 /// `phimax`, a line of every quadric's table.
@@ -172,7 +174,7 @@ fn mesh_file(
     format: MeshFormat,
     p: &ParamValues,
     r: &mut dyn ShapeInput,
-) -> Option<Geometry> {
+) -> Option<Surface> {
     let file = p.string("filename");
     if file.is_empty() {
         r.error(
@@ -182,7 +184,7 @@ fn mesh_file(
         );
         return None;
     }
-    r.mesh_file(format, file).map(Geometry::TriangleMesh)
+    r.mesh_file(format, file).map(Surface::TriangleMesh)
 }
 
 use crate::geometry::RayDiff;

@@ -5,7 +5,7 @@
 //! per statement, which then takes the triangle-mesh path. pbrt-v3 gives
 //! such meshes no `alpha`/`shadowalpha`, and neither does pbrs.
 
-use super::{Geometry, ShapeKind};
+use super::{ShapeKind, Surface};
 use crate::scene::{Elem, ParamSpec, Support};
 use std::sync::Arc;
 
@@ -44,6 +44,6 @@ pub const KIND: ShapeKind = ShapeKind {
     doc: "a NURBS patch, refined to a triangle mesh. Refined at load as pbrt-v3 (`src/loader/refine/nurbs.rs`): a fixed 30×30 grid from (u0, v0) to (u1, v1), normals normalise(∂p/∂u × ∂p/∂v) (zero where that vanishes), uv = (u, v). Missing parameter, order outside 2…32, nu < order, wrong knot count, decreasing or non-finite knots, empty domain, u0…v1 outside it or u0 = u1, wrong point count, a weight ≤ 0: error. u0 > u1: warning, diced backwards as pbrt-v3",
     build: |_, r| {
         r.refine(KIND.name)
-            .map(|m| Geometry::TriangleMesh(Arc::new(m)))
+            .map(|m| Surface::TriangleMesh(Arc::new(m)))
     },
 };

@@ -18,9 +18,13 @@
 //! above z grows as (4cz + 1)^{3/2}, inverted in closed form), with the
 //! exact world-area density.
 
-use super::quadric::{Analytic, QuadricHit};
-use super::{at_origin, check_floats, phi_max, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use super::analytic::{pbrt_closest, phi_f32, phi_of, Analytic, AnalyticHit, Placed};
+use super::{at_origin, check_floats, phi_max, ShapeInput, ShapeKind, Surface, PHIMAX};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::efloat::{quadratic, transform_ray, EFloat};
+use crate::geometry::{gamma, Bounds3};
 use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float("radius", 1.0, "radius at zmax (> 0)"),
@@ -40,7 +44,7 @@ pub const KIND: ShapeKind = ShapeKind {
 
 /// pbrt-v3's checks: finite values, a positive radius and zmax (error); a
 /// zmin below the apex is 0 (warning); an empty extent is skipped.
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let radius = p.float("radius");
     let (zmin, zmax) = (p.float("zmin"), p.float("zmax"));
     let values = [
@@ -81,28 +85,18 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         return None;
     }
     let phimax = phi_max("paraboloid", p, r)?;
-    at_origin(Paraboloid::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+    at_origin(Paraboloid::new(Placed::origin((radius, z0, z1, phimax))))
 }
-
-use super::quadric::{pbrt_closest, phi_f32, phi_of, Placement};
-use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::geometry::efloat::{quadratic, transform_ray, EFloat};
-use crate::geometry::{gamma, Bounds3};
-use glam::{DMat4, DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Paraboloid {
-    /// The arguments of [`Paraboloid::new`] but the placement: the shape as its
-    /// kind built it, placed again by [`Analytic::placed`].
-    pub args: (f32, f32, f32, f32),
+    /// Its parameters, placement, material and area light.
+    pub at: Placed<(f32, f32, f32, f32)>,
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
     /// Radians.
     pub phi_max: f64,
-    pub place: Placement,
-    pub material: u32,
-    pub light: Option<u32>,
     /// (4c·zmin + 1)^{3/2} and (4c·zmax + 1)^{3/2}, c = zmax / radius².
     a_min: f64,
     a_max: f64,
@@ -112,19 +106,12 @@ pub struct Paraboloid {
 
 impl Paraboloid {
     /// The loader ensures 0 <= z_min < z_max and radius > 0.
-    pub fn new(
-        radius: f32,
-        z_min: f32,
-        z_max: f32,
-        phi_max_deg: f32,
-        object_to_world: DMat4,
-        reverse: bool,
-        material: u32,
-    ) -> Paraboloid {
+    pub fn new(at: Placed<(f32, f32, f32, f32)>) -> Paraboloid {
+        let (radius, z_min, z_max, phi_max_deg) = at.args;
         let r = radius.abs() as f64;
         let (z0, z1) = (z_min.min(z_max) as f64, z_min.max(z_max) as f64);
         let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
-        let place = Placement::new(object_to_world, reverse);
+        let place = &at.place;
         let c = z1 / (r * r);
         let (a_min, a_max) = (
             (4.0 * c * z0 + 1.0).powf(1.5),
@@ -132,62 +119,22 @@ impl Paraboloid {
         );
         let obj_area = phi_max / (12.0 * c * c) * (a_max - a_min);
         Paraboloid {
-            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: z0,
             z_max: z1,
             phi_max,
             area: place.world_area(obj_area),
-            place,
-            material,
-            light: None,
             a_min,
             a_max,
             obj_area,
+            at,
         }
-    }
-
-    pub fn area(&self) -> f32 {
-        self.area
-    }
-
-    pub fn is_valid(&self) -> bool {
-        self.place.is_valid()
-            && self.radius > 0.0
-            && self.z_max > self.z_min
-            && self.z_min >= 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
-    }
-
-    pub fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
-        self.place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
     }
 
     /// c = zmax / radius²: the surface is c (x² + y²) = z.
     #[inline]
     fn c(&self) -> f64 {
         self.z_max / (self.radius * self.radius)
-    }
-
-    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Paraboloid::Intersect`
-    /// computes it (f32 with running error bounds).
-    #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, Vec3, Vec3)> {
-        let (o, d) = transform_ray(&self.place.world_to_object_f32, o, d);
-        let (r, z0, z1) = (self.radius as f32, self.z_min as f32, self.z_max as f32);
-        let k = EFloat::exact(z1) / (EFloat::exact(r) * EFloat::exact(r));
-        let [ox, oy, oz] = o;
-        let [dx, dy, dz] = d;
-        let a = k * (dx * dx + dy * dy);
-        let b = 2.0 * k * (dx * ox + dy * oy) - dz;
-        let c = k * (ox * ox + oy * oy) - oz;
-        let phi_max = self.phi_max as f32;
-        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
-            p.z < z0 || p.z > z1 || phi_f32(p) > phi_max
-        })
     }
 
     #[inline]
@@ -213,11 +160,66 @@ impl Paraboloid {
         }
     }
 
-    pub fn surface_point(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
-        self.place.surface_point(p_obj, self.normal_obj(p_obj), err)
+    fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
+        self.at
+            .place
+            .surface_point(p_obj, self.normal_obj(p_obj), err)
+    }
+}
+
+impl Analytic for Paraboloid {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        Paraboloid::new(self.at.again(to_world, reverse, material))
     }
 
-    pub fn diff_geom(&self, p: DVec3) -> DiffGeom {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn is_valid(&self) -> bool {
+        self.at.place.is_valid()
+            && self.radius > 0.0
+            && self.z_max > self.z_min
+            && self.z_min >= 0.0
+            && self.area > 0.0
+            && self.area.is_finite()
+    }
+
+    fn bounds(&self) -> Bounds3 {
+        let r = self.radius;
+        self.at
+            .place
+            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+    }
+
+    /// Closest hit with 0 < t < t_max, as pbrt-v3's `Paraboloid::Intersect`
+    /// computes it (f32 with running error bounds).
+    #[inline]
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (o, d) = transform_ray(&self.at.place.world_to_object_f32, o, d);
+        let (r, z0, z1) = (self.radius as f32, self.z_min as f32, self.z_max as f32);
+        let k = EFloat::exact(z1) / (EFloat::exact(r) * EFloat::exact(r));
+        let [ox, oy, oz] = o;
+        let [dx, dy, dz] = d;
+        let a = k * (dx * dx + dy * dy);
+        let b = 2.0 * k * (dx * ox + dy * oy) - dz;
+        let c = k * (ox * ox + oy * oy) - oz;
+        let phi_max = self.phi_max as f32;
+        pbrt_closest(quadratic(a, b, c)?, o, d, t_max, |p| {
+            p.z < z0 || p.z > z1 || phi_f32(p) > phi_max
+        })
+        .map(|(t, p, err)| (t, AnalyticHit::Bounded { p, err }))
+    }
+
+    #[inline]
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        let (p, err) = h.point_and_error();
+        self.point_at(p, err)
+    }
+
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        let p = h.point_and_error().0;
         let (pm, dz) = (self.phi_max, self.z_max - self.z_min);
         let u = phi_of(p) / pm;
         let v = (p.z - self.z_min) / dz;
@@ -225,55 +227,27 @@ impl Paraboloid {
         let d2uu = -pm * pm * DVec3::new(p.x, p.y, 0.0);
         let d2uv = dz * pm * DVec3::new(-p.y / (2.0 * p.z), p.x / (2.0 * p.z), 0.0);
         let d2vv = -dz * dz * DVec3::new(p.x / (4.0 * p.z * p.z), p.y / (4.0 * p.z * p.z), 0.0);
-        self.place.diff_geom((u, v), dpdu, dpdv, [d2uu, d2uv, d2vv])
+        self.at
+            .place
+            .diff_geom((u, v), dpdu, dpdv, [d2uu, d2uv, d2vv])
     }
 
     #[inline]
-    pub fn area_density(&self, p_obj: DVec3) -> f32 {
-        (1.0 / (self.obj_area * self.place.area_scale(self.normal_obj(p_obj)))) as f32
+    fn area_density(&self, p_obj: DVec3) -> f32 {
+        (1.0 / (self.obj_area * self.at.place.area_scale(self.normal_obj(p_obj)))) as f32
     }
 
     /// Uniform by area.
-    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let k = self.c();
         let a = self.a_min + (self.a_max - self.a_min) * u.x as f64;
         let z = ((a.powf(2.0 / 3.0) - 1.0) / (4.0 * k)).clamp(self.z_min, self.z_max);
         let phi = self.phi_max * u.y as f64;
         let rho = (z / k).sqrt();
         let p_obj = DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
-        ShapeSample {
-            point: self.surface_point(p_obj, p_obj.abs() * gamma(5) as f64),
+        Some(ShapeSample {
+            point: self.point_at(p_obj, p_obj.abs() * gamma(5) as f64),
             pdf: self.area_density(p_obj),
-        }
-    }
-}
-
-impl Analytic for Paraboloid {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Paraboloid::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.is_valid()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p, err)| (t, QuadricHit::Bounded { p, err }))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        let (p, err) = h.point_and_error();
-        self.surface_point(p, err)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn density_at(&self, p_obj: DVec3) -> f32 {
-        self.area_density(p_obj)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
+        })
     }
 }

@@ -8,9 +8,14 @@
 //! | `zmax`    | float | `radius`        |
 //! | `phimax`  | float | 360 (degrees)   |
 
-use super::quadric::{Analytic, QuadricHit};
-use super::{at_origin, Geometry, ShapeInput, ShapeKind, ORIGIN, PHIMAX};
+use super::analytic::{Analytic, AnalyticHit, Placed};
+use super::{at_origin, ShapeInput, ShapeKind, Surface, PHIMAX};
+use super::{DiffGeom, ShapeSample, SurfacePoint};
+use crate::geometry::{gamma, offset_ray_origin, Bounds3, Frame};
+use crate::sampling::uniform_cone_pdf;
 use crate::scene::{ParamSpec, ParamValues, Support};
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::f32::consts::PI;
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::float("radius", 1.0, "radius (> 0)"),
@@ -36,7 +41,7 @@ pub const KIND: ShapeKind = ShapeKind {
 
 /// pbrt-v3's checks: radius > 0 (error), a non-empty zone and sector
 /// (warning, skipped), a radius that fits a 32-bit float.
-fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
+fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Surface> {
     let radius = p.float("radius");
     if radius <= 0.0 {
         r.error(
@@ -69,40 +74,24 @@ fn build(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<Geometry> {
         );
         return None;
     }
-    at_origin(Sphere::new(radius, z0, z1, phimax, ORIGIN, false, 0))
+    at_origin(Sphere::new(Placed::origin((radius, z0, z1, phimax))))
 }
-
-use super::{DiffGeom, ShapeSample, SurfacePoint};
-use crate::geometry::{gamma, offset_ray_origin, Bounds3, Frame};
-use crate::sampling::uniform_cone_pdf;
-use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// A (possibly partial) sphere centred at its object-space origin. Ray tests
 /// run in object space in f64, so hits are exact to far below f32 precision;
 /// the world hit point carries an error bound like every other surface.
 #[derive(Clone, Debug)]
 pub struct Sphere {
-    /// The arguments of [`Sphere::new`] but the placement: the shape as its
-    /// kind built it, placed again by [`Analytic::placed`].
-    pub args: (f32, f32, f32, f32),
+    /// Its parameters, placement, material and area light.
+    pub at: Placed<(f32, f32, f32, f32)>,
     pub radius: f64,
     pub z_min: f64,
     pub z_max: f64,
     /// Radians.
     pub phi_max: f64,
-    pub object_to_world: DMat4,
-    pub world_to_object: DMat4,
-    /// Inverse transpose of the linear part, for normals.
-    normal_matrix: DMat3,
-    /// |det| of the linear part of the transform.
-    det_abs: f64,
-    pub flip_normal: bool,
     /// pbrt-v3's θ range of the zone: θ(z_min) and θ(z_max), radians.
     theta_min: f64,
     theta_max: f64,
-    pub material: u32,
-    pub light: Option<u32>,
     /// Some((world centre, world radius)) when the transform is a similarity
     /// and the sphere is whole: then lights sample the cone it subtends.
     cone: Option<(Vec3, f32)>,
@@ -110,25 +99,16 @@ pub struct Sphere {
 }
 
 impl Sphere {
-    pub fn new(
-        radius: f32,
-        z_min: f32,
-        z_max: f32,
-        phi_max_deg: f32,
-        object_to_world: DMat4,
-        reverse: bool,
-        material: u32,
-    ) -> Sphere {
+    pub fn new(at: Placed<(f32, f32, f32, f32)>) -> Sphere {
+        let (radius, z_min, z_max, phi_max_deg) = at.args;
         let r = radius.abs() as f64;
         let zmin = (z_min.min(z_max) as f64).clamp(-r, r);
         let zmax = (z_min.max(z_max) as f64).clamp(-r, r);
         let phi_max = (phi_max_deg.clamp(0.0, 360.0) as f64).to_radians();
-        let lin = DMat3::from_mat4(object_to_world);
-        let det = lin.determinant();
-        let normal_matrix = lin.inverse().transpose();
+        let place = &at.place;
         let whole = zmin <= -r && zmax >= r && phi_max >= std::f64::consts::TAU;
         // Similarity: columns orthogonal with equal lengths.
-        let (c0, c1, c2) = (lin.x_axis, lin.y_axis, lin.z_axis);
+        let (c0, c1, c2) = (place.lin.x_axis, place.lin.y_axis, place.lin.z_axis);
         let (l0, l1, l2) = (c0.length(), c1.length(), c2.length());
         let tol = 1e-6 * l0.max(l1).max(l2);
         let similarity = (l0 - l1).abs() < tol
@@ -138,7 +118,10 @@ impl Sphere {
             && c1.dot(c2).abs() < tol * l0;
         let cone = (whole && similarity).then(|| {
             (
-                object_to_world.transform_point3(DVec3::ZERO).as_vec3(),
+                place
+                    .object_to_world
+                    .transform_point3(DVec3::ZERO)
+                    .as_vec3(),
                 (r * l0) as f32,
             )
         });
@@ -148,63 +131,98 @@ impl Sphere {
         let scale2 = if similarity {
             l0 * l0
         } else {
-            det.abs().powf(2.0 / 3.0)
+            place.det_abs.powf(2.0 / 3.0)
         };
         Sphere {
-            args: (radius, z_min, z_max, phi_max_deg),
             radius: r,
             z_min: zmin,
             z_max: zmax,
             phi_max,
-            object_to_world,
-            world_to_object: object_to_world.inverse(),
-            normal_matrix,
-            det_abs: det.abs(),
-            flip_normal: reverse ^ (det < 0.0),
             theta_min: (zmin / r).clamp(-1.0, 1.0).acos(),
             theta_max: (zmax / r).clamp(-1.0, 1.0).acos(),
-            material,
-            light: None,
             cone,
             area: (obj_area * scale2) as f32,
+            at,
         }
     }
 
-    pub fn area(&self) -> f32 {
-        self.area
+    #[inline]
+    fn is_partial(&self) -> bool {
+        self.z_min > -self.radius
+            || self.z_max < self.radius
+            || self.phi_max < std::f64::consts::TAU
+    }
+
+    /// World-space surface point for an object-space point on the sphere:
+    /// the object-space error of the reprojected point is pbrt-v3's γ5·|p|.
+    fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
+        let obj_err = p_obj.abs() * gamma(5) as f64;
+        self.at
+            .place
+            .exact_point(p_obj, obj_err, self.at.place.normal(p_obj))
+    }
+
+    /// World-area density of `sample_area` at the point with object-space
+    /// unit normal `n_obj`: dA_world / dA_obj = |det M| · |M^-T n_obj|.
+    #[inline]
+    fn density_at_normal(&self, n_obj: DVec3) -> f32 {
+        let obj_area = self.phi_max * self.radius * (self.z_max - self.z_min);
+        let pl = &self.at.place;
+        (1.0 / (obj_area * pl.det_abs * (pl.normal_matrix * n_obj).length())) as f32
+    }
+
+    /// Density by area at a world point of this sphere (for area sampling).
+    pub fn pdf_area(&self, p_world: Vec3) -> f32 {
+        let p_obj = self
+            .at
+            .place
+            .world_to_object
+            .transform_point3(p_world.as_dvec3());
+        self.density_at_normal(p_obj / p_obj.length().max(1e-300))
+    }
+
+    /// If a reference point sees the whole sphere as a cone, (centre, radius, cosθmax).
+    fn cone_from(&self, p: Vec3, p_error: Vec3, n: Vec3) -> Option<(Vec3, f32, f32)> {
+        let (c, r) = self.cone?;
+        let origin = offset_ray_origin(p, p_error, n, c - p);
+        if origin.distance_squared(c) <= r * r {
+            return None;
+        }
+        let sin2 = r * r / p.distance_squared(c);
+        let cos_max = (1.0 - sin2).max(0.0).sqrt();
+        Some((c, r, cos_max))
+    }
+}
+
+impl Analytic for Sphere {
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
+        Sphere::new(self.at.again(to_world, reverse, material))
     }
 
     /// False for singular transforms (e.g. `Scale 0 0 0`): such a sphere has
     /// no area and is left out of the scene.
-    pub fn is_invertible(&self) -> bool {
-        self.world_to_object.is_finite() && self.area > 0.0 && self.area.is_finite()
+    fn is_valid(&self) -> bool {
+        self.radius > 0.0
+            && self.at.place.world_to_object.is_finite()
+            && self.area > 0.0
+            && self.area.is_finite()
     }
 
-    pub fn bounds(&self) -> Bounds3 {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn bounds(&self) -> Bounds3 {
         let r = self.radius;
-        let mut b = Bounds3::EMPTY;
-        for i in 0..8 {
-            let c = DVec3::new(
-                if i & 1 == 0 { -r } else { r },
-                if i & 2 == 0 { -r } else { r },
-                if i & 4 == 0 { self.z_min } else { self.z_max },
-            );
-            let w = self.object_to_world.transform_point3(c).as_vec3();
-            b = b.union_point(w);
-        }
-        // Widen by a few ulps so f32 rounding of the corners stays conservative.
-        let pad = (b.max.abs().max(b.min.abs())) * 4.0 * f32::EPSILON;
-        Bounds3 {
-            min: b.min - pad,
-            max: b.max + pad,
-        }
+        self.at
+            .place
+            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
     }
 
     /// Closest hit with 0 < t < t_max; returns t and the object-space point.
     #[inline]
-    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, DVec3)> {
-        let oo = self.world_to_object.transform_point3(o.as_dvec3());
-        let od = self.world_to_object.transform_vector3(d.as_dvec3());
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        let (oo, od) = self.at.place.ray_to_object(o, d);
         let a = od.length_squared();
         if a == 0.0 {
             return None;
@@ -253,49 +271,23 @@ impl Sphere {
                     continue;
                 }
             }
-            return Some((t as f32, p));
+            return Some((t as f32, AnalyticHit::Exact(p)));
         }
         None
     }
 
     #[inline]
-    fn is_partial(&self) -> bool {
-        self.z_min > -self.radius
-            || self.z_max < self.radius
-            || self.phi_max < std::f64::consts::TAU
-    }
-
-    /// World-space surface point for an object-space point on the sphere.
-    pub fn surface_point(&self, p_obj: DVec3) -> SurfacePoint {
-        let pw = self.object_to_world.transform_point3(p_obj);
-        let p = pw.as_vec3();
-        // Object-space error of the reprojected point (pbrt: γ5·|p|), carried
-        // through the transform, plus the final rounding to f32.
-        let obj_err = p_obj.abs() * gamma(5) as f64;
-        let lin = DMat3::from_mat4(self.object_to_world);
-        let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
-        let err = abs_lin * obj_err
-            + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
-                * gamma(3) as f64;
-        let p_error = err.as_vec3() + p.abs() * f32::EPSILON;
-        let mut n = (self.normal_matrix * p_obj).normalize().as_vec3();
-        if self.flip_normal {
-            n = -n;
-        }
-        SurfacePoint {
-            p,
-            p_error,
-            n,
-            ns: n,
-        }
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        self.point_at(h.point_and_error().0)
     }
 
     /// The differential geometry at an object-space hit point (pbrt-v3's
     /// `Sphere::Intersect`): u = φ/φmax, v from θ over the zone, dp/du,
     /// dp/dv and the Weingarten equations' dn/du, dn/dv, in world space.
-    pub fn diff_geom(&self, p_obj: DVec3) -> DiffGeom {
+    #[inline]
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
         let r = self.radius;
-        let mut p = p_obj;
+        let mut p = h.point_and_error().0;
         if p.x == 0.0 && p.y == 0.0 {
             p.x = 1e-5 * r;
         }
@@ -316,79 +308,27 @@ impl Sphere {
         let d2pduu = -self.phi_max * self.phi_max * DVec3::new(p.x, p.y, 0.0);
         let d2pduv = dtheta * p.z * self.phi_max * DVec3::new(-sin_phi, cos_phi, 0.0);
         let d2pdvv = -dtheta * dtheta * p;
-        let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
-        let n = dpdu.cross(dpdv).normalize();
-        let (e, f, g) = (n.dot(d2pduu), n.dot(d2pduv), n.dot(d2pdvv));
-        let inv = 1.0 / (e1 * g1 - f1 * f1);
-        let dndu = (f * f1 - e * g1) * inv * dpdu + (e * f1 - f * e1) * inv * dpdv;
-        let dndv = (g * f1 - f * g1) * inv * dpdu + (f * f1 - g * e1) * inv * dpdv;
-        let lin = DMat3::from_mat4(self.object_to_world);
-        let (dpdu, dpdv) = ((lin * dpdu).as_vec3(), (lin * dpdv).as_vec3());
-        let fin = |v: DVec3| {
-            let v = (self.normal_matrix * v).as_vec3();
-            if v.is_finite() {
-                v
-            } else {
-                Vec3::ZERO
-            }
-        };
-        let (dndu, dndv) = (fin(dndu), fin(dndv));
-        DiffGeom {
-            uv: Vec2::new(u as f32, v as f32),
-            dpdu,
-            dpdv,
-            dndu,
-            dndv,
-            shading_dpdu: dpdu,
-            shading_dpdv: dpdv,
-            shading_dndu: dndu,
-            shading_dndv: dndv,
-            ..DiffGeom::ZERO
-        }
+        self.at
+            .place
+            .diff_geom((u, v), dpdu, dpdv, [d2pduu, d2pduv, d2pdvv])
     }
 
     /// Uniform sample by area on the sphere's zone (object space), with the
     /// density converted to world area through the transform's Jacobian.
-    pub fn sample_area(&self, u: Vec2) -> ShapeSample {
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let r = self.radius;
         let z = self.z_min + (self.z_max - self.z_min) * u.x as f64;
         let phi = self.phi_max * u.y as f64;
         let rxy = (r * r - z * z).max(0.0).sqrt();
         let p_obj = DVec3::new(rxy * phi.cos(), rxy * phi.sin(), z);
-        ShapeSample {
-            point: self.surface_point(p_obj),
-            pdf: self.area_density(p_obj / r),
-        }
-    }
-
-    /// World-area density of `sample_area` at the point with object-space
-    /// unit normal `n_obj`: dA_world / dA_obj = |det M| · |M^-T n_obj|.
-    #[inline]
-    fn area_density(&self, n_obj: DVec3) -> f32 {
-        let obj_area = self.phi_max * self.radius * (self.z_max - self.z_min);
-        (1.0 / (obj_area * self.det_abs * (self.normal_matrix * n_obj).length())) as f32
-    }
-
-    /// Density by area at a world point of this sphere (for area sampling).
-    pub fn pdf_area(&self, p_world: Vec3) -> f32 {
-        let p_obj = self.world_to_object.transform_point3(p_world.as_dvec3());
-        self.area_density(p_obj / p_obj.length().max(1e-300))
-    }
-
-    /// If a reference point sees the whole sphere as a cone, (centre, radius, cosθmax).
-    fn cone_from(&self, p: Vec3, p_error: Vec3, n: Vec3) -> Option<(Vec3, f32, f32)> {
-        let (c, r) = self.cone?;
-        let origin = offset_ray_origin(p, p_error, n, c - p);
-        if origin.distance_squared(c) <= r * r {
-            return None;
-        }
-        let sin2 = r * r / p.distance_squared(c);
-        let cos_max = (1.0 - sin2).max(0.0).sqrt();
-        Some((c, r, cos_max))
+        Some(ShapeSample {
+            point: self.point_at(p_obj),
+            pdf: self.density_at_normal(p_obj / r),
+        })
     }
 
     /// Sample a point as seen from a reference point; density by solid angle.
-    pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
+    fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
         if let Some((c, r, cos_max)) = self.cone_from(p, p_error, n) {
             // pbrt-v3 Sphere::Sample(ref, u): sample the subtended cone, then
             // find the point on the sphere along the sampled direction.
@@ -410,7 +350,7 @@ impl Sphere {
                 n: n_world,
                 ns: n_world,
             };
-            if self.flip_normal {
+            if self.at.place.flip_normal {
                 point.n = -point.n;
                 point.ns = point.n;
             }
@@ -419,28 +359,21 @@ impl Sphere {
                 pdf: uniform_cone_pdf(cos_max),
             });
         }
-        let s = self.sample_area(u);
-        to_solid_angle(p, s)
+        to_solid_angle(p, self.sample_area(u)?)
     }
 
     /// Density by solid angle of `sample_from` producing direction `wi`
     /// from `p` (pbrt-v3's Sphere::Pdf): the cone density when the sphere is
     /// seen from outside, else the area density at the first hit of `wi`.
-    pub fn pdf_from(
-        &self,
-        p: Vec3,
-        p_error: Vec3,
-        n: Vec3,
-        wi: Vec3,
-        hit: impl Fn(Vec3, Vec3) -> Option<(f32, DVec3)>,
-    ) -> f32 {
+    #[inline]
+    fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
         if let Some((_, _, cos_max)) = self.cone_from(p, p_error, n) {
             return uniform_cone_pdf(cos_max);
         }
         let o = offset_ray_origin(p, p_error, n, wi);
-        match hit(o, wi) {
-            Some((_, p_obj)) => {
-                let h = self.surface_point(p_obj);
+        match self.intersect(o, wi, f32::INFINITY) {
+            Some((_, hit)) => {
+                let h = self.surface_point(hit);
                 // pbrt-v3's Shape::Pdf: the cosine with the ray direction wi
                 // (not with p→hit: the ray starts at the offset origin, and
                 // the mixed form is off by ~|offset|/(2cos²θ) at grazing wi).
@@ -480,57 +413,18 @@ pub fn area_to_solid_angle(p: Vec3, q: Vec3, nq: Vec3, pdf_area: f32) -> f32 {
     }
 }
 
-impl Analytic for Sphere {
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self {
-        let a = self.args;
-        Sphere::new(a.0, a.1, a.2, a.3, to_world, reverse, material)
-    }
-    fn valid(&self) -> bool {
-        self.radius > 0.0 && self.is_invertible()
-    }
-    #[inline]
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-        self.intersect(o, d, t_max)
-            .map(|(t, p)| (t, QuadricHit::Exact(p)))
-    }
-    #[inline]
-    fn point(&self, h: QuadricHit) -> SurfacePoint {
-        self.surface_point(h.point_and_error().0)
-    }
-    #[inline]
-    fn geom(&self, h: QuadricHit) -> DiffGeom {
-        self.diff_geom(h.point_and_error().0)
-    }
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample> {
-        Some(self.sample_area(u))
-    }
-    #[inline]
-    fn sample_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
-        self.sample_from(p, p_error, n, u)
-    }
-    #[inline]
-    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-        self.pdf_from(p, p_error, n, wi, |o, d| {
-            self.intersect(o, d, f32::INFINITY)
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn unit_sphere_hits_and_normals() {
-        let s = Sphere::new(
-            1.0,
-            -1.0,
-            1.0,
-            360.0,
+        let s = Sphere::new(Placed::new(
+            (1.0, -1.0, 1.0, 360.0),
             DMat4::from_translation(DVec3::new(0.0, 0.0, 5.0)),
             false,
             0,
-        );
+        ));
         let (t, p) = s.intersect(Vec3::ZERO, Vec3::Z, f32::INFINITY).unwrap();
         assert!((t - 4.0).abs() < 1e-6);
         let sp = s.surface_point(p);
@@ -548,18 +442,15 @@ mod tests {
     #[test]
     fn leaving_ray_does_not_rehit() {
         for scale in [1e-4f64, 1.0, 1e5] {
-            let s = Sphere::new(
-                1.0,
-                -1.0,
-                1.0,
-                360.0,
+            let s = Sphere::new(Placed::new(
+                (1.0, -1.0, 1.0, 360.0),
                 DMat4::from_scale(DVec3::splat(scale)),
                 false,
                 0,
-            );
+            ));
             for i in 0..1000 {
                 let u = Vec2::new((i as f32 * 0.618034) % 1.0, (i as f32 * 0.7548776) % 1.0);
-                let smp = s.sample_area(u);
+                let smp = s.sample_area(u).unwrap();
                 let sp = smp.point;
                 // Outward along a tangent-ish direction must miss the sphere.
                 let w = (sp.n + Frame::from_normal(sp.n).s * 30.0).normalize();

@@ -12,7 +12,7 @@
 //! state by the loader, as for every triangle mesh it reads from a file.
 
 use super::curve::to_vec3;
-use super::{Geometry, ShapeInput, ShapeKind};
+use super::{ShapeInput, ShapeKind, Surface};
 use crate::scene::{Elem, MeshData, ParamSpec, ParamValues, Support};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
@@ -39,7 +39,7 @@ pub const KIND: ShapeKind = ShapeKind {
     support: Support::Supported,
     params: PARAMS,
     doc: "a triangle mesh given in the scene file (alpha/shadowalpha textures). Index count not a multiple of 3, an index negative or ≥ vertex count, no P: error. N or uv count mismatch: warning, dropped. S, faceIndices: unused warning",
-    build: |p, r| mesh(p, r).map(|m| Geometry::TriangleMesh(Arc::new(m))),
+    build: |p, r| mesh(p, r).map(|m| Surface::TriangleMesh(Arc::new(m))),
 };
 
 /// pbrt-v3's checks: positions given, finite; indices a multiple of 3 and

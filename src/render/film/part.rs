@@ -450,8 +450,31 @@ fn parse_bounds(s: Option<&str>) -> Option<Bounds2i> {
 /// missing part (gap), a part whose data window is not its own.
 pub fn merge(parts: &[Part]) -> Result<Image, String> {
     let first = parts.first().ok_or("no parts to merge")?;
-    let name = |p: &Part| p.path.display().to_string();
-    for p in &parts[1..] {
+    check_same_render(first, &parts[1..])?;
+    let display = parse_bounds(first.header.setting("pixelbounds"))
+        .filter(|b| b.width() > 0 && b.height() > 0)
+        .ok_or_else(|| format!("{}: malformed pixelbounds", name(first)))?;
+    let (w, h) = (display.width() as u32, display.height() as u32);
+    if w as u64 * h as u64 > crate::scene::MAX_IMAGE_PIXELS {
+        return Err(format!("{}: the image is too large", name(first)));
+    }
+    let mut img = Image::new(w, h);
+    match first.header.kind {
+        PartKind::Tile { count, .. } => merge_tiles(parts, first, display, count, &mut img)?,
+        PartKind::Samples { .. } => merge_samples(parts, first, display, &mut img)?,
+    }
+    Ok(img)
+}
+
+/// A part's file, in messages.
+fn name(p: &Part) -> String {
+    p.path.display().to_string()
+}
+
+/// Refuses `rest` unless each is of `first`'s kind (tiles or sample
+/// ranges) with the same recorded settings.
+fn check_same_render(first: &Part, rest: &[Part]) -> Result<(), String> {
+    for p in rest {
         if std::mem::discriminant(&p.header.kind) != std::mem::discriminant(&first.header.kind) {
             return Err(format!(
                 "{} is {} but {} is {}: tiles and sample ranges cannot be merged together",
@@ -481,156 +504,168 @@ pub fn merge(parts: &[Part]) -> Result<Image, String> {
             ));
         }
     }
-    let display = parse_bounds(first.header.setting("pixelbounds"))
-        .filter(|b| b.width() > 0 && b.height() > 0)
-        .ok_or_else(|| format!("{}: malformed pixelbounds", name(first)))?;
+    Ok(())
+}
+
+/// Assembles the `count` tiles of `display` into `img`, refusing a
+/// different split, a duplicate, a gap or a wrong data window.
+fn merge_tiles(
+    parts: &[Part],
+    first: &Part,
+    display: Bounds2i,
+    count: u32,
+    img: &mut Image,
+) -> Result<(), String> {
+    let w = display.width() as u32;
+    let mut seen: Vec<Option<&Part>> = vec![None; count as usize];
+    for p in parts {
+        let PartKind::Tile { index, count: n } = p.header.kind else {
+            unreachable!("kinds checked above")
+        };
+        if n != count {
+            return Err(format!(
+                "{} is {} but {} is {}: the frame was split differently",
+                name(p),
+                p.header.kind,
+                name(first),
+                first.header.kind
+            ));
+        }
+        if index >= count {
+            return Err(format!("{}: {} does not exist", name(p), p.header.kind));
+        }
+        if let Some(q) = seen[index as usize] {
+            return Err(format!(
+                "overlap: {} and {} are both {}",
+                name(q),
+                name(p),
+                p.header.kind
+            ));
+        }
+        let want = tile_rect(display, index, count);
+        if p.window != want {
+            return Err(format!(
+                "{}: its data window (rows {}..{}, columns {}..{}) is not {}'s (rows {}..{}, columns {}..{})",
+                name(p), p.window.min.y, p.window.max.y, p.window.min.x, p.window.max.x,
+                p.header.kind, want.min.y, want.max.y, want.min.x, want.max.x
+            ));
+        }
+        seen[index as usize] = Some(p);
+    }
+    let missing: Vec<String> = seen
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(k, _)| {
+            let r = tile_rect(display, k as u32, count);
+            format!("tile {k} (rows {}..{})", r.min.y, r.max.y)
+        })
+        .collect();
+    if !missing.is_empty() {
+        return Err(format!(
+            "gap: of {count} tiles, {} missing: {}",
+            if missing.len() == 1 {
+                "this is"
+            } else {
+                "these are"
+            },
+            missing.join(", ")
+        ));
+    }
+    for p in parts {
+        let PartData::Rgb(rgb) = &p.data else {
+            unreachable!("tile parts hold RGB")
+        };
+        let row = 3 * w as usize;
+        let y0 = (p.window.min.y - display.min.y) as usize;
+        let n = rgb.len();
+        img.data[y0 * row..y0 * row + n].copy_from_slice(rgb);
+    }
+    Ok(())
+}
+
+/// Adds the sample ranges' sums in the order of their first sample and
+/// writes the pixels into `img`, refusing an overlap, a gap or a wrong data
+/// window.
+fn merge_samples(
+    parts: &[Part],
+    first: &Part,
+    display: Bounds2i,
+    img: &mut Image,
+) -> Result<(), String> {
     let (w, h) = (display.width() as u32, display.height() as u32);
-    if w as u64 * h as u64 > crate::scene::MAX_IMAGE_PIXELS {
-        return Err(format!("{}: the image is too large", name(first)));
-    }
-    let mut img = Image::new(w, h);
-    match first.header.kind {
-        PartKind::Tile { count, .. } => {
-            let mut seen: Vec<Option<&Part>> = vec![None; count as usize];
-            for p in parts {
-                let PartKind::Tile { index, count: n } = p.header.kind else {
-                    unreachable!("kinds checked above")
-                };
-                if n != count {
-                    return Err(format!(
-                        "{} is {} but {} is {}: the frame was split differently",
-                        name(p),
-                        p.header.kind,
-                        name(first),
-                        first.header.kind
-                    ));
-                }
-                if index >= count {
-                    return Err(format!("{}: {} does not exist", name(p), p.header.kind));
-                }
-                if let Some(q) = seen[index as usize] {
-                    return Err(format!(
-                        "overlap: {} and {} are both {}",
-                        name(q),
-                        name(p),
-                        p.header.kind
-                    ));
-                }
-                let want = tile_rect(display, index, count);
-                if p.window != want {
-                    return Err(format!(
-                        "{}: its data window (rows {}..{}, columns {}..{}) is not {}'s (rows {}..{}, columns {}..{})",
-                        name(p), p.window.min.y, p.window.max.y, p.window.min.x, p.window.max.x,
-                        p.header.kind, want.min.y, want.max.y, want.min.x, want.max.x
-                    ));
-                }
-                seen[index as usize] = Some(p);
-            }
-            let missing: Vec<String> = seen
-                .iter()
-                .enumerate()
-                .filter(|(_, s)| s.is_none())
-                .map(|(k, _)| {
-                    let r = tile_rect(display, k as u32, count);
-                    format!("tile {k} (rows {}..{})", r.min.y, r.max.y)
-                })
-                .collect();
-            if !missing.is_empty() {
-                return Err(format!(
-                    "gap: of {count} tiles, {} missing: {}",
-                    if missing.len() == 1 {
-                        "this is"
-                    } else {
-                        "these are"
-                    },
-                    missing.join(", ")
-                ));
-            }
-            for p in parts {
-                let PartData::Rgb(rgb) = &p.data else {
-                    unreachable!("tile parts hold RGB")
-                };
-                let row = 3 * w as usize;
-                let y0 = (p.window.min.y - display.min.y) as usize;
-                let n = rgb.len();
-                img.data[y0 * row..y0 * row + n].copy_from_slice(rgb);
-            }
+    let spp: u32 = first
+        .header
+        .setting("spp")
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| format!("{}: malformed spp", name(first)))?;
+    let scale = first
+        .header
+        .setting("scale")
+        .and_then(|s| u32::from_str_radix(s, 16).ok())
+        .map(f32::from_bits)
+        .ok_or_else(|| format!("{}: malformed scale", name(first)))?;
+    let mut order: Vec<(u32, u32, &Part)> = parts
+        .iter()
+        .map(|p| match p.header.kind {
+            PartKind::Samples { start, end } => (start, end, p),
+            PartKind::Tile { .. } => unreachable!("kinds checked above"),
+        })
+        .collect();
+    order.sort_by_key(|&(a, b, _)| (a, b));
+    let mut next = 0u32;
+    let mut prev: Option<&Part> = None;
+    for &(a, b, p) in &order {
+        if a >= b || b > spp {
+            return Err(format!(
+                "{}: {} is not a range of the {spp} samples per pixel",
+                name(p),
+                p.header.kind
+            ));
         }
-        PartKind::Samples { .. } => {
-            let spp: u32 = first
-                .header
-                .setting("spp")
-                .and_then(|s| s.parse().ok())
-                .ok_or_else(|| format!("{}: malformed spp", name(first)))?;
-            let scale = first
-                .header
-                .setting("scale")
-                .and_then(|s| u32::from_str_radix(s, 16).ok())
-                .map(f32::from_bits)
-                .ok_or_else(|| format!("{}: malformed scale", name(first)))?;
-            let mut order: Vec<(u32, u32, &Part)> = parts
-                .iter()
-                .map(|p| match p.header.kind {
-                    PartKind::Samples { start, end } => (start, end, p),
-                    PartKind::Tile { .. } => unreachable!("kinds checked above"),
-                })
-                .collect();
-            order.sort_by_key(|&(a, b, _)| (a, b));
-            let mut next = 0u32;
-            let mut prev: Option<&Part> = None;
-            for &(a, b, p) in &order {
-                if a >= b || b > spp {
-                    return Err(format!(
-                        "{}: {} is not a range of the {spp} samples per pixel",
-                        name(p),
-                        p.header.kind
-                    ));
-                }
-                if a < next {
-                    return Err(format!(
-                        "overlap: {} ({}) and {} ({}) share samples",
-                        name(prev.unwrap_or(p)),
-                        prev.map_or(String::new(), |q| q.header.kind.to_string()),
-                        name(p),
-                        p.header.kind
-                    ));
-                }
-                if a > next {
-                    return Err(format!(
-                        "gap: samples [{next}, {a}) of the {spp} per pixel are in no part"
-                    ));
-                }
-                if p.window != display {
-                    return Err(format!(
-                        "{}: its data window is not the film's pixel bounds",
-                        name(p)
-                    ));
-                }
-                next = b;
-                prev = Some(p);
+        if a < next {
+            return Err(format!(
+                "overlap: {} ({}) and {} ({}) share samples",
+                name(prev.unwrap_or(p)),
+                prev.map_or(String::new(), |q| q.header.kind.to_string()),
+                name(p),
+                p.header.kind
+            ));
+        }
+        if a > next {
+            return Err(format!(
+                "gap: samples [{next}, {a}) of the {spp} per pixel are in no part"
+            ));
+        }
+        if p.window != display {
+            return Err(format!(
+                "{}: its data window is not the film's pixel bounds",
+                name(p)
+            ));
+        }
+        next = b;
+        prev = Some(p);
+    }
+    if next != spp {
+        return Err(format!(
+            "gap: samples [{next}, {spp}) of the {spp} per pixel are in no part"
+        ));
+    }
+    let mut sums = vec![PixelSums::default(); (w * h) as usize];
+    for &(_, _, p) in &order {
+        let PartData::Sums(s) = &p.data else {
+            unreachable!("sample parts hold sums")
+        };
+        for (d, s) in sums.iter_mut().zip(s) {
+            for c in 0..3 {
+                d.contrib[c] += s.contrib[c];
             }
-            if next != spp {
-                return Err(format!(
-                    "gap: samples [{next}, {spp}) of the {spp} per pixel are in no part"
-                ));
-            }
-            let mut sums = vec![PixelSums::default(); (w * h) as usize];
-            for &(_, _, p) in &order {
-                let PartData::Sums(s) = &p.data else {
-                    unreachable!("sample parts hold sums")
-                };
-                for (d, s) in sums.iter_mut().zip(s) {
-                    for c in 0..3 {
-                        d.contrib[c] += s.contrib[c];
-                    }
-                    d.weight += s.weight;
-                }
-            }
-            let scale = scale as f64;
-            for (i, s) in sums.iter().enumerate() {
-                img.data[3 * i..3 * i + 3].copy_from_slice(&pixel_rgb(s, scale));
-            }
+            d.weight += s.weight;
         }
     }
-    Ok(img)
+    let scale = scale as f64;
+    for (i, s) in sums.iter().enumerate() {
+        img.data[3 * i..3 * i + 3].copy_from_slice(&pixel_rgb(s, scale));
+    }
+    Ok(())
 }

@@ -1,170 +1,207 @@
-//! The closed set of analytic shapes (pbrt-v3's quadrics, and curve pieces)
-//! as one enum that only delegates: the BVH holds them as non-triangle
+//! The analytic shapes (pbrt-v3's quadrics, and curve pieces): the shapes
+//! the render core intersects by their equations rather than as triangles.
+//! Each kind answers [`Analytic`] in its own file; [`AnalyticShape`] is
+//! their closed set as one enum that only delegates (a `match`, inlined: no
+//! dynamic dispatch per ray). The BVH holds them as non-triangle
 //! primitives, traced by callback, and area lights sit on them (not on
-//! curves, which pbrt-v3 cannot sample).
+//! curves, which pbrt-v3 cannot sample). [`Placement`] is where one sits in
+//! world space, written once for every kind.
 
-use super::curve::{Curve, CurveHit};
-use super::{
-    Cone, Cylinder, DiffGeom, Disk, Hyperboloid, Paraboloid, ShapeSample, Sphere, SurfacePoint,
-};
+use super::curve::CurveHit;
+use super::{DiffGeom, ShapeSample, SurfacePoint};
 use crate::geometry::efloat::EFloat;
 use crate::geometry::{gamma, offset_ray_origin, Bounds3};
 use glam::{DMat3, DMat4, DVec3, Mat4, Vec2, Vec3};
 
-macro_rules! from_shape {
-    ($($t:ident),*) => {
-        $(impl From<$t> for Quadric {
-            fn from(s: $t) -> Quadric {
-                Quadric::$t(Box::new(s))
-            }
-        })*
-    };
-}
-from_shape!(Sphere, Disk, Cylinder, Cone, Paraboloid, Hyperboloid);
-
-impl From<Curve> for Quadric {
-    fn from(c: Curve) -> Quadric {
-        Quadric::Curve(c)
-    }
-}
-
-/// What every analytic shape answers, each in its own file; [`Quadric`]
-/// only delegates (static dispatch, inlined). The defaults are pbrt-v3's
-/// for shapes sampled by area alone.
-pub trait Analytic {
+/// What every analytic shape answers, each in its own file;
+/// [`AnalyticShape`] only delegates. The defaults are pbrt-v3's for shapes
+/// sampled by area alone.
+pub trait Analytic: Sized {
     /// The same shape placed by `to_world` (from its object space), with
     /// the orientation flag and material of its `Shape` statement.
-    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self
-    where
-        Self: Sized;
+    fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Self;
     /// False for shapes left out of the scene (singular transforms, no area).
-    fn valid(&self) -> bool;
+    fn is_valid(&self) -> bool;
+    /// World area.
+    fn area(&self) -> f32;
+    /// World bounds.
+    fn bounds(&self) -> Bounds3;
     /// Closest hit with 0 < t < t_max: t and the object-space hit.
-    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)>;
-    fn point(&self, h: QuadricHit) -> SurfacePoint;
-    fn geom(&self, h: QuadricHit) -> DiffGeom;
+    fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)>;
+    /// The world point, error bound and oriented normal of a hit.
+    fn surface_point(&self, h: AnalyticHit) -> SurfacePoint;
+    /// The world differential geometry of a hit.
+    fn diff_geom(&self, h: AnalyticHit) -> DiffGeom;
     /// Density by world area of the shape's area sampling at an object
     /// point (NaN for the shapes not sampled by area alone).
-    fn density_at(&self, _p_obj: DVec3) -> f32 {
+    fn area_density(&self, _p_obj: DVec3) -> f32 {
         f32::NAN
     }
     /// A point sampled by area (`None`: never a light).
-    fn area_sample(&self, u: Vec2) -> Option<ShapeSample>;
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample>;
     /// A point sampled as seen from a reference point; density by solid angle.
     #[inline]
-    fn sample_toward(&self, p: Vec3, _p_error: Vec3, _n: Vec3, u: Vec2) -> Option<ShapeSample> {
-        super::to_solid_angle(p, self.area_sample(u)?)
+    fn sample_from(&self, p: Vec3, _p_error: Vec3, _n: Vec3, u: Vec2) -> Option<ShapeSample> {
+        super::to_solid_angle(p, self.sample_area(u)?)
     }
     /// pbrt-v3's `Shape::Pdf(ref, wi)`: the area density at the first hit
     /// of the ray spawned along `wi`, by solid angle.
     #[inline]
-    fn pdf_toward(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+    fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
         let o = offset_ray_origin(p, p_error, n, wi);
-        match self.hit(o, wi, f32::INFINITY) {
+        match self.intersect(o, wi, f32::INFINITY) {
             Some((_, h)) => {
-                let density = self.density_at(h.point_and_error().0);
-                solid_angle_pdf(p, &self.point(h), wi, density)
+                let density = self.area_density(h.point_and_error().0);
+                solid_angle_pdf(p, &self.surface_point(h), wi, density)
             }
             None => 0.0,
         }
     }
 }
 
-macro_rules! quadrics {
-    ($($(#[$doc:meta])* $variant:ident($ty:ty) = $kind:ident,)*) => {
+macro_rules! analytic_shapes {
+    (
+        $d:tt
+        // The quadrics: boxed, each with a [`Placed`] header.
+        boxed { $($(#[$bdoc:meta])* $bvariant:ident = $bkind:ident,)* }
+        $($(#[$doc:meta])* $variant:ident = $kind:ident,)*
+    ) => {
         /// The quadrics are boxed (each holds its transforms, several
         /// hundred bytes), so that the array of primitives stays small: a
         /// scene of 10,000 curves has 80,000 pieces of a few words each,
         /// which would otherwise each take a quadric's size (672 bytes) and
         /// spread the BVH's leaf tests over 54 MB.
         #[derive(Clone, Debug)]
-        pub enum Quadric {
-            $($(#[$doc])* $variant($ty),)*
+        pub enum AnalyticShape {
+            $($(#[$bdoc])* $bvariant(Box<super::$bkind::$bvariant>),)*
+            $($(#[$doc])* $variant(super::$kind::$variant),)*
         }
 
-        impl Quadric {
-            /// The same shape placed by `to_world`, with the orientation
-            /// flag and material of its `Shape` statement.
-            pub fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> Quadric {
-                match self { $(Quadric::$variant(s) => Quadric::from(s.placed(to_world, reverse, material)),)* }
+        $(impl From<super::$bkind::$bvariant> for AnalyticShape {
+            fn from(s: super::$bkind::$bvariant) -> AnalyticShape {
+                AnalyticShape::$bvariant(Box::new(s))
+            }
+        })*
+        $(impl From<super::$kind::$variant> for AnalyticShape {
+            fn from(s: super::$kind::$variant) -> AnalyticShape {
+                AnalyticShape::$variant(s)
+            }
+        })*
+
+        /// Every method of [`Analytic`], delegated by `match`.
+        /// `$e` for the shape `$s` of any variant of `$self`.
+        macro_rules! each {
+            ($d self:ident, $d s:ident => $d e:expr) => {
+                match $d self {
+                    $(AnalyticShape::$bvariant($d s) => $d e,)*
+                    $(AnalyticShape::$variant($d s) => $d e,)*
+                }
+            };
+        }
+
+        impl AnalyticShape {
+            /// Its `Shape` statement's material (the quadrics hold it in
+            /// their [`Placed`], the curve pieces in the piece).
+            #[inline]
+            pub fn material(&self) -> u32 {
+                match self {
+                    $(AnalyticShape::$bvariant(s) => s.at.material,)*
+                    $(AnalyticShape::$variant(s) => s.material,)*
+                }
+            }
+            /// Its area light, if it emits.
+            #[inline]
+            pub fn light(&self) -> Option<u32> {
+                match self {
+                    $(AnalyticShape::$bvariant(s) => s.at.light,)*
+                    $(AnalyticShape::$variant(s) => s.light,)*
+                }
+            }
+            pub fn set_light(&mut self, light: Option<u32>) {
+                match self {
+                    $(AnalyticShape::$bvariant(s) => s.at.light = light,)*
+                    $(AnalyticShape::$variant(s) => s.light = light,)*
+                }
             }
             /// The name of its kind in [`SHAPES`](super::SHAPES).
             pub fn kind_name(&self) -> &'static str {
-                match self { $(Quadric::$variant(_) => super::$kind::KIND.name,)* }
-            }
-            #[inline]
-            pub fn material(&self) -> u32 {
-                match self { $(Quadric::$variant(s) => s.material,)* }
-            }
-            #[inline]
-            pub fn light(&self) -> Option<u32> {
-                match self { $(Quadric::$variant(s) => s.light,)* }
-            }
-            pub fn set_light(&mut self, light: Option<u32>) {
-                match self { $(Quadric::$variant(s) => s.light = light,)* }
-            }
-            pub fn area(&self) -> f32 {
-                match self { $(Quadric::$variant(s) => s.area(),)* }
-            }
-            pub fn bounds(&self) -> Bounds3 {
-                match self { $(Quadric::$variant(s) => s.bounds(),)* }
-            }
-            /// False for shapes left out of the scene (singular transforms, no area).
-            pub fn is_valid(&self) -> bool {
-                match self { $(Quadric::$variant(s) => s.valid(),)* }
-            }
-            /// Closest hit with 0 < t < t_max: t and the object-space point.
-            #[inline]
-            pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, QuadricHit)> {
-                match self { $(Quadric::$variant(s) => s.hit(o, d, t_max),)* }
-            }
-            #[inline]
-            pub fn surface_point(&self, h: QuadricHit) -> SurfacePoint {
-                match self { $(Quadric::$variant(s) => s.point(h),)* }
-            }
-            #[inline]
-            pub fn diff_geom(&self, h: QuadricHit) -> DiffGeom {
-                match self { $(Quadric::$variant(s) => s.geom(h),)* }
-            }
-            /// Density by world area of the shape's area sampling at an
-            /// object point (the shapes sampled by area alone; not spheres
-            /// or disks).
-            pub fn area_density(&self, p_obj: DVec3) -> f32 {
-                match self { $(Quadric::$variant(s) => s.density_at(p_obj),)* }
-            }
-            /// A point sampled as seen from a reference point; density by
-            /// solid angle.
-            #[inline]
-            pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
-                match self { $(Quadric::$variant(s) => s.sample_toward(p, p_error, n, u),)* }
-            }
-            /// Density by solid angle of `sample_from` producing direction
-            /// `wi`: pbrt-v3's `Shape::Pdf(ref, wi)`.
-            #[inline]
-            pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
-                match self { $(Quadric::$variant(s) => s.pdf_toward(p, p_error, n, wi),)* }
+                match self {
+                    $(AnalyticShape::$bvariant(_) => super::$bkind::KIND.name,)*
+                    $(AnalyticShape::$variant(_) => super::$kind::KIND.name,)*
+                }
             }
         }
     };
 }
 
-quadrics! {
-    Sphere(Box<Sphere>) = sphere,
-    Disk(Box<Disk>) = disk,
-    Cylinder(Box<Cylinder>) = cylinder,
-    Cone(Box<Cone>) = cone,
-    Paraboloid(Box<Paraboloid>) = paraboloid,
-    Hyperboloid(Box<Hyperboloid>) = hyperboloid,
+analytic_shapes! {
+    $
+    boxed {
+        Sphere = sphere,
+        Disk = disk,
+        Cylinder = cylinder,
+        Cone = cone,
+        Paraboloid = paraboloid,
+        Hyperboloid = hyperboloid,
+    }
     /// A piece of a curve segment (never a light: pbrt-v3 cannot sample
     /// curves, and the scene leaves their emission out).
-    Curve(Curve) = curve,
+    Curve = curve,
 }
 
-/// A hit on a quadric in its object space: a point computed in f64 (its
+impl AnalyticShape {
+    /// The same shape placed by `to_world`, with the orientation flag and
+    /// material of its `Shape` statement.
+    pub fn placed(&self, to_world: DMat4, reverse: bool, material: u32) -> AnalyticShape {
+        each!(self, s => AnalyticShape::from(s.placed(to_world, reverse, material)))
+    }
+    pub fn area(&self) -> f32 {
+        each!(self, s => s.area())
+    }
+    pub fn bounds(&self) -> Bounds3 {
+        each!(self, s => s.bounds())
+    }
+    /// False for shapes left out of the scene (singular transforms, no area).
+    pub fn is_valid(&self) -> bool {
+        each!(self, s => s.is_valid())
+    }
+    /// Closest hit with 0 < t < t_max: t and the object-space point.
+    #[inline]
+    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
+        each!(self, s => s.intersect(o, d, t_max))
+    }
+    #[inline]
+    pub fn surface_point(&self, h: AnalyticHit) -> SurfacePoint {
+        each!(self, s => s.surface_point(h))
+    }
+    #[inline]
+    pub fn diff_geom(&self, h: AnalyticHit) -> DiffGeom {
+        each!(self, s => s.diff_geom(h))
+    }
+    /// Density by world area of the shape's area sampling at an object
+    /// point (the shapes sampled by area alone; not spheres or disks).
+    pub fn area_density(&self, p_obj: DVec3) -> f32 {
+        each!(self, s => s.area_density(p_obj))
+    }
+    /// A point sampled as seen from a reference point; density by solid
+    /// angle.
+    #[inline]
+    pub fn sample_from(&self, p: Vec3, p_error: Vec3, n: Vec3, u: Vec2) -> Option<ShapeSample> {
+        each!(self, s => s.sample_from(p, p_error, n, u))
+    }
+    /// Density by solid angle of `sample_from` producing direction `wi`:
+    /// pbrt-v3's `Shape::Pdf(ref, wi)`.
+    #[inline]
+    pub fn pdf_from(&self, p: Vec3, p_error: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        each!(self, s => s.pdf_from(p, p_error, n, wi))
+    }
+}
+
+/// A hit on an analytic shape in its object space: a point computed in f64 (its
 /// error is the shape's to bound), or pbrt-v3's f32 point with its running
 /// error bound.
 #[derive(Clone, Copy, Debug)]
-pub enum QuadricHit {
+pub enum AnalyticHit {
     Exact(DVec3),
     Bounded {
         p: Vec3,
@@ -174,19 +211,55 @@ pub enum QuadricHit {
     Curve(CurveHit),
 }
 
-impl QuadricHit {
+impl AnalyticHit {
     #[inline]
     pub fn point_and_error(self) -> (DVec3, DVec3) {
         match self {
-            QuadricHit::Exact(p) => (p, DVec3::ZERO),
-            QuadricHit::Bounded { p, err } => (p.as_dvec3(), err.as_dvec3()),
-            QuadricHit::Curve(h) => (h.p.as_dvec3(), DVec3::splat(h.err as f64)),
+            AnalyticHit::Exact(p) => (p, DVec3::ZERO),
+            AnalyticHit::Bounded { p, err } => (p.as_dvec3(), err.as_dvec3()),
+            AnalyticHit::Curve(h) => (h.p.as_dvec3(), DVec3::splat(h.err as f64)),
         }
     }
 }
 
-/// Where a quadric sits: its object-to-world transform and what the ray
-/// tests, normals and densities derive from it, computed once.
+/// What every quadric holds besides its own surface: the parameters its
+/// kind built it from (so that it can be placed again), where it sits, and
+/// its `Shape` statement's material and area light.
+#[derive(Clone, Debug)]
+pub struct Placed<A> {
+    pub args: A,
+    pub place: Placement,
+    pub material: u32,
+    pub light: Option<u32>,
+}
+
+impl<A: Copy> Placed<A> {
+    /// `args` placed by `object_to_world`, with the orientation flag and
+    /// material of a `Shape` statement.
+    pub fn new(args: A, object_to_world: DMat4, reverse: bool, material: u32) -> Placed<A> {
+        Placed {
+            args,
+            place: Placement::new(object_to_world, reverse),
+            material,
+            light: None,
+        }
+    }
+
+    /// `args` in their object space: what a kind's builder makes.
+    pub fn origin(args: A) -> Placed<A> {
+        Placed::new(args, DMat4::IDENTITY, false, 0)
+    }
+
+    /// The same parameters placed again (see [`Placed::new`]).
+    pub fn again(&self, to_world: DMat4, reverse: bool, material: u32) -> Placed<A> {
+        Placed::new(self.args, to_world, reverse, material)
+    }
+}
+
+/// Where an analytic shape sits: its object-to-world transform and what the
+/// ray tests, normals, bounds and densities derive from it (the inverse,
+/// the normal matrix, the Jacobian, pbrt-v3's normal flip), computed once
+/// for every kind.
 #[derive(Clone, Debug)]
 pub struct Placement {
     pub object_to_world: DMat4,
@@ -194,9 +267,11 @@ pub struct Placement {
     /// Both rounded to f32, for pbrt-v3's f32 transforms.
     pub world_to_object_f32: Mat4,
     object_to_world_f32: Mat4,
-    lin: DMat3,
-    normal_matrix: DMat3,
-    det_abs: f64,
+    /// The linear part, and its inverse transpose (for normals).
+    pub lin: DMat3,
+    pub normal_matrix: DMat3,
+    /// |det| of the linear part.
+    pub det_abs: f64,
     /// ReverseOrientation xor a handedness-swapping transform (pbrt-v3's
     /// normal flip).
     pub flip_normal: bool,
@@ -271,13 +346,41 @@ impl Placement {
         if w != 1.0 {
             pw /= w;
         }
+        let n = self.normal(n_obj);
+        SurfacePoint {
+            p: pw,
+            p_error: Vec3::from(ew),
+            n,
+            ns: n,
+        }
+    }
+
+    /// The oriented world unit normal of the object normal `n_obj` (any
+    /// length).
+    #[inline]
+    pub fn normal(&self, n_obj: DVec3) -> Vec3 {
         let mut n = (self.normal_matrix * n_obj).normalize().as_vec3();
         if self.flip_normal {
             n = -n;
         }
+        n
+    }
+
+    /// The world point of an object point computed in f64 (the shapes that
+    /// intersect in f64), with its error bound: `obj_err` carried through
+    /// the transform, the transform's rounding γ₃·(|M||p| + |t|), and the
+    /// final rounding to f32; `n` is the oriented world normal.
+    #[inline]
+    pub fn exact_point(&self, p_obj: DVec3, obj_err: DVec3, n: Vec3) -> SurfacePoint {
+        let p = self.object_to_world.transform_point3(p_obj).as_vec3();
+        let lin = self.lin;
+        let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
+        let err = abs_lin * obj_err
+            + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
+                * gamma(3) as f64;
         SurfacePoint {
-            p: pw,
-            p_error: Vec3::from(ew),
+            p,
+            p_error: err.as_vec3() + p.abs() * f32::EPSILON,
             n,
             ns: n,
         }
