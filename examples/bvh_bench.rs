@@ -8,7 +8,7 @@
 //! memory (VmHWM) is per case.
 
 use glam::{DMat4, DVec3, Vec3};
-use pbrs::accel::{Geometry, Instance, Object};
+use pbrs::accel::{Aggregate, Instance, Object};
 use pbrs::geometry::Ray;
 use pbrs::render::driver::peak_memory_bytes;
 use pbrs::shapes::TriangleMesh;
@@ -48,7 +48,7 @@ fn grid(n: u32) -> TriangleMesh {
 }
 
 /// Random rays from a sphere of radius 4 towards points near the origin.
-fn trace(g: &Geometry, n: usize) -> (f64, usize) {
+fn trace(g: &Aggregate, n: usize) -> (f64, usize) {
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut rnd = || {
         state ^= state << 13;
@@ -86,7 +86,7 @@ fn flat() {
     let tris = mesh.triangle_count();
     let before = peak_memory_bytes();
     let start = Instant::now();
-    let g = Geometry::new(vec![mesh], Vec::new());
+    let g = Aggregate::new(vec![mesh], Vec::new());
     let build = start.elapsed();
     let resident = resident_bytes();
     let (mrays, hits) = trace(&g, 1_000_000);
@@ -119,7 +119,7 @@ fn instanced() {
         instances.push(Instance::new(object.clone(), m).expect("invertible"));
     }
     let start = Instant::now();
-    let g = Geometry::with_instances(Vec::new(), Vec::new(), instances);
+    let g = Aggregate::with_instances(Vec::new(), Vec::new(), instances);
     let top_build = start.elapsed();
     let resident = resident_bytes();
     let (mrays, hits) = trace(&g, 1_000_000);

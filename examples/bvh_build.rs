@@ -5,7 +5,7 @@
 //! cargo run --release --example bvh_build [-- N...]
 
 use glam::Vec3;
-use pbrs::accel::Geometry;
+use pbrs::accel::Aggregate;
 use pbrs::shapes::TriangleMesh;
 use std::time::Instant;
 
@@ -68,7 +68,7 @@ fn main() {
                 random(n)
             };
             let t = Instant::now();
-            let g = Geometry::new(vec![m], Vec::new());
+            let g = Aggregate::new(vec![m], Vec::new());
             let s = t.elapsed().as_secs_f64();
             let nlogn = n as f64 * (n as f64).log2();
             println!(

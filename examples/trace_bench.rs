@@ -8,7 +8,7 @@
 //! single-threaded. Compare two builds by running both in turn.
 
 use glam::Vec3;
-use pbrs::accel::{Geometry, Hit};
+use pbrs::accel::{Aggregate, Hit};
 use pbrs::geometry::{spawn_ray, spawn_ray_to_point, Ray};
 use pbrs::integrators::RenderScene;
 use pbrs::loader::load_scene;
@@ -33,7 +33,7 @@ fn main() {
         }
     };
     let rs = RenderScene::new(&loaded.scene);
-    let g = &rs.geometry;
+    let g = &rs.aggregate;
     let b = g.bounds;
     let mut rng = Pcg32::with_sequence(1);
     let mut rnd = || rng.uniform_f32();
@@ -95,7 +95,7 @@ fn main() {
 // attribute each query's cost.
 
 #[inline(never)]
-fn closest_all(g: &Geometry, rays: &[Ray]) -> Vec<Hit> {
+fn closest_all(g: &Aggregate, rays: &[Ray]) -> Vec<Hit> {
     let mut hits = Vec::with_capacity(rays.len());
     for r in rays {
         if let Some(h) = g.intersect(r) {
@@ -106,11 +106,11 @@ fn closest_all(g: &Geometry, rays: &[Ray]) -> Vec<Hit> {
 }
 
 #[inline(never)]
-fn shadow_all(g: &Geometry, rays: &[Ray]) -> usize {
+fn shadow_all(g: &Aggregate, rays: &[Ray]) -> usize {
     rays.iter().filter(|r| g.occluded(r)).count()
 }
 
 #[inline(never)]
-fn surface_all(g: &Geometry, hits: &[Hit]) -> f32 {
+fn surface_all(g: &Aggregate, hits: &[Hit]) -> f32 {
     hits.iter().map(|h| g.surface(h).point.p.x).sum()
 }

@@ -35,7 +35,7 @@ fn coincident_triangles_build_in_n_log_n_work() {
     for n in [5_000usize, 20_000, 80_000] {
         let l = load_text(&coincident_scene(n, ""));
         let scene = RenderScene::new(&l.scene);
-        let w = scene.geometry.build_work;
+        let w = scene.aggregate.build_work;
         assert!(w.bounded, "{n}: the bounded builder should be used");
         assert_eq!(w.largest_coincident, n);
         let bound = 12.0 * n as f64 * log2(n);
@@ -56,7 +56,7 @@ fn a_few_coincident_copies_keep_ploc_and_all_scenes_render() {
     // Two copies of a triangle: PLOC as before.
     let l = load_text(&coincident_scene(2, ""));
     let scene = RenderScene::new(&l.scene);
-    assert!(!scene.geometry.build_work.bounded);
+    assert!(!scene.aggregate.build_work.bounded);
     // Coincident plus collinear slivers and a huge triangle: the render sees
     // the coincident triangle where it is (the centre pixel is lit).
     let mut extra = String::from("Shape \"trianglemesh\" \"point P\" [");

@@ -36,9 +36,9 @@ fn trace(sc: &RenderScene, o: Vec3, d: Vec3) -> Option<Found> {
         d,
         t_max: f32::INFINITY,
     };
-    let hit = sc.geometry.intersect(&ray)?;
-    let s = sc.geometry.surface(&hit);
-    let geom = sc.geometry.diff_geom(&hit, &s);
+    let hit = sc.aggregate.intersect(&ray)?;
+    let s = sc.aggregate.surface(&hit);
+    let geom = sc.aggregate.diff_geom(&hit, &s);
     Some(Found {
         t: hit.t,
         point: s.point,

@@ -181,9 +181,9 @@ fn rays_with_negative_zero_direction_components_hit() {
     ] {
         let o = Vec3::new(0.0, -0.590_630_6, 0.806_941_2);
         assert!(
-            sc.geometry.intersect(&Ray::new(o, d)).is_some(),
+            sc.aggregate.intersect(&Ray::new(o, d)).is_some(),
             "{d:?} misses"
         );
-        assert!(sc.geometry.intersect(&Ray::new(Vec3::ZERO, d)).is_some());
+        assert!(sc.aggregate.intersect(&Ray::new(Vec3::ZERO, d)).is_some());
     }
 }

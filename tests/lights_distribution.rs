@@ -55,7 +55,7 @@ fn pick_frequencies(
     for k in 0..n {
         let u = (k as f32 + 0.5) / n as f32;
         let (i, p_i) = ls
-            .sample(p, Vec3::ZERO, u, &sc.lights, &sc.geometry)
+            .sample(p, Vec3::ZERO, u, &sc.lights, &sc.aggregate)
             .expect("a light");
         let i = i as usize;
         freq[i] += 1.0 / n as f64;
@@ -72,7 +72,7 @@ fn power_picks_lights_in_proportion_to_power() {
     let sc = scene("scenes/analytic/lights.pbrt");
     assert_eq!(sc.lights.len(), 5);
     let total: f64 = sc.lights.iter().map(expected_power).sum();
-    let ls = LightSampler::new(LightSamplerKind::Power, &sc.lights, &sc.geometry);
+    let ls = LightSampler::new(LightSamplerKind::Power, &sc.lights, &sc.aggregate);
     assert_eq!(ls.kind(), LightSamplerKind::Power);
     let n = 100_000;
     let (freq, pmf) = pick_frequencies(&ls, &sc, Vec3::ZERO, n);
@@ -99,7 +99,7 @@ fn power_picks_lights_in_proportion_to_power() {
 #[test]
 fn uniform_picks_every_light_equally() {
     let sc = scene("scenes/analytic/lights.pbrt");
-    let ls = LightSampler::new(LightSamplerKind::Uniform, &sc.lights, &sc.geometry);
+    let ls = LightSampler::new(LightSamplerKind::Uniform, &sc.lights, &sc.aggregate);
     let (freq, pmf) = pick_frequencies(&ls, &sc, Vec3::ZERO, 10_000);
     for i in 0..5 {
         assert_eq!(pmf[i], 0.2f32 as f64);
@@ -118,7 +118,7 @@ fn point_light(sc: &RenderScene, i: f32) -> usize {
 #[test]
 fn spatial_is_a_valid_distribution_favouring_nearby_lights() {
     let sc = scene("scenes/analytic/lights.pbrt");
-    let ls = LightSampler::new(LightSamplerKind::Spatial, &sc.lights, &sc.geometry);
+    let ls = LightSampler::new(LightSamplerKind::Spatial, &sc.lights, &sc.aggregate);
     assert_eq!(ls.kind(), LightSamplerKind::Spatial);
     let points = [
         (Vec3::new(-1.9, 0.05, 0.05), Some(point_light(&sc, 1.0))),
@@ -168,7 +168,7 @@ fn one_light_is_uniform_for_every_strategy() {
         LightSamplerKind::Spatial,
         LightSamplerKind::Bvh,
     ] {
-        let ls = LightSampler::new(kind, &sc.lights, &sc.geometry);
+        let ls = LightSampler::new(kind, &sc.lights, &sc.aggregate);
         assert_eq!(ls.kind(), LightSamplerKind::Uniform, "{kind:?}");
         for u in [0.0, 0.3, 0.999_999] {
             let (i, pmf) = ls
@@ -177,7 +177,7 @@ fn one_light_is_uniform_for_every_strategy() {
                     Vec3::ZERO,
                     u,
                     &sc.lights,
-                    &sc.geometry,
+                    &sc.aggregate,
                 )
                 .unwrap();
             assert_eq!((i, pmf), (0, 1.0), "{kind:?}");
@@ -228,10 +228,10 @@ fn area_light_sampling_matches_its_density() {
             d.length() <= radius || wi.dot(d.normalize()) >= cos_max
         };
         let res = chi2_sphere(
-            |u: Vec2| light.sample_li(&r, u, &sc.geometry).map(|s| s.wi),
+            |u: Vec2| light.sample_li(&r, u, &sc.aggregate).map(|s| s.wi),
             |wi| {
                 if in_cone(wi) {
-                    light.pdf_li(&r, wi, &sc.geometry)
+                    light.pdf_li(&r, wi, &sc.aggregate)
                 } else {
                     0.0
                 }

@@ -52,7 +52,7 @@ fn li_towards(l: &Light, sc: &RenderScene, light_p: Vec3, w: Vec3, d: f32) -> Ve
         ns: Vec3::ZERO,
     };
     let s = l
-        .sample_li(&r, Vec2::new(0.5, 0.5), &sc.geometry)
+        .sample_li(&r, Vec2::new(0.5, 0.5), &sc.aggregate)
         .expect("a sample");
     assert_eq!(s.pdf, 1.0);
     s.li * d * d

@@ -127,7 +127,7 @@ const CASES: &[Case] = &[
             let s = sample(sc, Vec3::ZERO);
             assert_eq!((s.li, s.wi), (Vec3::new(1.0, 2.0, 3.0), Vec3::Z));
             // The scene radius comes from the built scene (preprocess).
-            let (_, r) = sc.geometry.bounds.bounding_sphere();
+            let (_, r) = sc.aggregate.bounds.bounding_sphere();
             assert!(r > 0.0 && l.scene_radius == r);
             assert_close(
                 sc.lights[0].power(),
@@ -263,7 +263,7 @@ const CASES: &[Case] = &[
             // 30° across a square window: nothing 20° off the axis.
             let off = Vec3::new(2.0 * 20f32.to_radians().tan(), 0.0, 0.0);
             let r = at(off);
-            let s = sc.lights[0].sample_li(&r, Vec2::ZERO, &sc.geometry).unwrap();
+            let s = sc.lights[0].sample_li(&r, Vec2::ZERO, &sc.aggregate).unwrap();
             assert_eq!(s.li, Vec3::ZERO);
             let cos_total = (15f32.to_radians().tan() * 2f32.sqrt()).atan().cos();
             assert_close(
@@ -303,7 +303,7 @@ fn at(p: Vec3) -> SurfacePoint {
 
 fn sample(sc: &RenderScene, p: Vec3) -> pbrs::lights::LightSample {
     sc.lights[0]
-        .sample_li(&at(p), Vec2::new(0.3, 0.6), &sc.geometry)
+        .sample_li(&at(p), Vec2::new(0.3, 0.6), &sc.aggregate)
         .expect("a sample")
 }
 
@@ -321,7 +321,7 @@ fn mean_inverse_pdf(light: &Light, sc: &RenderScene, p: Vec3) -> f32 {
     let mut sum = 0.0f64;
     for _ in 0..SAMPLES {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-        if let Some(s) = light.sample_li(&r, u, &sc.geometry) {
+        if let Some(s) = light.sample_li(&r, u, &sc.aggregate) {
             sum += 1.0 / s.pdf as f64;
         }
     }
@@ -336,7 +336,7 @@ fn check_sampling(name: &str, light: &Light, sc: &RenderScene, p: Vec3) {
     let mut some = 0;
     for _ in 0..2000 {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-        let Some(s) = light.sample_li(&r, u, &sc.geometry) else {
+        let Some(s) = light.sample_li(&r, u, &sc.aggregate) else {
             continue;
         };
         some += 1;
@@ -346,7 +346,7 @@ fn check_sampling(name: &str, light: &Light, sc: &RenderScene, p: Vec3) {
             s.li
         );
         assert!((s.wi.length() - 1.0).abs() < 1e-4, "{name}: {}", s.wi);
-        let pdf = light.pdf_li(&r, s.wi, &sc.geometry);
+        let pdf = light.pdf_li(&r, s.wi, &sc.aggregate);
         if light.is_delta() {
             assert_eq!((s.pdf, pdf), (1.0, 0.0), "{name}");
         } else {

@@ -56,7 +56,7 @@ LightSource "distant" "point from" [0 1 0] "point to" [0 0 0] "rgb L" [0.3 0.3 0
 LightSource "infinite" "rgb L" [0.1 0.1 0.1]"#;
     let loaded = load_text(&many_lights_scene(300, 8, 1, "bvh", extra));
     let scene = RenderScene::new(&loaded.scene);
-    let ls = LightSampler::new(LightSamplerKind::Bvh, &scene.lights, &scene.geometry);
+    let ls = LightSampler::new(LightSamplerKind::Bvh, &scene.lights, &scene.aggregate);
     assert_eq!(ls.kind(), LightSamplerKind::Bvh);
     let n_lights = scene.lights.len();
     assert!(n_lights >= 304);
@@ -69,7 +69,7 @@ LightSource "infinite" "rgb L" [0.1 0.1 0.1]"#;
     let mut rng = Pcg32::with_sequence(11);
     for (p, nrm) in points {
         let pmf: Vec<f64> = (0..n_lights as u32)
-            .map(|i| ls.pmf(p, nrm, i, &scene.lights, &scene.geometry) as f64)
+            .map(|i| ls.pmf(p, nrm, i, &scene.lights, &scene.aggregate) as f64)
             .collect();
         let sum: f64 = pmf.iter().sum();
         // A light of pmf 0 must be one that cannot reach p (else the
@@ -78,7 +78,7 @@ LightSource "infinite" "rgb L" [0.1 0.1 0.1]"#;
         for &z in &zeros {
             for k in 0..16 {
                 let u = glam::Vec2::new((k % 4) as f32 / 4.0 + 0.1, (k / 4) as f32 / 4.0 + 0.1);
-                let c = scene.lights[z].contribution_estimate(p, u, &scene.geometry);
+                let c = scene.lights[z].contribution_estimate(p, u, &scene.aggregate);
                 assert!(c == 0.0, "light {z} has pmf 0 at {p} but contributes {c}");
             }
         }
@@ -95,7 +95,7 @@ LightSource "infinite" "rgb L" [0.1 0.1 0.1]"#;
         let mut failed = 0usize;
         for _ in 0..draws {
             let u = rng.uniform_f32();
-            let Some((i, q)) = ls.sample(p, nrm, u, &scene.lights, &scene.geometry) else {
+            let Some((i, q)) = ls.sample(p, nrm, u, &scene.lights, &scene.aggregate) else {
                 failed += 1;
                 continue;
             };
@@ -204,11 +204,11 @@ fn spatial_falls_back_to_the_bvh_past_the_light_limit() {
     let n = pbrs::lights::SPATIAL_MAX_LIGHTS + 1;
     let l = load_text(&many_lights_scene(n, 4, 1, "spatial", ""));
     let scene = RenderScene::new(&l.scene);
-    let ls = LightSampler::new(LightSamplerKind::Spatial, &scene.lights, &scene.geometry);
+    let ls = LightSampler::new(LightSamplerKind::Spatial, &scene.lights, &scene.aggregate);
     assert_eq!(ls.kind(), LightSamplerKind::Bvh);
     assert!(ls.spatial_fallback());
     let l = load_text(&many_lights_scene(n - 1, 4, 1, "spatial", ""));
     let scene = RenderScene::new(&l.scene);
-    let ls = LightSampler::new(LightSamplerKind::Spatial, &scene.lights, &scene.geometry);
+    let ls = LightSampler::new(LightSamplerKind::Spatial, &scene.lights, &scene.aggregate);
     assert_eq!(ls.kind(), LightSamplerKind::Spatial);
 }

@@ -471,7 +471,7 @@ WorldEnd
 #[test]
 fn rays_hit_a_moving_sphere_where_its_transform_puts_it() {
     let sc = render_scene(MOVING);
-    let g = &sc.geometry;
+    let g = &sc.aggregate;
     assert_eq!(g.moving_count(), 2);
     for (x, time, hit) in [
         (0.0, 0.0, true),
@@ -500,7 +500,7 @@ fn rays_hit_a_moving_sphere_where_its_transform_puts_it() {
 #[test]
 fn rays_hit_a_turning_triangle_where_its_transform_puts_it() {
     let sc = render_scene(MOVING);
-    let g = &sc.geometry;
+    let g = &sc.aggregate;
     // At time 0 the triangle lies along +x (at z = -3), at time 1 along +y,
     // halfway along the diagonal.
     let on = |x: f32, y: f32, t: f32| {
@@ -542,7 +542,7 @@ AttributeEnd
 WorldEnd
 "#;
     let sc = render_scene(text);
-    let g = &sc.geometry;
+    let g = &sc.aggregate;
     assert_eq!((g.instance_count(), g.moving_count()), (1, 1));
     for t in [0.0, 0.3, 1.0] {
         assert!(g.intersect_at(&down(-3.0, 0.0), t).is_some());
@@ -658,7 +658,7 @@ fn a_static_scene_ignores_transform_times_and_the_shutter() {
     ));
     assert_eq!(plain, same);
     let sc = render_scene(&format!("{head}{STILL_WORLD}"));
-    assert_eq!(sc.geometry.moving_count(), 0);
+    assert_eq!(sc.aggregate.moving_count(), 0);
     assert!(!sc.camera.is_moving());
     assert!(sc
         .notes
@@ -744,7 +744,7 @@ fn singular_and_mirrored_animated_transforms_warn_and_never_panic() {
     let w = warnings_of(&text);
     assert!(w.iter().any(|w| w.contains("singular")), "{w:?}");
     let sc = render_scene(&text);
-    assert_eq!(sc.geometry.moving_count(), 0);
+    assert_eq!(sc.aggregate.moving_count(), 0);
     assert!(sc.notes.iter().any(|n| n.contains("singular start or end")));
     assert!(image(&text).iter().all(|v| v.is_finite()));
     // A mirror at the end: warned (pbrt-v3 interpolates it wrongly); the
@@ -754,11 +754,11 @@ fn singular_and_mirrored_animated_transforms_warn_and_never_panic() {
     let w = warnings_of(&text);
     assert!(w.iter().any(|w| w.contains("mirror")), "{w:?}");
     let sc = render_scene(&text);
-    assert_eq!(sc.geometry.moving_count(), 1);
+    assert_eq!(sc.aggregate.moving_count(), 1);
     let ray = Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::Z);
-    assert!(sc.geometry.intersect_at(&ray, 0.0).is_some());
-    assert!(sc.geometry.intersect_at(&ray, 1.0).is_some());
-    assert!(!sc.geometry.occluded_at(
+    assert!(sc.aggregate.intersect_at(&ray, 0.0).is_some());
+    assert!(sc.aggregate.intersect_at(&ray, 1.0).is_some());
+    assert!(!sc.aggregate.occluded_at(
         &Ray {
             t_max: 100.0,
             ..ray
@@ -794,6 +794,6 @@ WorldEnd
         "{w:?}"
     );
     let sc = render_scene(text);
-    assert_eq!(sc.geometry.moving_count(), 0);
-    assert!(sc.geometry.intersect_at(&down(0.0, 0.0), 1.0).is_some());
+    assert_eq!(sc.aggregate.moving_count(), 0);
+    assert!(sc.aggregate.intersect_at(&down(0.0, 0.0), 1.0).is_some());
 }

@@ -468,14 +468,14 @@ fn quadric_lights_sample_with_their_pdf_li() {
             };
             for _ in 0..20_000 {
                 let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-                let Some(s) = light.sample_li(&r, u, &sc.geometry) else {
+                let Some(s) = light.sample_li(&r, u, &sc.aggregate) else {
                     continue;
                 };
                 assert!(s.pdf.is_finite() && s.pdf > 0.0);
                 // Samples hidden behind the shape's own front see another
                 // point first; pbrt-v3's Pdf (the first hit's) then differs,
                 // as the shadow ray would block the sample anyway.
-                let pdf = light.pdf_li(&r, s.wi, &sc.geometry);
+                let pdf = light.pdf_li(&r, s.wi, &sc.aggregate);
                 if (pdf - s.pdf).abs() <= 1e-3 * s.pdf {
                     n_ok += 1;
                 }

@@ -193,8 +193,8 @@ fn disk_light_sampling_matches_its_density() {
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for _ in 0..n {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-        let s = light.sample_li(&r, u, &sc.geometry).expect("a sample");
-        let pdf = light.pdf_li(&r, s.wi, &sc.geometry);
+        let s = light.sample_li(&r, u, &sc.aggregate).expect("a sample");
+        let pdf = light.pdf_li(&r, s.wi, &sc.aggregate);
         assert!(
             (pdf - s.pdf).abs() <= 1e-3 * s.pdf,
             "sampled density {} vs pdf_li {pdf}",
@@ -232,7 +232,7 @@ fn partial_disk_density_integrates_to_one() {
         let phi = rng.uniform_f32() * std::f32::consts::TAU;
         let s = (1.0 - z * z).max(0.0).sqrt();
         let w = Vec3::new(s * phi.cos(), s * phi.sin(), z);
-        let f = light.pdf_li(&r, w, &sc.geometry) as f64 * 4.0 * PI;
+        let f = light.pdf_li(&r, w, &sc.aggregate) as f64 * 4.0 * PI;
         sum += f;
         sum2 += f * f;
     }
@@ -381,8 +381,8 @@ fn cylinder_light_sampling_matches_its_density() {
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for _ in 0..n {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-        let s = light.sample_li(&p, u, &sc.geometry).expect("a sample");
-        let pdf = light.pdf_li(&p, s.wi, &sc.geometry);
+        let s = light.sample_li(&p, u, &sc.aggregate).expect("a sample");
+        let pdf = light.pdf_li(&p, s.wi, &sc.aggregate);
         assert!((pdf - s.pdf).abs() <= 1e-3 * s.pdf, "{} vs {pdf}", s.pdf);
         let inv = 1.0 / s.pdf as f64;
         sum += inv;

@@ -136,7 +136,7 @@ fn probe_rays_find_the_hits_of_the_entry_points_material() {
         "WorldBegin\nMaterial \"subsurface\"\nShape \"sphere\" \"float radius\" 1\nAttributeBegin\nTranslate 3 0 0\nMaterial \"matte\"\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\nWorldEnd\n",
     );
     let rs = RenderScene::new(&s.scene);
-    let g = &rs.geometry;
+    let g = &rs.aggregate;
     let material_at = |o: Vec3| {
         let h = g.intersect_at(&Ray::new(o, Vec3::NEG_Z), 0.0).unwrap();
         g.surface_at(&h, 0.0).material

@@ -178,7 +178,7 @@ fn alpha_cuts_closest_hits_and_shadow_rays() {
         "{CK}\n{QUAD} \"texture alpha\" \"ck\"\nTranslate 5 0 0\n{QUAD} \"texture shadowalpha\" \"ck\""
     ));
     assert!(w.is_empty(), "{w}");
-    let g = &rs.geometry;
+    let g = &rs.aggregate;
     let (mut cut, mut kept) = (0, 0);
     for p in sample_points() {
         let s = solid(p.x, p.y);
@@ -205,7 +205,7 @@ fn alpha_cuts_closest_hits_and_shadow_rays() {
         .find(|p| !solid(p.x, p.y))
         .unwrap();
     let h = behind
-        .geometry
+        .aggregate
         .intersect(&down_ray(hole.x, hole.y))
         .unwrap();
     assert!((h.t - 3.0).abs() < 1e-4, "{}", h.t);
@@ -218,7 +218,7 @@ fn alpha_in_instances_and_constant_alphas() {
     ));
     for p in sample_points() {
         assert_eq!(
-            rs.geometry.intersect(&down_ray(p.x, p.y + 10.0)).is_some(),
+            rs.aggregate.intersect(&down_ray(p.x, p.y + 10.0)).is_some(),
             solid(p.x, p.y),
             "{p}"
         );
@@ -226,7 +226,7 @@ fn alpha_in_instances_and_constant_alphas() {
     // A constant alpha 0 hides a shape from every ray: it is left out
     // (noted), unless it emits (lights still sample it).
     let (rs, _, skipped) = render_scene(&format!("{QUAD} \"float alpha\" 0"));
-    assert!(rs.geometry.meshes.is_empty());
+    assert!(rs.aggregate.meshes.is_empty());
     assert!(
         skipped.iter().any(|s| s.contains("\"alpha\" 0")),
         "{skipped:?}"
@@ -235,12 +235,12 @@ fn alpha_in_instances_and_constant_alphas() {
         "AreaLightSource \"diffuse\"\n{QUAD} \"float alpha\" 0"
     ));
     assert_eq!(rs.lights.len(), 2, "an emitter stays a light");
-    assert!(rs.geometry.intersect(&down_ray(0.1, 0.1)).is_none());
+    assert!(rs.aggregate.intersect(&down_ray(0.1, 0.1)).is_none());
     // Constants other than 0 cut nothing; a missing texture warns.
     let (rs, w, _) = render_scene(&format!(
         "{QUAD} \"float alpha\" 0.5\nTranslate 5 0 0\n{QUAD} \"texture alpha\" \"nope\"\nShape \"sphere\" \"float alpha\" 0"
     ));
-    assert!(rs.geometry.meshes.iter().all(|m| m.alpha.is_none()));
+    assert!(rs.aggregate.meshes.iter().all(|m| m.alpha.is_none()));
     assert!(
         w.contains("couldn't find float texture \"nope\" for \"alpha\""),
         "{w}"

@@ -579,8 +579,8 @@ impl Shapes<'_> {
     }
 }
 
-/// All geometry of a scene and the BVHs over it.
-pub struct Geometry {
+/// The aggregate: every shape of a scene placed in world space (meshes, analytic shapes, instances, moving instances) and the BVHs over them, which rays are traced against (pbrt-v3's `Aggregate`).
+pub struct Aggregate {
     /// World-space meshes (lights refer to their triangles by index).
     pub meshes: Vec<TriangleMesh>,
     /// World-space quadrics (spheres, disks).
@@ -601,10 +601,10 @@ pub struct Geometry {
     pub build_time: Duration,
 }
 
-impl Geometry {
+impl Aggregate {
     /// Builds the scene-level BVH over world-space shapes alone.
-    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<AnalyticShape>) -> Geometry {
-        Geometry::with_instances(meshes, quadrics, Vec::new())
+    pub fn new(meshes: Vec<TriangleMesh>, quadrics: Vec<AnalyticShape>) -> Aggregate {
+        Aggregate::with_instances(meshes, quadrics, Vec::new())
     }
 
     /// Builds the scene-level BVH over world-space shapes and instances (whose
@@ -613,8 +613,8 @@ impl Geometry {
         meshes: Vec<TriangleMesh>,
         quadrics: Vec<AnalyticShape>,
         instances: Vec<Instance>,
-    ) -> Geometry {
-        Geometry::with_motion(meshes, quadrics, instances, Vec::new())
+    ) -> Aggregate {
+        Aggregate::with_motion(meshes, quadrics, instances, Vec::new())
     }
 
     /// `with_instances` with moving instances too: the scene-level BVH holds
@@ -624,7 +624,7 @@ impl Geometry {
         quadrics: Vec<AnalyticShape>,
         instances: Vec<Instance>,
         moving: Vec<MovingInstance>,
-    ) -> Geometry {
+    ) -> Aggregate {
         let start = std::time::Instant::now();
         let instances: Vec<Instance> = instances
             .into_iter()
@@ -651,7 +651,7 @@ impl Geometry {
                 degenerate += o.level.degenerate;
             }
         }
-        Geometry {
+        Aggregate {
             meshes,
             quadrics,
             bounds: top.bounds,
@@ -696,7 +696,7 @@ impl Geometry {
     /// with wider loads stalls store forwarding.)
     ///
     /// At time 0: for a still scene (or a test); a path takes
-    /// [`Geometry::intersect_at`] with its time.
+    /// [`Aggregate::intersect_at`] with its time.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.intersect_at(ray, 0.0)
@@ -709,7 +709,7 @@ impl Geometry {
         self.closest_at(ray, time)
     }
 
-    /// [`Geometry::intersect_at`] written to `out`: the batched loops keep
+    /// [`Aggregate::intersect_at`] written to `out`: the batched loops keep
     /// their hits in an array, and a hit returned by value is stored by the
     /// callee and at once copied by the caller with wider loads than its
     /// stores (a store-forwarding stall on every ray).
@@ -761,7 +761,7 @@ impl Geometry {
     }
 
     /// True if anything blocks the ray before `t_max`, at time 0 (see
-    /// [`Geometry::intersect`]).
+    /// [`Aggregate::intersect`]).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.occluded_at(ray, 0.0)
@@ -809,7 +809,7 @@ impl Geometry {
         place.geom_to_world(shapes.diff_geom(hit.prim, hit.local, local.point.ns))
     }
 
-    /// Shading data of a hit found at time 0 (see [`Geometry::intersect`]).
+    /// Shading data of a hit found at time 0 (see [`Aggregate::intersect`]).
     #[inline]
     pub fn surface(&self, hit: &Hit) -> SurfaceHit {
         self.surface_at(hit, 0.0)

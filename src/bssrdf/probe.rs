@@ -19,7 +19,7 @@
 //! hit, twice the probe rays).
 
 use super::tabulated::TabulatedBssrdf;
-use crate::accel::{Geometry, SurfaceHit};
+use crate::accel::{Aggregate, SurfaceHit};
 use crate::geometry::{spawn_ray_to_point, Frame, Ray, SHADOW_EPSILON};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -88,7 +88,7 @@ const MAX_PROBE_HITS: u32 = 64;
 /// `material`) for each; stops when `visit` returns true. Returns the
 /// number of admissible hits seen.
 fn walk(
-    geometry: &Geometry,
+    geometry: &Aggregate,
     seg: &ProbeSegment,
     material: u32,
     time: f32,
@@ -128,7 +128,7 @@ fn walk(
 /// the probe finds none. The caller divides [`pdf_sp`] by the count.
 /// `rays` counts the probe rays traced.
 pub fn find_exit(
-    geometry: &Geometry,
+    geometry: &Aggregate,
     seg: &ProbeSegment,
     material: u32,
     time: f32,

@@ -8,7 +8,7 @@ pub const SHADOW_EPSILON: f32 = 0.0001;
 ///
 /// pbrt-v3's `Ray::time` is not a field: every ray of a path has the camera
 /// ray's time, so the integrators keep it once per path and pass it to the
-/// `*_at` queries of [`Geometry`](crate::accel::Geometry), and a
+/// `*_at` queries of [`Aggregate`](crate::accel::Aggregate), and a
 /// still scene's rays stay 28 bytes.
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {

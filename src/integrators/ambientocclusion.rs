@@ -131,10 +131,10 @@ impl Integrate for AmbientOcclusion {
         let mut crossed = 0;
         let (hit, s) = loop {
             scratch.counts.closest += 1;
-            let Some(hit) = scene.geometry.intersect_at(&ray, time) else {
+            let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
                 return Vec3::ZERO;
             };
-            let s = scene.geometry.surface_at(&hit, time);
+            let s = scene.aggregate.surface_at(&hit, time);
             if !scene.materials[s.material as usize].is_none() {
                 break (hit, s);
             }
@@ -145,7 +145,7 @@ impl Integrate for AmbientOcclusion {
             ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
         };
         let n = face_forward(s.point.n, -ray.d);
-        let dpdu = scene.geometry.diff_geom(&hit, &s).dpdu;
+        let dpdu = scene.aggregate.diff_geom(&hit, &s).dpdu;
         let sx = dpdu.normalize();
         let t = s.point.n.cross(sx);
         let Some(u) = sampler.get_2d_array(self.n) else {
@@ -167,7 +167,7 @@ impl Integrate for AmbientOcclusion {
             );
             scratch.counts.shadow += 1;
             let shadow = spawn_ray(s.point.p, s.point.p_error, s.point.n, wi);
-            if !scene.geometry.occluded_at(&shadow, time) {
+            if !scene.aggregate.occluded_at(&shadow, time) {
                 l += wi.dot(n) / (pdf * count);
             }
         }

@@ -112,7 +112,7 @@ pub(super) fn trace_paths<M: PathMedium>(
             scratch.counts.closest += 1;
             let ray = &states[j].ray;
             scene
-                .geometry
+                .aggregate
                 .intersect_into(ray, b.times[j], &mut b.hits[j]);
         }
         let mut kept = 0;
@@ -143,7 +143,7 @@ pub(super) fn trace_camera_rays(b: &mut Batch, scene: &RenderScene) {
     for j in 0..b.len {
         if b.weights[j] > 0.0 {
             let hit = &mut b.hits[j];
-            scene.geometry.intersect_into(&b.rays[j], b.times[j], hit);
+            scene.aggregate.intersect_into(&b.rays[j], b.times[j], hit);
         }
     }
 }

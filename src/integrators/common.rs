@@ -22,7 +22,7 @@ use glam::{Vec2, Vec3};
 /// derivatives of ray differentials `d`.
 #[inline]
 pub(super) fn with_diff(scene: &RenderScene, hit: &Hit, s: &SurfaceHit, d: &RayDiff) -> DiffGeom {
-    let mut g = scene.geometry.diff_geom(hit, s);
+    let mut g = scene.aggregate.diff_geom(hit, s);
     g.compute_differentials(s.point.p, s.point.n, d);
     g
 }
@@ -42,7 +42,7 @@ pub(super) fn shade<'a>(
 ) {
     let geom = match diff {
         Some(d) if scene.material_needs_geom[s.material as usize] => {
-            let mut g = scene.geometry.diff_geom(hit, s);
+            let mut g = scene.aggregate.diff_geom(hit, s);
             g.compute_differentials(s.point.p, s.point.n, d);
             Some(g)
         }
@@ -72,7 +72,7 @@ pub(super) fn shade_geom<'a>(
     if let Some(geom) = geom.filter(|_| needs_geom) {
         material.bsdf_into(&ShadingContext { hit: s, geom }, &ctx, bsdf);
     } else if needs_geom {
-        let geom = scene.geometry.diff_geom(hit, s);
+        let geom = scene.aggregate.diff_geom(hit, s);
         material.bsdf_into(
             &ShadingContext {
                 hit: s,
@@ -213,11 +213,11 @@ pub(super) fn bsdf_mis_weight(
 ) -> f32 {
     // The context of the vertex the BSDF sample left (pbrt-v4's
     // PMF(prevIntrCtx, light)).
-    let pmf = lights.pmf(r.p, r.n, light, &scene.lights, &scene.geometry);
+    let pmf = lights.pmf(r.p, r.n, light, &scene.lights, &scene.aggregate);
     if pmf == 0.0 {
         return 1.0;
     }
-    let light_pdf = pmf * scene.lights[light as usize].pdf_li(r, wi, &scene.geometry);
+    let light_pdf = pmf * scene.lights[light as usize].pdf_li(r, wi, &scene.aggregate);
     power_heuristic(1, bsdf_pdf, 1, light_pdf)
 }
 
@@ -248,7 +248,7 @@ pub(super) fn choose_light(
     }
     let u = sampler.get_1d();
     let early = (first == LightSampleFirst::Yes).then(|| sampler.get_2d());
-    let (light, pmf) = lights.sample(point.p, point.n, u, &scene.lights, &scene.geometry)?;
+    let (light, pmf) = lights.sample(point.p, point.n, u, &scene.lights, &scene.aggregate)?;
     let u_light = match early {
         Some(u_light) => u_light,
         None => sampler.get_2d(),
@@ -324,7 +324,7 @@ impl ShadowRay for Unoccluded {
         scratch: &mut Scratch,
     ) -> Option<Vec3> {
         scratch.counts.shadow += 1;
-        (!scene.geometry.occluded_at(shadow, time)).then_some(f)
+        (!scene.aggregate.occluded_at(shadow, time)).then_some(f)
     }
 }
 
@@ -392,7 +392,7 @@ pub(super) fn light_strategy(
     let light = &scene.lights[light_index as usize];
     // Read in place: moved out of the option, the sample was copied by
     // wide loads that stalled on the narrower stores that had just made it.
-    let sample = light.sample_li(point, u_light, &scene.geometry);
+    let sample = light.sample_li(point, u_light, &scene.aggregate);
     let Some(ls) = sample.as_ref() else {
         return Vec3::ZERO;
     };
@@ -428,9 +428,9 @@ pub(super) fn light_along(
 ) -> Vec3 {
     scratch.counts.closest += 1;
     let light = &scene.lights[light_index as usize];
-    match scene.geometry.intersect_at(ray, time) {
+    match scene.aggregate.intersect_at(ray, time) {
         Some(h) => {
-            let hs = scene.geometry.surface_at(&h, time);
+            let hs = scene.aggregate.surface_at(&h, time);
             if hs.light == Some(light_index) {
                 light.emitted(hs.point.n, -wi)
             } else {
@@ -450,5 +450,5 @@ pub(super) fn light_sampler(strategy: LightSampleStrategy, scene: &RenderScene) 
         LightSampleStrategy::Spatial => LightSamplerKind::Spatial,
         LightSampleStrategy::Bvh => LightSamplerKind::Bvh,
     };
-    LightSampler::new(kind, &scene.lights, &scene.geometry)
+    LightSampler::new(kind, &scene.lights, &scene.aggregate)
 }

@@ -295,7 +295,7 @@ fn lane_ld(
                 lane3(&e.q_error, lane),
                 lane3(&pack.n, lane),
             );
-            if !scene.geometry.occluded_at(&shadow, v.time) {
+            if !scene.aggregate.occluded_at(&shadow, v.time) {
                 let li = lane3(&pack.l, lane);
                 let light_pdf = 1.0 * e.pdf_l[lane];
                 ld = f * li * power_heuristic(1, light_pdf, 1, e.scatter_pdf_l[lane]) / light_pdf;

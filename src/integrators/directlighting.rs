@@ -303,7 +303,7 @@ impl DirectLighting {
                 b.l[j] = go_on(First::Hit(None), &mut bsdf);
                 continue;
             };
-            let mut s = scene.geometry.surface_at(&hit, time);
+            let mut s = scene.aggregate.surface_at(&hit, time);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 b.l[j] = go_on(First::Hit(Some(hit)), &mut bsdf);
@@ -427,7 +427,7 @@ pub(super) fn estimate_direct(
     scratch: &mut Scratch,
 ) -> Vec3 {
     let light = &scene.lights[light_index as usize];
-    let geom = &scene.geometry;
+    let geom = &scene.aggregate;
     let ns = s.point.ns;
     let scatter = SurfaceScatter {
         bsdf,

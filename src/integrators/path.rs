@@ -195,7 +195,7 @@ pub(super) fn path_li<M: PathMedium>(
     let mut bsdf = Bsdf::empty();
     loop {
         scratch.counts.closest += 1;
-        let hit = p.scene.geometry.intersect_at(&st.ray, p.time);
+        let hit = p.scene.aggregate.intersect_at(&st.ray, p.time);
         if !path_step(&mut st, &hit, p, sampler, scratch, &mut bsdf) {
             break;
         }
@@ -449,7 +449,7 @@ pub(super) fn path_step<'a, M: PathMedium>(
         );
         return false;
     };
-    let mut s = scene.geometry.surface_at(hit, time);
+    let mut s = scene.aggregate.surface_at(hit, time);
     let wo = -ray.d;
     st.l += emitted_mis(
         scene,

@@ -3,14 +3,14 @@
 //! `crate::render::compile` makes it from the scene description
 //! ([`RenderScene::new`]); only what the scene references is built.
 
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::cameras::Camera;
 use crate::lights::Light;
 use crate::materials::Material;
 use crate::media::Medium;
 
 pub struct RenderScene {
-    pub geometry: Geometry,
+    pub aggregate: Aggregate,
     pub materials: Vec<Material>,
     /// `materials[i].needs_geom()`, computed once: the answer walks the
     /// material's textures (and a mix's materials), too much for every hit.

@@ -90,13 +90,13 @@ pub(super) fn specular_tree_li<'a>(
             f => {
                 let hit = match f {
                     First::Hit(h) => h,
-                    _ => scene.geometry.intersect_at(&w.ray, time),
+                    _ => scene.aggregate.intersect_at(&w.ray, time),
                 };
                 let Some(hit) = hit else {
                     l += w.beta * escaped(scene, w.ray.d);
                     continue;
                 };
-                let mut s = scene.geometry.surface_at(&hit, time);
+                let mut s = scene.aggregate.surface_at(&hit, time);
                 let material = &scene.materials[s.material as usize];
                 if material.is_none() {
                     if w.pass < MAX_PASS_THROUGH {

@@ -35,7 +35,7 @@ pub(super) fn subsurface_exit<'a>(
     let u1 = sampler.get_1d();
     let u2 = sampler.get_2d();
     let geom = if scene.material_needs_geom[s.material as usize] {
-        scene.geometry.diff_geom(hit, s)
+        scene.aggregate.diff_geom(hit, s)
     } else {
         DiffGeom::ZERO
     };
@@ -45,7 +45,7 @@ pub(super) fn subsurface_exit<'a>(
     })?;
     let seg = probe_segment(&b, s.point.p, frame, u1, u2)?;
     let (pi, found) = find_exit(
-        &scene.geometry,
+        &scene.aggregate,
         &seg,
         s.material,
         time,

@@ -225,7 +225,7 @@ pub(super) fn transmittance(
 ) -> Vec3 {
     if !scene.has_pass_through {
         scratch.counts.shadow += 1;
-        if scene.geometry.occluded_at(shadow, time) {
+        if scene.aggregate.occluded_at(shadow, time) {
             return Vec3::ZERO;
         }
         return match medium {
@@ -241,13 +241,13 @@ pub(super) fn transmittance(
     let mut tr = Vec3::ONE;
     for _ in 0..=MAX_PASS_THROUGH {
         scratch.counts.shadow += 1;
-        let Some(hit) = scene.geometry.intersect_at(&ray, time) else {
+        let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
             if let Some(m) = medium {
                 tr *= scene.media[m as usize].tr(&ray, sampler);
             }
             return tr;
         };
-        let s = scene.geometry.surface_at(&hit, time);
+        let s = scene.aggregate.surface_at(&hit, time);
         if !scene.materials[s.material as usize].is_none() {
             return Vec3::ZERO;
         }

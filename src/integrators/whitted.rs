@@ -113,7 +113,7 @@ impl SpecularTree for Whitted {
     ) {
         for light in &scene.lights {
             let u = sampler.get_2d();
-            let Some(ls) = light.sample_li(&s.point, u, &scene.geometry) else {
+            let Some(ls) = light.sample_li(&s.point, u, &scene.aggregate) else {
                 continue;
             };
             if ls.li == Vec3::ZERO || ls.pdf == 0.0 {
@@ -122,7 +122,7 @@ impl SpecularTree for Whitted {
             let f = bsdf.f(wo, ls.wi, BxdfFlags::ALL);
             if f != Vec3::ZERO {
                 scratch.counts.shadow += 1;
-                if !scene.geometry.occluded_at(&ls.shadow, s.time) {
+                if !scene.aggregate.occluded_at(&ls.shadow, s.time) {
                     *local += f * ls.li * ls.wi.dot(s.point.ns).abs() / ls.pdf;
                 }
             }

@@ -14,7 +14,7 @@
 //! sphere or cone of directions).
 
 use super::Light;
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::Bounds3;
 use crate::sampling::ONE_MINUS_EPSILON;
 use glam::Vec3;
@@ -160,7 +160,7 @@ fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
 /// The bounds of a light (each kind's [`LightModel::bounds`](super::LightModel::bounds)),
 /// None for lights at infinity (distant, infinite) and lights that emit
 /// nothing.
-pub fn light_bounds(light: &Light, geom: &Geometry) -> Option<LightBounds> {
+pub fn light_bounds(light: &Light, geom: &Aggregate) -> Option<LightBounds> {
     let b = light.bounds(geom)?;
     if !(b.phi > 0.0 && b.phi.is_finite()) {
         return None;
@@ -197,7 +197,7 @@ const BUCKETS: usize = 12;
 
 impl LightBvh {
     /// Builds over the scene lights listed in `active` (those that emit).
-    pub fn new(active: &[u32], lights: &[Light], geom: &Geometry) -> LightBvh {
+    pub fn new(active: &[u32], lights: &[Light], geom: &Aggregate) -> LightBvh {
         let mut infinite = Vec::new();
         let mut is_infinite = vec![false; lights.len()];
         let mut items: Vec<(u32, LightBounds)> = Vec::new();

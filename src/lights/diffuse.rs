@@ -20,7 +20,7 @@
 
 use super::bvh::LightBounds;
 use super::{contribution_by_sampling, AreaLightKind, LightModel, LightSample};
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::{luminance, spawn_ray, spawn_ray_to, Bounds3, Ray};
 use crate::scene::{ParamSpec, ParamValues, Support};
 use crate::shapes::{sample_triangle_point, SurfacePoint};
@@ -94,7 +94,7 @@ pub struct DiffuseLight {
 
 impl DiffuseLight {
     /// The light of `shape` (already in `geom`) emitting as `e` says.
-    pub fn new(e: DiffuseEmission, shape: AreaShape, geom: &Geometry) -> DiffuseLight {
+    pub fn new(e: DiffuseEmission, shape: AreaShape, geom: &Aggregate) -> DiffuseLight {
         let (area, tri) = match shape {
             AreaShape::Triangle { mesh, tri } => (
                 geom.meshes[mesh as usize].area(tri),
@@ -141,7 +141,7 @@ impl LightModel for DiffuseLight {
     }
 
     #[inline]
-    fn contribution(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
+    fn contribution(&self, p: Vec3, u: Vec2, geom: &Aggregate) -> f32 {
         let AreaShape::Triangle { mesh, tri: t } = self.shape else {
             return contribution_by_sampling(self, p, u, geom);
         };
@@ -162,7 +162,7 @@ impl LightModel for DiffuseLight {
     }
 
     #[inline]
-    fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample> {
+    fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Aggregate) -> Option<LightSample> {
         let (l, two_sided, area, cache) = (self.l, self.two_sided, self.area, self.tri);
         let s = match self.shape {
             AreaShape::Triangle { .. } if cache.n != Vec3::ZERO => {
@@ -198,12 +198,12 @@ impl LightModel for DiffuseLight {
     /// pbrt-v3's `Pdf_Li`: the ray is tested against the light's own shape
     /// only.
     #[inline]
-    fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
+    fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Aggregate) -> f32 {
         self.pdf_li_ray(r, &spawn_ray(r.p, r.p_error, r.n, wi), geom)
     }
 
     #[inline]
-    fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Geometry) -> f32 {
+    fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Aggregate) -> f32 {
         match self.shape {
             AreaShape::Triangle { .. } => self.tri.hit_pdf(ray),
             AreaShape::Analytic(i) => {
@@ -214,7 +214,7 @@ impl LightModel for DiffuseLight {
 
     /// pbrt-v4's: the shape's bounds, its normal's cone (the whole sphere
     /// unless the normal is constant), φ = L·area (twice for two-sided).
-    fn bounds(&self, geom: &Geometry) -> Option<LightBounds> {
+    fn bounds(&self, geom: &Aggregate) -> Option<LightBounds> {
         let phi = luminance(self.l) * self.area * if self.two_sided { 2.0 } else { 1.0 };
         let tri = self.tri;
         let (bounds, w, cos_theta_o) = match self.shape {
@@ -248,7 +248,7 @@ pub enum AreaShape {
         mesh: u32,
         tri: u32,
     },
-    /// A sphere, disk or other analytic shape of `Geometry::quadrics`.
+    /// A sphere, disk or other analytic shape of `Aggregate::quadrics`.
     Analytic(u32),
 }
 
@@ -273,7 +273,7 @@ pub struct TriangleCache {
 pub(super) const HIT_SLACK: f32 = 1e-4;
 
 impl TriangleCache {
-    pub fn new(geom: &Geometry, mesh: u32, tri: u32) -> TriangleCache {
+    pub fn new(geom: &Aggregate, mesh: u32, tri: u32) -> TriangleCache {
         let m = &geom.meshes[mesh as usize];
         let p = m.vertices(tri);
         let corners =

@@ -14,7 +14,7 @@
 //! built, [`LightModel::preprocess`]).
 
 use super::{LightKind, LightModel, LightSample};
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::spawn_ray_to_point;
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
 use crate::shapes::SurfacePoint;
@@ -91,7 +91,7 @@ impl LightModel for DistantLight {
     }
 
     #[inline]
-    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
         let far = r.p + self.w * (2.0 * self.scene_radius);
         Some(LightSample {
             li: self.l,
@@ -101,7 +101,7 @@ impl LightModel for DistantLight {
         })
     }
 
-    fn preprocess(&mut self, geom: &Geometry) {
+    fn preprocess(&mut self, geom: &Aggregate) {
         self.scene_radius = geom.bounds.bounding_sphere().1;
     }
 }

@@ -11,7 +11,7 @@
 
 use super::bvh::LightBvh;
 use super::Light;
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::Bounds3;
 use crate::sampling::distribution::{find_interval_by, sanitise_u};
 use crate::sampling::Distribution1D;
@@ -175,7 +175,7 @@ fn halton_points() -> &'static [[f32; 5]; VOXEL_SAMPLES] {
 impl LightSampler {
     /// Builds only what the strategy needs: nothing for one light or uniform,
     /// a power table, or an (initially empty) voxel grid.
-    pub fn new(kind: LightSamplerKind, lights: &[Light], geom: &Geometry) -> LightSampler {
+    pub fn new(kind: LightSamplerKind, lights: &[Light], geom: &Aggregate) -> LightSampler {
         let active: Vec<u32> = (0..lights.len() as u32)
             .filter(|&i| lights[i as usize].power() > 0.0)
             .collect();
@@ -287,7 +287,7 @@ impl LightSampler {
         normal: Vec3,
         u: f32,
         lights: &[Light],
-        geom: &Geometry,
+        geom: &Aggregate,
     ) -> Option<(u32, f32)> {
         let n = self.active.len();
         if n == 0 {
@@ -314,7 +314,14 @@ impl LightSampler {
     /// Probability that `sample` at `p` (normal `normal`) chooses scene
     /// light `light`.
     #[inline]
-    pub fn pmf(&self, p: Vec3, normal: Vec3, light: u32, lights: &[Light], geom: &Geometry) -> f32 {
+    pub fn pmf(
+        &self,
+        p: Vec3,
+        normal: Vec3,
+        light: u32,
+        lights: &[Light],
+        geom: &Aggregate,
+    ) -> f32 {
         let n = self.active.len();
         let Some(&k) = self.active_pos.get(light as usize) else {
             return 0.0;
@@ -347,7 +354,7 @@ impl SpatialGrid {
         p: Vec3,
         active: &[u32],
         lights: &[Light],
-        geom: &Geometry,
+        geom: &Aggregate,
         local: &'a mut Vec<f32>,
     ) -> VoxelCdf<'a> {
         let o = self.bounds.offset(p);
@@ -402,7 +409,7 @@ impl SpatialGrid {
     /// pbrt-v3's SpatialLightDistribution::ComputeDistribution: estimate each
     /// light's contribution (Li/pdf, visibility ignored) at 128 Halton points
     /// of the voxel, and floor every light at 0.1% of the average.
-    fn compute(&self, v: [i32; 3], active: &[u32], lights: &[Light], geom: &Geometry) -> Vec<f32> {
+    fn compute(&self, v: [i32; 3], active: &[u32], lights: &[Light], geom: &Aggregate) -> Vec<f32> {
         let d = self.bounds.diagonal();
         let vmin = self.bounds.min
             + d * Vec3::new(

@@ -20,7 +20,7 @@
 
 use super::bvh::LightBounds;
 use super::{LightKind, LightModel, LightSample};
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::{luminance, spawn_ray_to_point, Bounds3};
 use crate::scene::{Decode, ParamSpec, ParamValues, Report, RgbImage, Support};
 use crate::shapes::SurfacePoint;
@@ -194,7 +194,7 @@ impl LightModel for GoniometricLight {
     }
 
     #[inline]
-    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
         let d = self.p - r.p;
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -210,7 +210,7 @@ impl LightModel for GoniometricLight {
     }
 
     /// A point emitting in every direction, φ its power.
-    fn bounds(&self, _geom: &Geometry) -> Option<LightBounds> {
+    fn bounds(&self, _geom: &Aggregate) -> Option<LightBounds> {
         Some(LightBounds {
             bounds: Bounds3::from_point(self.p),
             w: Vec3::Z,

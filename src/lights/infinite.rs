@@ -37,7 +37,7 @@
 //! transform that scales).
 
 use super::{LightKind, LightModel, LightSample};
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::spawn_ray;
 use crate::geometry::{luminance, Ray};
 use crate::sampling::{uniform_sample_sphere, uniform_sphere_pdf, Distribution2D};
@@ -162,7 +162,7 @@ impl LightModel for InfiniteLight {
     }
 
     #[inline]
-    fn sample_li(&self, r: &SurfacePoint, u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+    fn sample_li(&self, r: &SurfacePoint, u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
         let (wi, li, pdf) = self.map.sample(u)?;
         // Anything in the way occludes an infinitely distant light.
         let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
@@ -175,16 +175,16 @@ impl LightModel for InfiniteLight {
     }
 
     #[inline]
-    fn pdf_li(&self, _r: &SurfacePoint, wi: Vec3, _geom: &Geometry) -> f32 {
+    fn pdf_li(&self, _r: &SurfacePoint, wi: Vec3, _geom: &Aggregate) -> f32 {
         self.map.pdf(wi)
     }
 
     #[inline]
-    fn pdf_li_ray(&self, _r: &SurfacePoint, ray: &Ray, _geom: &Geometry) -> f32 {
+    fn pdf_li_ray(&self, _r: &SurfacePoint, ray: &Ray, _geom: &Aggregate) -> f32 {
         self.map.pdf(ray.d)
     }
 
-    fn preprocess(&mut self, geom: &Geometry) {
+    fn preprocess(&mut self, geom: &Aggregate) {
         self.scene_radius = geom.bounds.bounding_sphere().1;
     }
 }

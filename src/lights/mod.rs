@@ -32,7 +32,7 @@ pub use point::PointLight;
 pub use projection::ProjectionLight;
 pub use spot::SpotLight;
 
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::{luminance, Ray};
 use crate::scene::{Kind, ParamValues, Report};
 use crate::shapes::SurfacePoint;
@@ -126,37 +126,37 @@ pub trait LightModel {
 
     /// luminance(Li)/pdf at `p` for one sample (not yet made finite and
     /// non-negative): the spatial light distribution's estimate.
-    fn contribution(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
+    fn contribution(&self, p: Vec3, u: Vec2, geom: &Aggregate) -> f32 {
         contribution_by_sampling(self, p, u, geom)
     }
 
     /// Sample incident light at `r` (pbrt-v3's `Sample_Li`). Visibility is
     /// not tested here: the caller traces `shadow`.
-    fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample>;
+    fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Aggregate) -> Option<LightSample>;
 
     /// Solid-angle density of `sample_li` producing direction `wi` from `r`
     /// (pbrt-v3's `Pdf_Li`); 0 when `wi` cannot come from this light.
     #[inline]
-    fn pdf_li(&self, _r: &SurfacePoint, _wi: Vec3, _geom: &Geometry) -> f32 {
+    fn pdf_li(&self, _r: &SurfacePoint, _wi: Vec3, _geom: &Aggregate) -> f32 {
         0.0
     }
 
     /// `pdf_li` for the direction of `ray`, the ray spawned from `r` in
     /// that direction.
     #[inline]
-    fn pdf_li_ray(&self, _r: &SurfacePoint, _ray: &Ray, _geom: &Geometry) -> f32 {
+    fn pdf_li_ray(&self, _r: &SurfacePoint, _ray: &Ray, _geom: &Aggregate) -> f32 {
         0.0
     }
 
     /// Bounds for the light BVH (pbrt-v4's `Bounds()`); `None` for lights
     /// at infinity.
-    fn bounds(&self, _geom: &Geometry) -> Option<LightBounds> {
+    fn bounds(&self, _geom: &Aggregate) -> Option<LightBounds> {
         None
     }
 
     /// What the light needs of the built scene (pbrt-v3's `Preprocess`:
     /// the scene's bounding radius for distant and infinite lights).
-    fn preprocess(&mut self, _geom: &Geometry) {}
+    fn preprocess(&mut self, _geom: &Aggregate) {}
 }
 
 /// [`LightModel::contribution`] by one `sample_li` from a point with no
@@ -165,7 +165,7 @@ pub fn contribution_by_sampling<L: LightModel + ?Sized>(
     light: &L,
     p: Vec3,
     u: Vec2,
-    geom: &Geometry,
+    geom: &Aggregate,
 ) -> f32 {
     let r = SurfacePoint {
         p,
@@ -227,7 +227,7 @@ macro_rules! lights {
             }
             /// A cheap estimate of luminance(Li)/pdf at a point in space,
             /// for the spatial light distribution: finite and ≥ 0.
-            pub fn contribution_estimate(&self, p: Vec3, u: Vec2, geom: &Geometry) -> f32 {
+            pub fn contribution_estimate(&self, p: Vec3, u: Vec2, geom: &Aggregate) -> f32 {
                 let c = match self { $(Light::$variant(l) => l.contribution(p, u, geom),)* };
                 if c.is_finite() {
                     c.max(0.0)
@@ -236,21 +236,21 @@ macro_rules! lights {
                 }
             }
             #[inline]
-            pub fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Geometry) -> Option<LightSample> {
+            pub fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Aggregate) -> Option<LightSample> {
                 match self { $(Light::$variant(l) => l.sample_li(r, u, geom),)* }
             }
             #[inline]
-            pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Geometry) -> f32 {
+            pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Aggregate) -> f32 {
                 match self { $(Light::$variant(l) => l.pdf_li(r, wi, geom),)* }
             }
             #[inline]
-            pub fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Geometry) -> f32 {
+            pub fn pdf_li_ray(&self, r: &SurfacePoint, ray: &Ray, geom: &Aggregate) -> f32 {
                 match self { $(Light::$variant(l) => l.pdf_li_ray(r, ray, geom),)* }
             }
-            pub fn bounds(&self, geom: &Geometry) -> Option<LightBounds> {
+            pub fn bounds(&self, geom: &Aggregate) -> Option<LightBounds> {
                 match self { $(Light::$variant(l) => l.bounds(geom),)* }
             }
-            pub fn preprocess(&mut self, geom: &Geometry) {
+            pub fn preprocess(&mut self, geom: &Aggregate) {
                 match self { $(Light::$variant(l) => l.preprocess(geom),)* }
             }
         }

@@ -12,7 +12,7 @@
 
 use super::bvh::LightBounds;
 use super::{LightKind, LightModel, LightSample};
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::{luminance, spawn_ray_to_point, Bounds3};
 use crate::scene::{ParamSpec, ParamValues, Support};
 use crate::shapes::SurfacePoint;
@@ -72,7 +72,7 @@ impl LightModel for PointLight {
     }
 
     #[inline]
-    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
         let d = self.p - r.p;
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -87,7 +87,7 @@ impl LightModel for PointLight {
     }
 
     /// pbrt-v4's: a point emitting in every direction, φ = 4π·I.
-    fn bounds(&self, _geom: &Geometry) -> Option<LightBounds> {
+    fn bounds(&self, _geom: &Aggregate) -> Option<LightBounds> {
         Some(LightBounds {
             bounds: Bounds3::from_point(self.p),
             w: Vec3::Z,

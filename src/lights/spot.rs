@@ -19,7 +19,7 @@
 
 use super::bvh::{safe_acos, LightBounds};
 use super::{LightKind, LightModel, LightSample};
-use crate::accel::Geometry;
+use crate::accel::Aggregate;
 use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame};
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
 use crate::shapes::SurfacePoint;
@@ -129,7 +129,7 @@ impl LightModel for SpotLight {
     }
 
     #[inline]
-    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Geometry) -> Option<LightSample> {
+    fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
         let d = self.p - r.p;
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -155,7 +155,7 @@ impl LightModel for SpotLight {
 
     /// pbrt-v4's: a point emitting in the falloff cone and spreading to the
     /// total cone, φ = 4π·I.
-    fn bounds(&self, _geom: &Geometry) -> Option<LightBounds> {
+    fn bounds(&self, _geom: &Aggregate) -> Option<LightBounds> {
         Some(LightBounds {
             bounds: Bounds3::from_point(self.p),
             w: self.frame.n,

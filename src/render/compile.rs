@@ -3,7 +3,7 @@
 //! a camera. Only what the scene references is built; what was left out is
 //! recorded for `--stats`.
 
-use crate::accel::{Geometry, Instance, MovingInstance, Object};
+use crate::accel::{Aggregate, Instance, MovingInstance, Object};
 use crate::cameras::Camera;
 use crate::integrators::{RenderScene, SurfaceMedia};
 use crate::lights::{AreaShape, DiffuseEmission, DiffuseLight, Light};
@@ -60,44 +60,44 @@ impl RenderScene {
             .iter()
             .filter(|s| s.area_light.is_some())
             .count();
-        let geometry = Geometry::with_motion(meshes, quadrics, instances, moving);
-        if geometry.degenerate_triangles > 0 {
+        let aggregate = Aggregate::with_motion(meshes, quadrics, instances, moving);
+        if aggregate.degenerate_triangles > 0 {
             notes.push(format!(
                 "{} zero-area triangles left out of the BVH",
-                geometry.degenerate_triangles
+                aggregate.degenerate_triangles
             ));
         }
-        if geometry.build_work.bounded {
+        if aggregate.build_work.bounded {
             notes.push(format!(
                 "BVH: {} primitives share one box, so the scene level was built by binned SAH with median splits (bounded O(n log n)) instead of PLOC",
-                geometry.build_work.largest_coincident
+                aggregate.build_work.largest_coincident
             ));
         }
-        if !geometry.has_bvh() {
+        if !aggregate.has_bvh() {
             notes.push("no geometry: no BVH built".into());
         }
 
-        let (lights, infinite_lights) = scene_lights(desc, &area, &geometry);
+        let (lights, infinite_lights) = scene_lights(desc, &area, &aggregate);
         let zero = lights.iter().filter(|l| l.power() <= 0.0).count();
         if zero > 0 {
             notes.push(format!("{zero} lights of zero power are never sampled"));
         }
         notes.push(format!(
             "built: {} triangles in {} meshes, {} quadrics, BVH over {} primitives in {:.1} ms; {} lights ({} area lights from {} emissive shapes)",
-            geometry.meshes.iter().map(|m| m.triangle_count() as u64).sum::<u64>(),
-            geometry.meshes.len(),
-            geometry.quadrics.len(),
-            geometry.primitive_count(),
-            geometry.build_time.as_secs_f64() * 1e3,
+            aggregate.meshes.iter().map(|m| m.triangle_count() as u64).sum::<u64>(),
+            aggregate.meshes.len(),
+            aggregate.quadrics.len(),
+            aggregate.primitive_count(),
+            aggregate.build_time.as_secs_f64() * 1e3,
             lights.len(),
             area.len(),
             emissive_shapes
         ));
         let camera = Camera::new(&desc.camera, &desc.film);
-        if geometry.moving_count() > 0 || camera.is_moving() {
+        if aggregate.moving_count() > 0 || camera.is_moving() {
             notes.push(format!(
                 "motion: {} moving shapes or instances (BVH over their motion bounds), {} camera, shutter {}..{}",
-                geometry.moving_count(),
+                aggregate.moving_count(),
                 if camera.is_moving() { "moving" } else { "static" },
                 desc.camera.shutter_open,
                 desc.camera.shutter_close
@@ -105,10 +105,10 @@ impl RenderScene {
         } else {
             notes.push("motion: none (no motion structures built)".into());
         }
-        if geometry.instance_count() > 0 {
+        if aggregate.instance_count() > 0 {
             notes.push(format!(
                 "instancing: {} instances of {} objects ({} triangles stored once, {} as instanced)",
-                geometry.instance_count(),
+                aggregate.instance_count(),
                 objects.iter().flatten().count(),
                 object_triangles,
                 instanced_triangles
@@ -126,7 +126,7 @@ impl RenderScene {
         }
         let has_pass_through = materials.iter().any(Material::is_none);
         RenderScene {
-            geometry,
+            aggregate,
             materials,
             material_needs_geom,
             lights,
@@ -226,7 +226,7 @@ fn world_shapes(desc: &SceneDescription, slots: &Slots) -> WorldShapes {
 fn scene_lights(
     desc: &SceneDescription,
     area: &[(AreaShape, DiffuseEmission)],
-    geometry: &Geometry,
+    geometry: &Aggregate,
 ) -> (Vec<Light>, Vec<u32>) {
     let mut lights: Vec<Light> = area
         .iter()

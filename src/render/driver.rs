@@ -423,7 +423,7 @@ struct CameraRays {
 
 impl CameraRays {
     fn new(scene: &RenderScene, sampler: &Sampler) -> CameraRays {
-        let moving = scene.camera.is_moving() || scene.geometry.moving_count() > 0;
+        let moving = scene.camera.is_moving() || scene.aggregate.moving_count() > 0;
         CameraRays {
             moving,
             lens: scene.camera.uses_lens() || moving,
