@@ -327,11 +327,11 @@ fn exit_codes_and_quiet() {
     let bad = write(
         &d,
         "bad.pbrt",
-        "WorldBegin\nShape \"sphere\" \"float radius\" [ -1 ]\nWorldEnd\n",
+        "WorldBegin\nShape \"sphere\" \"float radius\" [ 1 \nWorldEnd\n",
     );
     let out = run(pbrs().args(["--quiet", "--outfile"]).arg(&o).arg(&bad));
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("not positive"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("never closed"), "{}", stderr(&out));
     let out = run(pbrs().arg(d.join("missing.pbrt")));
     assert_eq!(out.status.code(), Some(1));
     let out = run(pbrs().args(["--check"]).arg(&bad));

@@ -252,8 +252,10 @@ fn one_file_is_read_once_for_several_lights() {
     }
 }
 
+/// A map that cannot be read: a located warning naming the file and why,
+/// and the light renders without it (constant `L`, as pbrt-v3).
 #[test]
-fn bad_maps_are_located_errors_naming_the_file() {
+fn bad_maps_are_located_warnings_naming_the_file() {
     let good = exr(8, 4, |_, _| Vec3::ONE);
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("missing.exr", Vec::new(), "No such file"),
@@ -276,10 +278,15 @@ fn bad_maps_are_located_errors_naming_the_file() {
         } else {
             vec![(name, bytes)]
         };
-        let Err(e) = load_with(&text, &files).0 else {
-            panic!("{name}: loaded");
+        let Ok(loaded) = load_with(&text, &files).0 else {
+            panic!("{name}: not loaded");
         };
-        let msg = format!("{e:?}");
+        let msg: String = loaded.warnings.iter().map(|w| format!("{w}\n")).collect();
+        assert!(msg.contains("rendered as without \"mapname\""), "{name}: {msg}");
+        assert!(
+            matches!(&loaded.scene.lights[..], [Light::Infinite(i)] if i.map.le(glam::Vec3::X) == glam::Vec3::ONE),
+            "{name}: not the constant light"
+        );
         assert!(msg.contains("scene.pbrt:3:"), "{name}: not located: {msg}");
         assert!(msg.contains(name), "{name}: file not named: {msg}");
         assert!(msg.contains(what), "{name}: {msg}");

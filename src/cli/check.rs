@@ -2,13 +2,19 @@
 
 use super::render::scenes_label;
 use super::Args;
-use crate::loader::{load_scene_files_each, print_diagnostics};
+use crate::loader::{load_scene_files_each, print_diagnostics, strictly};
 
 /// Parses and builds the scene files without rendering. Prints the warnings,
 /// then the summary and what was left out (exit 0), or the errors (exit 1).
 pub fn run(args: &Args) -> i32 {
     let label = scenes_label(args);
-    match load_scene_files_each(&args.scenes) {
+    match load_scene_files_each(&args.scenes).and_then(|s| {
+        if args.strict {
+            strictly(s)
+        } else {
+            Ok(s)
+        }
+    }) {
         Ok(scenes) => {
             let n = scenes.len();
             if n == 0 {

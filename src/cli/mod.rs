@@ -49,6 +49,11 @@ pub struct Args {
     /// Parse and build the scene, print warnings and a summary, do not render.
     #[arg(long)]
     pub check: bool,
+    /// Make every warning an error (a substitution, an ignored feature, a
+    /// file that could not be read): exit 1 and write nothing, where
+    /// pbrt-v3 (and pbrs by default) would render on.
+    #[arg(long)]
+    pub strict: bool,
     /// Print the scene as pbrs read it (Includes spliced, one directive per
     /// line, parameters normalised, file names resolved against the current
     /// directory) to standard output; do not render (pbrt-v3's --cat;

@@ -6,7 +6,7 @@ use super::display::Display;
 use super::Args;
 use crate::image::io::{check_output_path, format_for_path, write_image, ImageFormat};
 use crate::image::Image;
-use crate::loader::{load_scene_files_each, print_diagnostics};
+use crate::loader::{load_scene_files_each, print_diagnostics, strictly};
 use crate::render::driver::{
     peak_memory_bytes, render_observed, render_part, ChunkDone, RenderOptions,
 };
@@ -309,7 +309,13 @@ impl PartialWriter {
 pub fn run(args: &Args) -> i32 {
     let started = Instant::now();
     let label = scenes_label(args);
-    let scenes = match load_scene_files_each(&args.scenes) {
+    let scenes = match load_scene_files_each(&args.scenes).and_then(|s| {
+        if args.strict {
+            strictly(s)
+        } else {
+            Ok(s)
+        }
+    }) {
         Ok(l) => l,
         Err(f) => {
             if args.warnings() {

@@ -226,6 +226,8 @@ pub struct Parser<'l> {
     loader: &'l dyn FileLoader,
     /// Location of the end of the last token read (for EOF errors).
     last: Loc,
+    /// Source files already warned about numbers followed by commas.
+    comma_warned: Vec<u32>,
 }
 
 /// Result of one step: `Err(())` means an error was reported.
@@ -242,6 +244,7 @@ impl<'l> Parser<'l> {
             diags: Diags::default(),
             stack: vec![Lexer::new(file, 0)],
             peeked: None,
+            comma_warned: Vec::new(),
             file_dirs: vec![base_dir.clone()],
             base_dir,
             canon: vec![canon],
@@ -619,12 +622,41 @@ impl<'l> Parser<'l> {
             );
             return Err(());
         }
-        match parse_number(self.text(t).as_bytes()) {
+        match self.number_text(t) {
             Ok(v) => Ok(v),
             Err(e) => {
                 self.bad_number(t, e);
                 Err(())
             }
+        }
+    }
+
+    /// A bare token as a number; pbrt-v3 reads the number at the start of
+    /// a token (`strtod`), so a number followed by commas (`0.43,`, from
+    /// exporters that separate values with commas) is read without them,
+    /// with one warning per file. Anything else after a number stays an
+    /// error.
+    pub(super) fn number_text(&mut self, t: Token) -> Result<f64, NumError> {
+        let text = self.text(t).as_bytes();
+        match parse_number(text) {
+            Err(NumError::Malformed) if text.ends_with(b",") => {
+                let stem = text
+                    .iter()
+                    .rposition(|&c| c != b',')
+                    .map_or(&text[..0], |i| &text[..=i]);
+                let v = parse_number(stem)?;
+                if !self.comma_warned.contains(&t.loc.file) {
+                    self.comma_warned.push(t.loc.file);
+                    let found = self.text(t).to_string();
+                    self.warn(
+                        t.loc,
+                        format!("number `{found}` is followed by a comma: read as {v} (as pbrt-v3); commas are not separators in the pbrt format (further ones in this file are read the same way)"),
+                        "a comma after the number",
+                    );
+                }
+                Ok(v)
+            }
+            r => r,
         }
     }
 

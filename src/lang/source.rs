@@ -203,6 +203,20 @@ pub struct LocatedDiagnostic {
     help: Option<String>,
 }
 
+impl LocatedDiagnostic {
+    /// The same diagnostic as an error (`--strict` makes warnings errors).
+    pub fn as_error(&self, why: &str) -> LocatedDiagnostic {
+        LocatedDiagnostic {
+            message: format!("{} ({why})", self.message),
+            severity: Severity::Error,
+            label: self.label.clone(),
+            span: self.span,
+            source: self.source.clone(),
+            help: self.help.clone(),
+        }
+    }
+}
+
 impl fmt::Display for LocatedDiagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.message)

@@ -53,12 +53,14 @@ impl ImageCache {
     }
 }
 
-/// The image `filename` converted as `decode` says, or a located error.
+/// The image `filename` converted as `decode` says, or `None` after a located
+/// warning that names the file and says what is used instead (`substitute`).
 pub fn load_image(
     ctx: &mut Ctx,
     loc: Loc,
     filename: &str,
     decode: Decode,
+    substitute: &str,
 ) -> Option<Arc<RgbImage>> {
     let path = ctx.resolve(loc, filename);
     if let Some(img) = ctx.images.decoded.get(&(path.clone(), decode)) {
@@ -87,11 +89,13 @@ pub fn load_image(
             Some(img)
         }
         Err(e) => {
-            ctx.error(
+            ctx.warn(
                 loc,
-                format!("cannot read image \"{}\": {e}", path.display()),
+                format!(
+                    "cannot read image \"{}\": {e}: {substitute} (as pbrt-v3, which renders on)",
+                    path.display()
+                ),
                 "this image",
-                None,
             );
             None
         }

@@ -498,7 +498,10 @@ fn plain_value(ctx: &mut Ctx, s: &ParamSpec, l: &Lookup) -> Option<ParamValue> {
         ParamKind::Image(decode) => l
             .plain(s.name, ParamType::String)
             .filter(|q| !q.strs()[0].is_empty())
-            .and_then(|q| super::image::load_image(ctx, q.values_loc, &q.strs()[0], decode))
+            .and_then(|q| {
+                let instead = format!("rendered as without \"{}\"", s.name);
+                super::image::load_image(ctx, q.values_loc, &q.strs()[0], decode, &instead)
+            })
             .map(ParamValue::Image),
         ParamKind::List(e) => l
             .lists()

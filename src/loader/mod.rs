@@ -578,6 +578,29 @@ pub fn load_scene_files_each(paths: &[PathBuf]) -> Result<Vec<LoadedScene>, Load
 /// Prints diagnostics to stderr with miette's graphical handler (no colour when
 /// stderr is not a terminal or `NO_COLOR` is set). Each message starts with
 /// `FILE:LINE:COL`, and the help lists the Include chain.
+/// `--strict`: scenes loaded with warnings fail, each warning (a
+/// substitution, something ignored, a file that could not be read) made an
+/// error at its place.
+pub fn strictly(scenes: Vec<LoadedScene>) -> Result<Vec<LoadedScene>, LoadFailure> {
+    if scenes.iter().all(|s| s.warnings.is_empty()) {
+        return Ok(scenes);
+    }
+    let errors = scenes
+        .into_iter()
+        .flat_map(|s| s.warnings)
+        .map(
+            |w| match w.downcast_ref::<crate::lang::source::LocatedDiagnostic>() {
+                Some(d) => miette::Report::new(d.as_error("an error with --strict")),
+                None => miette::miette!("{w} (an error with --strict)"),
+            },
+        )
+        .collect();
+    Err(LoadFailure {
+        errors,
+        warnings: Vec::new(),
+    })
+}
+
 pub fn print_diagnostics(reports: &[miette::Report]) {
     let color = std::io::stderr().is_terminal()
         && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());

@@ -32,8 +32,8 @@ pub fn is_unsupported_shape(name: &str) -> bool {
     kind::find(SHAPES, name).is_none()
 }
 
-/// The surface of a `Shape`, or `None` (unknown: warning; invalid: error
-/// or warning, from its kind's builder). Unused parameters are left to the
+/// The surface of a `Shape`, or `None` (unknown or invalid: a warning, as
+/// pbrt-v3 renders on without it; the kind's builder says why). Unused parameters are left to the
 /// caller (the material may still read some).
 pub fn surface(
     ctx: &mut Ctx,
@@ -65,10 +65,16 @@ impl Report for Input<'_> {
     fn warn(&mut self, at: Option<&str>, msg: String, label: &str) {
         self.report.warn(at, msg, label);
     }
+    /// pbrt-v3 reports an invalid shape with `Error` and renders on
+    /// without it: a warning that says the shape is skipped.
     fn error(&mut self, at: Option<&str>, msg: String, label: &str) {
-        self.report.error(at, msg, label);
+        self.report.warn(at, format!("{msg}: {SKIPPED}"), label);
     }
 }
+
+/// What follows every reason a shape is not built.
+const SKIPPED: &str =
+    "the shape is skipped and the rest renders (as pbrt-v3 reports an invalid shape)";
 
 impl ShapeInput for Input<'_> {
     fn mesh_file(&mut self, format: MeshFormat, file: &str) -> Option<Arc<MeshData>> {
@@ -117,14 +123,13 @@ impl ShapeInput for Input<'_> {
                     );
                 }
                 if m.mesh.positions.iter().any(|v| !v.is_finite()) {
-                    ctx.error(
+                    ctx.warn(
                         floc,
                         format!(
-                            "{kind} file \"{}\" has a vertex that is not a finite 32-bit number",
+                            "{kind} file \"{}\" has a vertex that is not a finite 32-bit number: {SKIPPED}",
                             path.display()
                         ),
                         "this mesh",
-                        None,
                     );
                     None
                 } else {
@@ -132,7 +137,7 @@ impl ShapeInput for Input<'_> {
                 }
             }
             Err(e) => {
-                ctx.error(floc, e, "this mesh", None);
+                ctx.warn(floc, format!("{e}: {SKIPPED}"), "this mesh");
                 None
             }
         };

@@ -477,7 +477,8 @@ impl<'s, 'c> Builder<'s, 'c> {
                         let help = closest_name(&n.value, &names).map(|c| format!("did you mean \"{c}\"?")).or_else(|| {
                             Some(if names.is_empty() { "no named material is defined here (MakeNamedMaterial binds names in order, scoped by AttributeBegin/End)".into() } else { format!("defined here: {}", names.join(", ")) })
                         });
-                        self.ctx.error(n.loc, format!("unknown named material \"{}\"", n.value), "not defined by MakeNamedMaterial before this line", help);
+                        let help = help.map(|h| format!(" ({h})")).unwrap_or_default();
+                        self.ctx.warn(n.loc, format!("unknown named material \"{}\"{help}: the current material is kept (as pbrt-v3, which renders on)", n.value), "not defined by MakeNamedMaterial before this line");
                     }
                 }
             }

@@ -63,7 +63,13 @@ impl ImageSource for Images<'_> {
     fn image(&mut self, path: &str) -> Option<Arc<RgbImage>> {
         // Raw values: the texture decodes them (a float texture decodes the
         // luminance, not each channel).
-        load_image(self.ctx, self.loc, path, Decode::Raw)
+        load_image(
+            self.ctx,
+            self.loc,
+            path,
+            Decode::Raw,
+            "a constant grey texture (0.5) is used instead",
+        )
     }
 }
 

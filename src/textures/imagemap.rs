@@ -69,7 +69,8 @@ pub const CLASS: TextureClass = TextureClass {
 /// failures reported with the statement's location).
 pub trait ImageSource {
     /// The image of a file name as written in the scene (raw values, as
-    /// pbrt-v3's `ReadImage`), or `None` after a located error.
+    /// pbrt-v3's `ReadImage`), or `None` after a located warning (the
+    /// texture is then constant grey, as pbrt-v3's).
     fn image(&mut self, path: &str) -> Option<Arc<RgbImage>>;
 }
 

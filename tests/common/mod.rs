@@ -279,10 +279,13 @@ pub fn bsdf_of(
 }
 
 /// The errors of `body` wrapped in a world block, loaded as if from the file
-/// `path` (which need not exist), when it must not load: each message, then
-/// its rendered report (with the location).
+/// `path` (which need not exist), when it must not load under `--strict`
+/// (an error, or a warning of something pbrt-v3 renders through): each
+/// message, then its rendered report (with the location).
 pub fn world_errors(path: &Path, body: &str) -> String {
-    match pbrs::loader::load_scene_str(&format!("WorldBegin\n{body}\nWorldEnd\n"), path) {
+    match pbrs::loader::load_scene_str(&format!("WorldBegin\n{body}\nWorldEnd\n"), path)
+        .and_then(|s| pbrs::loader::strictly(vec![s]))
+    {
         Ok(_) => panic!("loaded, but should not: {body}"),
         Err(f) => f
             .errors
@@ -308,9 +311,12 @@ pub fn warning_text(s: &pbrs::loader::LoadedScene) -> String {
 }
 
 /// The errors of a scene given as text (as if from `mem.pbrt`) that must not
-/// load, one message per line.
+/// load under `--strict` (an error, or a warning of something pbrt-v3
+/// renders through), one message per line.
 pub fn error_text(text: &str) -> String {
-    match pbrs::loader::load_scene_str(text, Path::new("mem.pbrt")) {
+    match pbrs::loader::load_scene_str(text, Path::new("mem.pbrt"))
+        .and_then(|s| pbrs::loader::strictly(vec![s]))
+    {
         Ok(_) => panic!("loaded, but should not:\n{text}"),
         Err(f) => f
             .errors

@@ -41,7 +41,7 @@ impl<'l> Parser<'l> {
             .ok()
             .and_then(|(t, _)| ParamType::from_name(t))
             .is_some_and(ParamType::wants_strings);
-        let (nums, strs, values_loc) = self.values(decl, quoted)?;
+        let (mut nums, strs, values_loc) = self.values(decl, quoted)?;
         let (ty_name, name) = match parsed {
             Ok(x) => x,
             Err(_) => {
@@ -114,6 +114,11 @@ impl<'l> Parser<'l> {
             } else {
                 ty.arity()
             };
+            if ty == ParamType::Spectrum && nums.len() % 2 != 0 {
+                // pbrt-v3 warns and drops the extra value.
+                self.warn(values_loc, format!("parameter \"{type_name} {name}\" has {} numbers, an odd count: the last is ignored (as pbrt-v3)", nums.len()), "odd count");
+                nums.pop();
+            }
             if nums.len() % arity != 0 {
                 self.error(values_loc, format!("parameter \"{type_name} {name}\" has {} numbers, not a multiple of {arity}", nums.len()), format!("{} values", nums.len()), None);
                 return Err(());
@@ -203,7 +208,7 @@ impl<'l> Parser<'l> {
                                 Err(())
                             }
                         }
-                        TokKind::Bare => match parse_number(self.text(v).as_bytes()) {
+                        TokKind::Bare => match self.number_text(v) {
                             Ok(x) => nums.push(x),
                             Err(e) => {
                                 if directive_kind(self.text(v)).is_some() {

@@ -79,11 +79,13 @@ pub fn shape(ctx: &mut Ctx, name: &Name, p: &ParamList) -> Option<MeshData> {
     match result {
         Ok(mesh) => Some(mesh),
         Err(e) => {
-            ctx.error(
+            ctx.warn(
                 loc_of(&e),
-                format!("{}: {}", name.value, e.message),
+                format!(
+                    "{}: {}: the shape is skipped and the rest renders (as pbrt-v3 reports an invalid shape)",
+                    name.value, e.message
+                ),
                 "this shape",
-                None,
             );
             None
         }
