@@ -142,12 +142,18 @@ impl Sampler {
         dispatch!(self, s => s.samples_per_pixel())
     }
 
-    /// Bytes this copy of the sampler holds on the heap (its array store;
-    /// Halton's permutation tables are shared and not counted).
+    /// Bytes this copy of the sampler holds on the heap (its array store
+    /// and the pixel samplers' tables; Halton's permutation tables and the
+    /// Sobol' matrices are shared and not counted).
     pub fn heap_bytes(&self) -> usize {
         let a = dispatch!(self, s => &s.arrays);
+        let tables = match self {
+            Sampler::ZeroTwoSequence(s) | Sampler::MaxMinDist(s) => s.table_bytes(),
+            _ => 0,
+        };
         a.data_1d.iter().map(|v| v.len() * 4).sum::<usize>()
             + a.data_2d.iter().map(|v| v.len() * 8).sum::<usize>()
+            + tables
     }
 
     /// Asks for an array of `n` 1D values per sample. Call before rendering,
@@ -227,8 +233,8 @@ impl Sampler {
 
     /// As `get_camera_sample`; with `lens == false` the time and lens
     /// dimensions are consumed (later dimensions are the same) but their
-    /// values are not computed and read 0.5: for a pinhole camera without
-    /// motion, which never reads them.
+    /// values are not computed (Halton, Sobol') and read 0.5: for a pinhole
+    /// camera without motion, which never reads them.
     #[inline(always)]
     pub fn camera_sample(&mut self, pixel: IVec2, lens: bool) -> CameraSample {
         let base = pixel.as_vec2();
@@ -237,6 +243,10 @@ impl Sampler {
         let p_film = (base + self.get_2d()).min(top);
         let (time, p_lens) = match self {
             Sampler::Halton(h) if !lens => {
+                h.skip(3);
+                (0.5, Vec2::splat(0.5))
+            }
+            Sampler::Sobol(h) if !lens => {
                 h.skip(3);
                 (0.5, Vec2::splat(0.5))
             }

@@ -163,6 +163,12 @@ impl PixelSampler {
         self.spp
     }
 
+    /// Bytes of the per-dimension tables (not the array store).
+    pub fn table_bytes(&self) -> usize {
+        self.samples_1d.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.samples_2d.iter().map(|v| v.len() * 8).sum::<usize>()
+    }
+
     /// pbrt-v3's `RoundCount`: array sizes are powers of two.
     pub fn round_count(&self, n: u32) -> u32 {
         n.max(1).next_power_of_two()

@@ -161,6 +161,14 @@ impl SobolSampler {
         self.arrays.reset();
     }
 
+    /// Consumes `n` dimensions below the array dimensions without computing
+    /// them.
+    #[inline]
+    pub fn skip(&mut self, n: u32) {
+        debug_assert!(self.dimension + n <= ARRAY_START_DIM);
+        self.dimension += n;
+    }
+
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
         if self.dimension >= ARRAY_START_DIM && self.dimension < self.array_end_dim {

@@ -187,13 +187,11 @@ pub fn sobol_interval_to_index(t: &SobolMatrices, m: u32, mut frame: u64, p: (u3
 pub fn sobol_sample(t: &SobolMatrices, mut a: u64, dim: usize, scramble: u32) -> f32 {
     let mut v = scramble;
     let cols = &t.m32[dim * SOBOL_MATRIX_SIZE..(dim + 1) * SOBOL_MATRIX_SIZE];
-    let mut i = 0;
-    while a != 0 && i < SOBOL_MATRIX_SIZE {
-        if a & 1 == 1 {
-            v ^= cols[i];
-        }
-        a >>= 1;
-        i += 1;
+    // One step per set bit (the same XORs as pbrt-v3's loop over all bits).
+    a &= (1 << SOBOL_MATRIX_SIZE) - 1;
+    while a != 0 {
+        v ^= cols[a.trailing_zeros() as usize];
+        a &= a - 1;
     }
     to_unit(v)
 }
