@@ -374,6 +374,7 @@ fn bad_parameters_are_located() {
         "Sampler \"02sequence\" \"integer dimensions\" -1",
         "Sampler \"02sequence\" \"integer dimensions\" 100000",
         "Sampler \"maxmindist\" \"integer dimensions\" 0",
+        "Sampler \"02sequence\" \"integer pixelsamples\" 1048576 \"integer dimensions\" 1000",
         "Sampler \"maxmindist\" \"float pixelsamples\" 4",
     ] {
         let r = std::panic::catch_unwind(|| load(bad));

@@ -54,7 +54,7 @@ fn build(p: &ParamValues, r: &mut dyn Report) -> SamplerDesc {
     }
     SamplerDesc {
         kind: SamplerKind::MaxMinDist {
-            dimensions: dimensions(p, 1, r),
+            dimensions: dimensions(p, 1, spp, r),
         },
         pixel_samples: spp,
         sample_pixel_center: false,

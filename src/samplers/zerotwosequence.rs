@@ -30,8 +30,13 @@ pub const KIND: SamplerKindEntry = SamplerKindEntry {
     build,
 };
 
-/// The `dimensions` parameter, checked to be in `min..=MAX_DIMENSIONS`.
-pub(super) fn dimensions(p: &ParamValues, min: i32, r: &mut dyn Report) -> u32 {
+/// The most table entries (`pixelsamples × dimensions`) a pixel sampler
+/// makes per pixel (each 1D and 2D, 12 bytes, in every thread's copy).
+pub const MAX_TABLE: u64 = 1 << 26;
+
+/// The `dimensions` parameter, checked to be in `min..=MAX_DIMENSIONS` and
+/// to keep `spp × dimensions` within [`MAX_TABLE`] (errors otherwise).
+pub(super) fn dimensions(p: &ParamValues, min: i32, spp: u32, r: &mut dyn Report) -> u32 {
     let d = p.int("dimensions");
     if !(min..=MAX_DIMENSIONS).contains(&d) {
         r.error(
@@ -40,6 +45,17 @@ pub(super) fn dimensions(p: &ParamValues, min: i32, r: &mut dyn Report) -> u32 {
             "out of range",
         );
         return 4;
+    }
+    if spp as u64 * d as u64 > MAX_TABLE {
+        r.error(
+            Some("dimensions"),
+            format!(
+                "pixelsamples × dimensions = {} exceeds {MAX_TABLE} (the per-pixel tables)",
+                spp as u64 * d as u64
+            ),
+            "too many samples",
+        );
+        return (MAX_TABLE / spp as u64).clamp(1, 4) as u32;
     }
     d as u32
 }
@@ -56,7 +72,7 @@ fn build(p: &ParamValues, r: &mut dyn Report) -> SamplerDesc {
     }
     SamplerDesc {
         kind: SamplerKind::ZeroTwoSequence {
-            dimensions: dimensions(p, 0, r),
+            dimensions: dimensions(p, 0, spp, r),
         },
         pixel_samples: spp,
         sample_pixel_center: false,
