@@ -143,6 +143,31 @@ fn tiles_merge_to_the_full_render_byte_for_byte_for_every_filter() {
     }
 }
 
+/// The pixel samplers (02sequence, maxmindist) replay pbrt-v3's tile RNG
+/// wherever a farm tile starts: tiles merge to the full render's bytes.
+#[test]
+fn tiles_merge_byte_for_byte_with_the_pixel_samplers() {
+    use pbrs::scene::SamplerKind;
+    for kind in [
+        SamplerKind::ZeroTwoSequence { dimensions: 4 },
+        SamplerKind::MaxMinDist { dimensions: 3 },
+    ] {
+        let dir = tmp(&format!("tiles-{kind:?}").replace([' ', '{', '}', ':'], ""));
+        let mut desc = scene(
+            40,
+            30,
+            4,
+            Filter::Gaussian(Gaussian::new(Vec2::splat(2.0), 2.0)),
+        );
+        desc.sampler.kind = kind;
+        let (want, _) = full(&desc, &dir);
+        for n in [3, 7] {
+            let got = merged_bytes(&tiles(&desc, n, &dir), &dir);
+            assert!(got == want, "{kind:?}, {n} tiles: merged EXR differs");
+        }
+    }
+}
+
 #[test]
 fn tiles_merge_exactly_with_a_crop_window_and_an_indivisible_resolution() {
     let dir = tmp("crop");

@@ -20,7 +20,7 @@ struct Expect {
 const EXPECT: &[Expect] = &[
     Expect {
         file: "cornell-box.pbrt",
-        warnings: &["sampler \"sobol\" is not implemented: rendered with the halton sampler"],
+        warnings: &[],
         shapes: 8,
         triangles: 36,
         area_lights: 1,

@@ -134,9 +134,18 @@ fn filters_and_samplers_defaults() {
         }
     );
     assert_eq!(s("\"random\"").pixel_samples, 4);
-    assert_eq!(s("\"lowdiscrepancy\"").kind, SamplerKind::ZeroTwoSequence);
-    assert_eq!(s("\"02sequence\"").kind, SamplerKind::ZeroTwoSequence);
-    assert_eq!(s("\"maxmindist\"").kind, SamplerKind::MaxMinDist);
+    assert_eq!(
+        s("\"lowdiscrepancy\"").kind,
+        SamplerKind::ZeroTwoSequence { dimensions: 4 }
+    );
+    assert_eq!(
+        s("\"02sequence\"").kind,
+        SamplerKind::ZeroTwoSequence { dimensions: 4 }
+    );
+    assert_eq!(
+        s("\"maxmindist\"").kind,
+        SamplerKind::MaxMinDist { dimensions: 4 }
+    );
     assert_eq!(s("\"sobol\" \"integer pixelsamples\" 32").pixel_samples, 32);
 }
 

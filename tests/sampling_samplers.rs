@@ -19,7 +19,7 @@ fn bounds(w: i32, h: i32) -> Bounds2i {
     Bounds2i::new(IVec2::ZERO, IVec2::new(w, h))
 }
 
-const KINDS: [SamplerKind; 4] = [
+const KINDS: [SamplerKind; 6] = [
     SamplerKind::Halton,
     SamplerKind::Random,
     SamplerKind::Stratified {
@@ -27,7 +27,9 @@ const KINDS: [SamplerKind; 4] = [
         xsamples: 4,
         ysamples: 4,
     },
-    SamplerKind::Sobol, // maps to Halton
+    SamplerKind::Sobol,
+    SamplerKind::ZeroTwoSequence { dimensions: 4 },
+    SamplerKind::MaxMinDist { dimensions: 4 },
 ];
 
 fn assert_send_clone<T: Send + Clone + 'static>() {}
@@ -37,11 +39,15 @@ fn sampler_is_send_and_clone() {
     assert_send_clone::<Sampler>();
     assert!(matches!(
         Sampler::new(&desc(SamplerKind::Sobol, 4), bounds(8, 8), 0),
-        Sampler::Halton(_)
+        Sampler::Sobol(_)
     ));
     assert!(matches!(
-        Sampler::new(&desc(SamplerKind::MaxMinDist, 4), bounds(8, 8), 0),
-        Sampler::Halton(_)
+        Sampler::new(
+            &desc(SamplerKind::MaxMinDist { dimensions: 4 }, 4),
+            bounds(8, 8),
+            0
+        ),
+        Sampler::MaxMinDist(_)
     ));
 }
 
@@ -278,31 +284,37 @@ fn five_thousand_dimensions() {
 fn array_api() {
     for kind in KINDS {
         let mut s = Sampler::new(&desc(kind, 16), bounds(16, 16), 0);
-        assert_eq!(s.round_count(7), 7);
-        s.request_1d_array(3);
-        s.request_2d_array(5);
+        // The pixel samplers take arrays of powers of two (pbrt-v3's RoundCount).
+        let pow2 = matches!(
+            kind,
+            SamplerKind::ZeroTwoSequence { .. } | SamplerKind::MaxMinDist { .. }
+        );
+        assert_eq!(s.round_count(7), if pow2 { 8 } else { 7 });
+        let (n3, n5) = (s.round_count(3), s.round_count(5));
+        s.request_1d_array(n3);
+        s.request_2d_array(n5);
         s.request_2d_array(2);
         let mut firsts = Vec::new();
         for i in 0..16 {
             s.start_pixel_sample(IVec2::new(2, 3), i);
             let _ = s.get_camera_sample(IVec2::new(2, 3));
-            let a = s.get_1d_array(3).expect("1D array").to_vec();
-            assert_eq!(a.len(), 3);
+            let a = s.get_1d_array(n3).expect("1D array").to_vec();
+            assert_eq!(a.len(), n3 as usize);
             assert!(a.iter().all(|v| (0.0..1.0).contains(v)));
-            let b = s.get_2d_array(5).expect("2D array").to_vec();
-            assert_eq!(b.len(), 5);
+            let b = s.get_2d_array(n5).expect("2D array").to_vec();
+            assert_eq!(b.len(), n5 as usize);
             assert!(b
                 .iter()
                 .all(|v| (0.0..1.0).contains(&v.x) && (0.0..1.0).contains(&v.y)));
             assert_eq!(s.get_2d_array(2).map(|c| c.len()), Some(2));
             assert!(s.get_2d_array(2).is_none());
-            assert!(s.get_1d_array(3).is_none());
+            assert!(s.get_1d_array(n3).is_none());
             let v = s.get_1d();
             assert!((0.0..1.0).contains(&v));
             firsts.push(a[0]);
             // Same sample again: same arrays.
             s.start_pixel_sample(IVec2::new(2, 3), i);
-            assert_eq!(s.get_1d_array(3).unwrap(), &a[..]);
+            assert_eq!(s.get_1d_array(n3).unwrap(), &a[..]);
         }
         // Array values of a pixel's samples cover [0,1).
         let lo = firsts.iter().filter(|&&v| v < 0.5).count();
@@ -454,16 +466,20 @@ fn every_sampler_kind_loads_and_samples() {
             "\"integer pixelsamples\" 32",
             desc(SamplerKind::Sobol, 32),
         ),
-        ("02sequence", "", desc(SamplerKind::ZeroTwoSequence, 16)),
+        (
+            "02sequence",
+            "",
+            desc(SamplerKind::ZeroTwoSequence { dimensions: 4 }, 16),
+        ),
         (
             "lowdiscrepancy",
             "\"integer dimensions\" 2",
-            desc(SamplerKind::ZeroTwoSequence, 16),
+            desc(SamplerKind::ZeroTwoSequence { dimensions: 2 }, 16),
         ),
         (
             "maxmindist",
             "\"integer pixelsamples\" 4",
-            desc(SamplerKind::MaxMinDist, 4),
+            desc(SamplerKind::MaxMinDist { dimensions: 4 }, 4),
         ),
     ];
     for k in SAMPLERS {

@@ -86,8 +86,8 @@ impl Summary {
                 "stratified {xsamples}×{ysamples}{}",
                 if jitter { ", jittered" } else { "" }
             ),
-            SamplerKind::ZeroTwoSequence => "02sequence".into(),
-            SamplerKind::MaxMinDist => "maxmindist".into(),
+            SamplerKind::ZeroTwoSequence { .. } => "02sequence".into(),
+            SamplerKind::MaxMinDist { .. } => "maxmindist".into(),
         };
         s.sampler = format!("{kind}, {} samples per pixel", scene.sampler.pixel_samples);
         s.integrator = scene.integrator.summary();

@@ -6,20 +6,29 @@
 //! function of (pixel, index, seed) and of the calls made since, never of
 //! earlier pixels or of the thread. Every value is in `[0, 1)`.
 //!
-//! Halton follows pbrt-v3's `HaltonSampler` + `GlobalSampler`: one global
-//! sequence over the image whose first two dimensions are the pixel position.
+//! Halton and Sobol' follow pbrt-v3's `GlobalSampler`: one global sequence
+//! over the image whose first two dimensions are the pixel position.
+//! `02sequence` and `maxmindist` are pbrt-v3's pixel samplers
+//! ([`pixel`]), whose per-pixel tables are pbrt-v3's for every pixel.
 
 pub mod halton;
 pub mod lowdiscrepancy;
+pub mod maxmindist;
+pub mod pixel;
 pub mod random;
+pub mod sobol;
+pub mod sobolmatrices;
 pub mod stratified;
+pub mod zerotwosequence;
 
 pub use halton::HaltonSampler;
+pub use pixel::PixelSampler;
 pub use random::RandomSampler;
+pub use sobol::SobolSampler;
 pub use stratified::StratifiedSampler;
 
 use crate::geometry::Bounds2i;
-use crate::scene::{Kind, ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind, Support};
+use crate::scene::{Kind, ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind};
 use glam::{IVec2, Vec2};
 
 /// What a sampler kind builds from its parameters: the sampler's settings
@@ -34,9 +43,9 @@ pub static SAMPLERS: &[SamplerKindEntry] = &[
     halton::KIND,
     random::KIND,
     stratified::KIND,
-    SOBOL,
-    ZERO_TWO_SEQUENCE,
-    MAX_MIN_DIST,
+    sobol::KIND,
+    zerotwosequence::KIND,
+    maxmindist::KIND,
 ];
 
 /// The most samples per pixel pbrs takes (each sample index must fit the
@@ -65,55 +74,6 @@ const DIMENSIONS: ParamSpec = ParamSpec::int(
     "dimensions sampled with the sampler's own pattern (read; pbrs's samplers use their pattern for every dimension)",
 );
 
-/// A pbrt-v3 sampler pbrs renders with `halton`, with a warning.
-fn substituted(kind: SamplerKind, p: &ParamValues, report: &mut dyn Report) -> SamplerDesc {
-    let name = match kind {
-        SamplerKind::Sobol => "sobol",
-        SamplerKind::ZeroTwoSequence => "02sequence",
-        _ => "maxmindist",
-    };
-    report.warn(
-        None,
-        format!("sampler \"{name}\" is not implemented: rendered with the halton sampler (same expected image, different noise)"),
-        "rendered with halton",
-    );
-    SamplerDesc {
-        kind,
-        pixel_samples: count(p, "pixelsamples", 16, report),
-        sample_pixel_center: false,
-    }
-}
-
-const SUBSTITUTED: &str =
-    "rendered with `halton` (same expected image, different noise), with a warning";
-
-const SOBOL: SamplerKindEntry = SamplerKindEntry {
-    name: "sobol",
-    aliases: &[],
-    support: Support::Unsupported(SUBSTITUTED),
-    params: &[PIXELSAMPLES_16],
-    doc: "pbrt-v3's SobolSampler",
-    build: |p, r| substituted(SamplerKind::Sobol, p, r),
-};
-
-const ZERO_TWO_SEQUENCE: SamplerKindEntry = SamplerKindEntry {
-    name: "02sequence",
-    aliases: &["lowdiscrepancy"],
-    support: Support::Unsupported(SUBSTITUTED),
-    params: &[PIXELSAMPLES_16, DIMENSIONS],
-    doc: "pbrt-v3's ZeroTwoSequenceSampler",
-    build: |p, r| substituted(SamplerKind::ZeroTwoSequence, p, r),
-};
-
-const MAX_MIN_DIST: SamplerKindEntry = SamplerKindEntry {
-    name: "maxmindist",
-    aliases: &[],
-    support: Support::Unsupported(SUBSTITUTED),
-    params: &[PIXELSAMPLES_16, DIMENSIONS],
-    doc: "pbrt-v3's MaxMinDistSampler",
-    build: |p, r| substituted(SamplerKind::MaxMinDist, p, r),
-};
-
 /// What a camera needs to generate a ray.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct CameraSample {
@@ -128,6 +88,9 @@ pub enum Sampler {
     Halton(HaltonSampler),
     Random(RandomSampler),
     Stratified(StratifiedSampler),
+    Sobol(SobolSampler),
+    ZeroTwoSequence(PixelSampler),
+    MaxMinDist(PixelSampler),
 }
 
 macro_rules! dispatch {
@@ -136,15 +99,18 @@ macro_rules! dispatch {
             Sampler::Halton($s) => $e,
             Sampler::Random($s) => $e,
             Sampler::Stratified($s) => $e,
+            Sampler::Sobol($s) => $e,
+            Sampler::ZeroTwoSequence($s) => $e,
+            Sampler::MaxMinDist($s) => $e,
         }
     };
 }
 
 impl Sampler {
-    /// Builds the sampler for `desc`. Kinds not implemented (sobol,
-    /// 02sequence, maxmindist) map to Halton. `sample_bounds` is the film's
-    /// sample bounds; `seed` changes scrambling and random streams (seed 0 is
-    /// pbrt-v3's own Halton permutations).
+    /// Builds the sampler for `desc`. `sample_bounds` is the film's sample
+    /// bounds; `seed` changes scrambling and random streams (seed 0 is
+    /// pbrt-v3's own values: Halton's permutations, Sobol' unscrambled, the
+    /// pixel samplers' tile RNGs).
     pub fn new(desc: &SamplerDesc, sample_bounds: Bounds2i, seed: u64) -> Sampler {
         let spp = desc.pixel_samples.max(1);
         match desc.kind {
@@ -156,15 +122,19 @@ impl Sampler {
             } => Sampler::Stratified(StratifiedSampler::new(
                 xsamples, ysamples, spp, jitter, seed,
             )),
-            SamplerKind::Halton
-            | SamplerKind::Sobol
-            | SamplerKind::ZeroTwoSequence
-            | SamplerKind::MaxMinDist => Sampler::Halton(HaltonSampler::new(
+            SamplerKind::Halton => Sampler::Halton(HaltonSampler::new(
                 spp,
                 sample_bounds,
                 desc.sample_pixel_center,
                 seed,
             )),
+            SamplerKind::Sobol => Sampler::Sobol(SobolSampler::new(spp, sample_bounds, seed)),
+            SamplerKind::ZeroTwoSequence { dimensions } => Sampler::ZeroTwoSequence(
+                zerotwosequence::sampler(spp, dimensions, sample_bounds, seed),
+            ),
+            SamplerKind::MaxMinDist { dimensions } => {
+                Sampler::MaxMinDist(maxmindist::sampler(spp, dimensions, sample_bounds, seed))
+            }
         }
     }
 
@@ -172,12 +142,18 @@ impl Sampler {
         dispatch!(self, s => s.samples_per_pixel())
     }
 
-    /// Bytes this copy of the sampler holds on the heap (its array store;
-    /// Halton's permutation tables are shared and not counted).
+    /// Bytes this copy of the sampler holds on the heap (its array store
+    /// and the pixel samplers' tables; Halton's permutation tables and the
+    /// Sobol' matrices are shared and not counted).
     pub fn heap_bytes(&self) -> usize {
         let a = dispatch!(self, s => &s.arrays);
+        let tables = match self {
+            Sampler::ZeroTwoSequence(s) | Sampler::MaxMinDist(s) => s.table_bytes(),
+            _ => 0,
+        };
         a.data_1d.iter().map(|v| v.len() * 4).sum::<usize>()
             + a.data_2d.iter().map(|v| v.len() * 8).sum::<usize>()
+            + tables
     }
 
     /// Asks for an array of `n` 1D values per sample. Call before rendering,
@@ -190,10 +166,13 @@ impl Sampler {
         dispatch!(self, s => s.request_2d_array(n))
     }
 
-    /// The array size to request for `n` wanted values (no rounding needed
-    /// by the samplers here).
+    /// The array size to request for `n` wanted values (pbrt-v3's
+    /// `RoundCount`: a power of two for the pixel samplers, `n` otherwise).
     pub fn round_count(&self, n: u32) -> u32 {
-        n
+        match self {
+            Sampler::ZeroTwoSequence(s) | Sampler::MaxMinDist(s) => s.round_count(n),
+            _ => n,
+        }
     }
 
     /// Positions the sampler at sample `sample_index` of `pixel`.
@@ -214,10 +193,13 @@ impl Sampler {
     }
 
     /// Whether lanes of a batch can each have a copy of this sampler at a
-    /// modest cost per pixel: not the stratified sampler, which computes
-    /// every sample of a pixel when it starts one.
+    /// modest cost per pixel: not the stratified and pixel samplers, which
+    /// compute every sample of a pixel when they start one.
     pub fn batches_well(&self) -> bool {
-        !matches!(self, Sampler::Stratified(_))
+        !matches!(
+            self,
+            Sampler::Stratified(_) | Sampler::ZeroTwoSequence(_) | Sampler::MaxMinDist(_)
+        )
     }
 
     #[inline]
@@ -251,8 +233,8 @@ impl Sampler {
 
     /// As `get_camera_sample`; with `lens == false` the time and lens
     /// dimensions are consumed (later dimensions are the same) but their
-    /// values are not computed and read 0.5: for a pinhole camera without
-    /// motion, which never reads them.
+    /// values are not computed (Halton, Sobol') and read 0.5: for a pinhole
+    /// camera without motion, which never reads them.
     #[inline(always)]
     pub fn camera_sample(&mut self, pixel: IVec2, lens: bool) -> CameraSample {
         let base = pixel.as_vec2();
@@ -261,6 +243,10 @@ impl Sampler {
         let p_film = (base + self.get_2d()).min(top);
         let (time, p_lens) = match self {
             Sampler::Halton(h) if !lens => {
+                h.skip(3);
+                (0.5, Vec2::splat(0.5))
+            }
+            Sampler::Sobol(h) if !lens => {
                 h.skip(3);
                 (0.5, Vec2::splat(0.5))
             }

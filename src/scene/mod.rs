@@ -138,8 +138,13 @@ pub enum SamplerKind {
         xsamples: u32,
         ysamples: u32,
     },
-    ZeroTwoSequence,
-    MaxMinDist,
+    /// `dimensions`: how many 1D and 2D dimensions take the pattern.
+    ZeroTwoSequence {
+        dimensions: u32,
+    },
+    MaxMinDist {
+        dimensions: u32,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

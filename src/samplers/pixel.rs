@@ -1,0 +1,313 @@
+//! pbrt-v3's `PixelSampler` (core/sampler.cpp) as `ZeroTwoSequenceSampler`
+//! and `MaxMinDistSampler` use it: at each pixel, tables of every sample's
+//! values for the first `dimensions` 1D and 2D dimensions and for the
+//! requested arrays, made with the sampler's RNG: 1D values by the
+//! scrambled van der Corput sequence, 2D values by the scrambled Sobol'
+//! (0,2)-sequence (the first two Sobol' matrices, made from Joe and Kuo's
+//! direction numbers), each shuffled (core/lowdiscrepancy.h's
+//! `VanDerCorput`, `Sobol2D`); the max-min-distance sampler takes its
+//! first 2D dimension from its own generator matrix instead.
+//!
+//! pbrt-v3 clones the sampler for each 16×16 tile of the sample bounds
+//! with its RNG at sequence `tile.y * nTiles.x + tile.x`
+//! (`SamplerIntegrator::Render`), and the RNG advances through the
+//! tile's pixels in row order. This sampler does the same: the tables of a
+//! pixel are those pbrt-v3 makes, whatever thread, tile or region renders
+//! it, because a pixel reached out of that order replays the RNG from its
+//! tile's first pixel. Values past the tables (pbrt-v3 draws them from
+//! the same RNG, so that they depend on how many earlier pixels of the
+//! tile used) come from an independent stream seeded by (pixel, sample,
+//! seed), so that images do not depend on threads or tiling.
+
+use super::random::stream_rng;
+use super::sobolmatrices::{sobol_matrices, to_unit, SOBOL_MATRIX_SIZE};
+use super::ArrayStore;
+use crate::geometry::Bounds2i;
+use crate::sampling::rng::{mix64, Pcg32};
+use glam::{IVec2, Vec2};
+
+/// pbrt-v3's tile size in `SamplerIntegrator::Render`.
+pub const TILE_SIZE: i32 = 16;
+
+/// Which pattern the first 2D dimension takes.
+#[derive(Clone, Copy, Debug)]
+pub enum Pattern {
+    /// `ZeroTwoSequenceSampler`: the (0,2)-sequence.
+    ZeroTwo,
+    /// `MaxMinDistSampler`: `(i / spp, C · i)` for the generator matrix `C`
+    /// (columns, bit 31 the first digit), shuffled.
+    MaxMinDist(&'static [u32; 32]),
+}
+
+#[derive(Clone, Debug)]
+pub struct PixelSampler {
+    pattern: Pattern,
+    spp: u32,
+    /// The van der Corput and second Sobol' matrices (32 columns each).
+    c0: &'static [u32],
+    c1: &'static [u32],
+    samples_1d: Vec<Vec<f32>>,
+    samples_2d: Vec<Vec<Vec2>>,
+    pub(super) arrays: ArrayStore,
+    bounds: Bounds2i,
+    tiles_x: i32,
+    /// Added to the tile number for the RNG's sequence (0 for seed 0).
+    seed_offset: u64,
+    seed: u64,
+    /// The tile RNG, just after making the tables of `generated`.
+    rng: Pcg32,
+    generated: Option<IVec2>,
+    pixel: IVec2,
+    sample_index: u32,
+    dim_1d: usize,
+    dim_2d: usize,
+    /// Values past the tables.
+    extra: Pcg32,
+}
+
+/// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values.
+fn shuffle<T>(s: &mut [T], count: usize, n: usize, rng: &mut Pcg32) {
+    for i in 0..count {
+        let other = i + rng.uniform_u32_below((count - i) as u32) as usize;
+        for j in 0..n {
+            s.swap(n * i + j, n * other + j);
+        }
+    }
+}
+
+/// pbrt-v3's `GrayCodeSample` (one dimension) and `VanDerCorput`: the
+/// scrambled van der Corput values in Gray-code order, shuffled within each
+/// pixel sample's `per_sample` values, then the pixel samples shuffled.
+fn van_der_corput(per_sample: usize, spp: usize, out: &mut [f32], c: &[u32], rng: &mut Pcg32) {
+    let mut v = rng.uniform_u32();
+    for (i, o) in out.iter_mut().enumerate().take(per_sample * spp) {
+        *o = to_unit(v);
+        v ^= c[(i as u32 + 1).trailing_zeros() as usize];
+    }
+    for i in 0..spp {
+        shuffle(&mut out[i * per_sample..], per_sample, 1, rng);
+    }
+    shuffle(out, spp, per_sample, rng);
+}
+
+/// pbrt-v3's `Sobol2D`: the scrambled (0,2)-sequence in Gray-code order,
+/// shuffled as [`van_der_corput`].
+fn sobol_2d(per_sample: usize, spp: usize, out: &mut [Vec2], c: [&[u32]; 2], rng: &mut Pcg32) {
+    let mut v = [rng.uniform_u32(), rng.uniform_u32()];
+    for (i, o) in out.iter_mut().enumerate().take(per_sample * spp) {
+        *o = Vec2::new(to_unit(v[0]), to_unit(v[1]));
+        let k = (i as u32 + 1).trailing_zeros() as usize;
+        v[0] ^= c[0][k];
+        v[1] ^= c[1][k];
+    }
+    for i in 0..spp {
+        shuffle(&mut out[i * per_sample..], per_sample, 1, rng);
+    }
+    shuffle(out, spp, per_sample, rng);
+}
+
+/// pbrt-v3's `MultiplyGenerator`.
+#[inline]
+pub fn multiply_generator(c: &[u32], mut a: u32) -> u32 {
+    let mut v = 0;
+    let mut i = 0;
+    while a != 0 {
+        if a & 1 == 1 {
+            v ^= c[i];
+        }
+        a >>= 1;
+        i += 1;
+    }
+    v
+}
+
+impl PixelSampler {
+    /// `spp` must be a power of two (the kinds round it).
+    pub fn new(
+        pattern: Pattern,
+        spp: u32,
+        dimensions: u32,
+        sample_bounds: Bounds2i,
+        seed: u64,
+    ) -> Self {
+        let spp = spp.max(1);
+        let m = &sobol_matrices().m32;
+        let d = sample_bounds.max - sample_bounds.min;
+        Self {
+            pattern,
+            spp,
+            c0: &m[0..32],
+            c1: &m[SOBOL_MATRIX_SIZE..SOBOL_MATRIX_SIZE + 32],
+            samples_1d: vec![vec![0.0; spp as usize]; dimensions as usize],
+            samples_2d: vec![vec![Vec2::ZERO; spp as usize]; dimensions as usize],
+            arrays: ArrayStore::default(),
+            bounds: sample_bounds,
+            tiles_x: ((d.x + TILE_SIZE - 1) / TILE_SIZE).max(1),
+            seed_offset: if seed == 0 {
+                0
+            } else {
+                mix64(seed ^ 0x5069_7865_6c53_616d)
+            },
+            seed,
+            rng: Pcg32::new(),
+            generated: None,
+            pixel: IVec2::ZERO,
+            sample_index: 0,
+            dim_1d: 0,
+            dim_2d: 0,
+            extra: Pcg32::new(),
+        }
+    }
+
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.spp
+    }
+
+    /// Bytes of the per-dimension tables (not the array store).
+    pub fn table_bytes(&self) -> usize {
+        self.samples_1d.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.samples_2d.iter().map(|v| v.len() * 8).sum::<usize>()
+    }
+
+    /// pbrt-v3's `RoundCount`: array sizes are powers of two.
+    pub fn round_count(&self, n: u32) -> u32 {
+        n.max(1).next_power_of_two()
+    }
+
+    pub fn request_1d_array(&mut self, n: u32) {
+        self.arrays.request_1d(n, self.spp);
+        self.generated = None;
+    }
+
+    pub fn request_2d_array(&mut self, n: u32) {
+        self.arrays.request_2d(n, self.spp);
+        self.generated = None;
+    }
+
+    /// The tables of the current pixel made by pbrt-v3's `StartPixel` with
+    /// the RNG as it is.
+    fn generate(&mut self) {
+        let spp = self.spp as usize;
+        let rng = &mut self.rng;
+        let (c0, c1) = (self.c0, self.c1);
+        let mut rest_2d = &mut self.samples_2d[..];
+        if let Pattern::MaxMinDist(c) = self.pattern {
+            if let Some((first, rest)) = std::mem::take(&mut rest_2d).split_first_mut() {
+                let inv = 1.0 / self.spp as f32;
+                for (i, v) in first.iter_mut().enumerate() {
+                    *v = Vec2::new(i as f32 * inv, to_unit(multiply_generator(c, i as u32)));
+                }
+                shuffle(first, spp, 1, rng);
+                rest_2d = rest;
+            }
+        }
+        for s in &mut self.samples_1d {
+            van_der_corput(1, spp, s, c0, rng);
+        }
+        for s in rest_2d {
+            sobol_2d(1, spp, s, [c0, c1], rng);
+        }
+        let a = &mut self.arrays;
+        for (&n, data) in a.sizes_1d.iter().zip(a.data_1d.iter_mut()) {
+            van_der_corput(n as usize, spp, data, c0, rng);
+        }
+        for (&n, data) in a.sizes_2d.iter().zip(a.data_2d.iter_mut()) {
+            sobol_2d(n as usize, spp, data, [c0, c1], rng);
+        }
+    }
+
+    /// The number of `pixel`'s tile (pbrt-v3's numbering) and the pixel's
+    /// place in the tile's row order; `None` outside the sample bounds.
+    fn tile_of(&self, pixel: IVec2) -> Option<(u64, usize)> {
+        let b = self.bounds;
+        if pixel.x < b.min.x || pixel.y < b.min.y || pixel.x >= b.max.x || pixel.y >= b.max.y {
+            return None;
+        }
+        let t = (pixel - b.min) / TILE_SIZE;
+        let x0 = b.min.x + t.x * TILE_SIZE;
+        let y0 = b.min.y + t.y * TILE_SIZE;
+        let w = (x0 + TILE_SIZE).min(b.max.x) - x0;
+        let tile = (t.y as i64 * self.tiles_x as i64 + t.x as i64) as u64;
+        Some((tile, ((pixel.y - y0) * w + pixel.x - x0) as usize))
+    }
+
+    /// Makes the tables of `pixel` with the RNG pbrt-v3's tile sampler has
+    /// there: continuing from the last pixel made if it is earlier in the
+    /// same tile, else replaying from the tile's start.
+    fn start_pixel(&mut self, pixel: IVec2) {
+        let Some((tile, k)) = self.tile_of(pixel) else {
+            // Not a pixel pbrt-v3 samples: a stream of its own.
+            self.rng = stream_rng(pixel, u32::MAX, self.seed, 5);
+            self.generate();
+            self.generated = None;
+            return;
+        };
+        let start = match self.generated.and_then(|g| self.tile_of(g)) {
+            Some((t, j)) if t == tile && j < k => j + 1,
+            _ => {
+                self.rng.set_sequence(tile.wrapping_add(self.seed_offset));
+                0
+            }
+        };
+        for _ in start..=k {
+            self.generate();
+        }
+        self.generated = Some(pixel);
+    }
+
+    pub fn start_pixel_sample(&mut self, pixel: IVec2, sample_index: u32) {
+        if self.generated != Some(pixel) {
+            self.start_pixel(pixel);
+        }
+        self.pixel = pixel;
+        self.sample_index = sample_index;
+        self.dim_1d = 0;
+        self.dim_2d = 0;
+        self.extra = stream_rng(pixel, sample_index, self.seed, 4);
+        self.arrays.reset();
+    }
+
+    #[inline]
+    fn in_table(&self) -> bool {
+        self.sample_index < self.spp
+    }
+
+    #[inline]
+    pub fn get_1d(&mut self) -> f32 {
+        if self.dim_1d < self.samples_1d.len() && self.in_table() {
+            let v = self.samples_1d[self.dim_1d][self.sample_index as usize];
+            self.dim_1d += 1;
+            v
+        } else {
+            self.extra.uniform_f32()
+        }
+    }
+
+    #[inline]
+    pub fn get_2d(&mut self) -> Vec2 {
+        if self.dim_2d < self.samples_2d.len() && self.in_table() {
+            let v = self.samples_2d[self.dim_2d][self.sample_index as usize];
+            self.dim_2d += 1;
+            v
+        } else {
+            let x = self.extra.uniform_f32();
+            Vec2::new(x, self.extra.uniform_f32())
+        }
+    }
+
+    #[inline]
+    pub fn get_1d_array(&mut self, n: u32) -> Option<&[f32]> {
+        if !self.in_table() {
+            return None;
+        }
+        self.arrays.get_1d(n, self.sample_index as usize)
+    }
+
+    #[inline]
+    pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
+        if !self.in_table() {
+            return None;
+        }
+        self.arrays.get_2d(n, self.sample_index as usize)
+    }
+}
