@@ -125,6 +125,7 @@ impl Cone {
         }
     }
 
+    #[inline]
     fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
         self.at
             .place

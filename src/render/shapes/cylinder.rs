@@ -104,10 +104,11 @@ impl Cylinder {
 
     /// World-space surface point for an object-space point on the tube,
     /// with pbrt-v3's object-space error bound γ3·|(x, y, 0)|.
+    #[inline]
     fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
         let obj_err = DVec3::new(p_obj.x.abs(), p_obj.y.abs(), 0.0) * gamma(3) as f64;
         let n = self.at.place.normal(DVec3::new(p_obj.x, p_obj.y, 0.0));
-        self.at.place.exact_point(p_obj, obj_err, n)
+        self.at.place.exact_point(p_obj, Some(obj_err), n)
     }
 }
 

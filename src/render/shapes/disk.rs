@@ -128,8 +128,9 @@ impl Disk {
 
     /// World-space surface point for an object-space point on the disk:
     /// zero object-space error (z is exact; x, y are f64).
+    #[inline]
     fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
-        self.at.place.exact_point(p_obj, DVec3::ZERO, self.n)
+        self.at.place.exact_point(p_obj, None, self.n)
     }
 }
 

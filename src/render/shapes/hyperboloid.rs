@@ -236,6 +236,7 @@ impl Hyperboloid {
         (dpdu, dpdv)
     }
 
+    #[inline]
     fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
         self.at
             .place

@@ -160,6 +160,7 @@ impl Paraboloid {
         }
     }
 
+    #[inline]
     fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
         self.at
             .place

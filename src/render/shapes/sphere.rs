@@ -155,11 +155,12 @@ impl Sphere {
 
     /// World-space surface point for an object-space point on the sphere:
     /// the object-space error of the reprojected point is pbrt-v3's γ5·|p|.
+    #[inline]
     fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
         let obj_err = p_obj.abs() * gamma(5) as f64;
         self.at
             .place
-            .exact_point(p_obj, obj_err, self.at.place.normal(p_obj))
+            .exact_point(p_obj, Some(obj_err), self.at.place.normal(p_obj))
     }
 
     /// World-area density of `sample_area` at the point with object-space
