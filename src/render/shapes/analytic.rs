@@ -297,6 +297,19 @@ impl Placement {
         self.world_to_object.is_finite() && self.det_abs > 0.0 && self.det_abs.is_finite()
     }
 
+    /// An invertible placement (finite inverse) of a shape of world area
+    /// `area` > 0 and finite: what a shape needs to be in the scene.
+    pub fn holds(&self, area: f32) -> bool {
+        self.world_to_object.is_finite() && area > 0.0 && area.is_finite()
+    }
+
+    /// World bounds of the surface of revolution of `radius` about z over
+    /// `z_min`..`z_max` (its object-space box).
+    pub fn zone_bounds(&self, radius: f64, z_min: f64, z_max: f64) -> Bounds3 {
+        let r = radius;
+        self.bounds(DVec3::new(-r, -r, z_min), DVec3::new(r, r, z_max))
+    }
+
     /// The ray in object space, in f64.
     #[inline]
     pub fn ray_to_object(&self, o: Vec3, d: Vec3) -> (DVec3, DVec3) {

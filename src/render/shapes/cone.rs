@@ -143,11 +143,10 @@ impl Analytic for Cone {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.is_valid()
-            && self.radius > 0.0
+        self.radius > 0.0
             && self.height > 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
+            && self.at.place.is_valid()
+            && self.at.place.holds(self.area)
     }
 
     fn bounds(&self) -> Bounds3 {

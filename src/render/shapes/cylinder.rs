@@ -118,11 +118,7 @@ impl Analytic for Cylinder {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.world_to_object.is_finite()
-            && self.radius > 0.0
-            && self.z_max > self.z_min
-            && self.area > 0.0
-            && self.area.is_finite()
+        self.radius > 0.0 && self.z_max > self.z_min && self.at.place.holds(self.area)
     }
 
     fn area(&self) -> f32 {
@@ -130,10 +126,9 @@ impl Analytic for Cylinder {
     }
 
     fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
         self.at
             .place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+            .zone_bounds(self.radius, self.z_min, self.z_max)
     }
 
     /// Closest hit with 0 < t < t_max (pbrt-v3's `Cylinder::Intersect`).

@@ -141,11 +141,7 @@ impl Analytic for Disk {
 
     /// False for singular transforms and empty disks: left out of the scene.
     fn is_valid(&self) -> bool {
-        self.at.place.world_to_object.is_finite()
-            && self.radius > 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
-            && self.n.is_finite()
+        self.radius > 0.0 && self.n.is_finite() && self.at.place.holds(self.area)
     }
 
     fn area(&self) -> f32 {

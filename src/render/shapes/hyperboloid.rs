@@ -254,13 +254,12 @@ impl Analytic for Hyperboloid {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.is_valid()
-            && self.a.is_finite()
+        self.a.is_finite()
             && self.c.is_finite()
             && self.z_max > self.z_min
             && self.r_max.is_finite()
-            && self.area > 0.0
-            && self.area.is_finite()
+            && self.at.place.is_valid()
+            && self.at.place.holds(self.area)
     }
 
     fn bounds(&self) -> Bounds3 {

@@ -203,10 +203,7 @@ impl Analytic for Sphere {
     /// False for singular transforms (e.g. `Scale 0 0 0`): such a sphere has
     /// no area and is left out of the scene.
     fn is_valid(&self) -> bool {
-        self.radius > 0.0
-            && self.at.place.world_to_object.is_finite()
-            && self.area > 0.0
-            && self.area.is_finite()
+        self.radius > 0.0 && self.at.place.holds(self.area)
     }
 
     fn area(&self) -> f32 {
@@ -214,10 +211,9 @@ impl Analytic for Sphere {
     }
 
     fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
         self.at
             .place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+            .zone_bounds(self.radius, self.z_min, self.z_max)
     }
 
     /// Closest hit with 0 < t < t_max; returns t and the object-space point.
