@@ -297,6 +297,19 @@ impl Placement {
         self.world_to_object.is_finite() && self.det_abs > 0.0 && self.det_abs.is_finite()
     }
 
+    /// An invertible placement (finite inverse) of a shape of world area
+    /// `area` > 0 and finite: what a shape needs to be in the scene.
+    pub fn holds(&self, area: f32) -> bool {
+        self.world_to_object.is_finite() && area > 0.0 && area.is_finite()
+    }
+
+    /// World bounds of the surface of revolution of `radius` about z over
+    /// `z_min`..`z_max` (its object-space box).
+    pub fn zone_bounds(&self, radius: f64, z_min: f64, z_max: f64) -> Bounds3 {
+        let r = radius;
+        self.bounds(DVec3::new(-r, -r, z_min), DVec3::new(r, r, z_max))
+    }
+
     /// The ray in object space, in f64.
     #[inline]
     pub fn ray_to_object(&self, o: Vec3, d: Vec3) -> (DVec3, DVec3) {
@@ -367,17 +380,21 @@ impl Placement {
     }
 
     /// The world point of an object point computed in f64 (the shapes that
-    /// intersect in f64), with its error bound: `obj_err` carried through
-    /// the transform, the transform's rounding γ₃·(|M||p| + |t|), and the
-    /// final rounding to f32; `n` is the oriented world normal.
-    #[inline]
-    pub fn exact_point(&self, p_obj: DVec3, obj_err: DVec3, n: Vec3) -> SurfacePoint {
+    /// intersect in f64), with its error bound: the object-space error
+    /// `obj_err` (none: the point is exact) carried through the transform,
+    /// plus the transform's rounding γ₃·(|M||p| + |t|) and the final
+    /// rounding to f32; `n` is the oriented world normal.
+    #[inline(always)]
+    pub fn exact_point(&self, p_obj: DVec3, obj_err: Option<DVec3>, n: Vec3) -> SurfacePoint {
         let p = self.object_to_world.transform_point3(p_obj).as_vec3();
         let lin = self.lin;
         let abs_lin = DMat3::from_cols(lin.x_axis.abs(), lin.y_axis.abs(), lin.z_axis.abs());
-        let err = abs_lin * obj_err
-            + (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
-                * gamma(3) as f64;
+        let rounding = (abs_lin * p_obj.abs() + self.object_to_world.w_axis.truncate().abs())
+            * gamma(3) as f64;
+        let err = match obj_err {
+            Some(e) => abs_lin * e + rounding,
+            None => rounding,
+        };
         SurfacePoint {
             p,
             p_error: err.as_vec3() + p.abs() * f32::EPSILON,

@@ -125,6 +125,7 @@ impl Cone {
         }
     }
 
+    #[inline]
     fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
         self.at
             .place
@@ -142,11 +143,10 @@ impl Analytic for Cone {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.is_valid()
-            && self.radius > 0.0
+        self.radius > 0.0
             && self.height > 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
+            && self.at.place.is_valid()
+            && self.at.place.holds(self.area)
     }
 
     fn bounds(&self) -> Bounds3 {

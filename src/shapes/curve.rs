@@ -434,6 +434,102 @@ impl Curve {
             .max(self.common.width_at(self.u_max))
     }
 
+    /// Closest hit with 0 < t ≤ t_max (world ray; `t` is the same in object
+    /// space): pbrt-v3's recursive subdivision of the piece in the ray's
+    /// frame, and the hit's parameters.
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, CurveHit)> {
+        let (o, d) = self.common.placement.ray_to_object(o, d);
+        let (o, d) = (o.as_vec3(), d.as_vec3());
+        let ray_len = d.length();
+        if !(ray_len > 0.0 && ray_len.is_finite()) {
+            return None;
+        }
+        let dir = d / ray_len;
+        let cp_obj = self.control_points();
+        // The frame's "up" is along the chord, so the projected curve lies
+        // roughly along x and its boxes are thin in y.
+        let mut up = dir.cross(cp_obj[3] - cp_obj[0]);
+        if up.length_squared() == 0.0 {
+            up = coordinate_system(dir).0;
+        }
+        let right = up.normalize().cross(dir);
+        if right.length_squared().is_nan() || right.length_squared() <= 0.0 || !right.is_finite() {
+            return None;
+        }
+        let right = right.normalize();
+        let new_up = dir.cross(right);
+        let to_ray = |p: Vec3| {
+            let q = p - o;
+            Vec3::new(q.dot(right), q.dot(new_up), q.dot(dir))
+        };
+        let cp = [
+            to_ray(cp_obj[0]),
+            to_ray(cp_obj[1]),
+            to_ray(cp_obj[2]),
+            to_ray(cp_obj[3]),
+        ];
+        let z_max = ray_len * t_max;
+        if !overlaps(&cp, self.max_width(), z_max) {
+            return None;
+        }
+        // Subdivision depth from the curve's second differences (pbrt-v3's
+        // bound for a flatness within width / 20).
+        let mut l0 = 0.0f32;
+        for i in 0..2 {
+            let dd = (cp[i] - 2.0 * cp[i + 1] + cp[i + 2]).abs();
+            l0 = l0.max(dd.x.max(dd.y).max(dd.z));
+        }
+        let eps = self.common.width[0].max(self.common.width[1]) * 0.05;
+        let depth =
+            (log2_round(std::f32::consts::SQRT_2 * 6.0 * l0 / (8.0 * eps)) / 2).clamp(0, 10);
+        let mut best: Option<(f32, Leaf)> = None;
+        let mut z_best = z_max;
+        self.recurse(
+            &cp,
+            self.u_min,
+            self.u_max,
+            depth,
+            dir,
+            &mut z_best,
+            &mut best,
+        );
+        let (z, leaf) = best?;
+        let t = z / ray_len;
+        let p = o + d * t;
+        let c = &self.common;
+        let dpdu = bezier_derivative(&c.cp, leaf.u);
+        let dpdv = match c.kind {
+            CurveKind::Ribbon => leaf.n_ribbon.cross(dpdu).normalize() * leaf.width,
+            CurveKind::Flat | CurveKind::Cylinder => {
+                // Across the curve in the plane facing the ray.
+                let flat = dir.cross(dpdu).normalize() * leaf.width;
+                if c.kind == CurveKind::Flat {
+                    flat
+                } else {
+                    let theta = lerp(leaf.v, -90.0f32, 90.0).to_radians();
+                    rotate(flat, dpdu.normalize(), -theta)
+                }
+            }
+        };
+        let dpdv = if dpdv.is_finite() && dpdv.length_squared() > 0.0 {
+            dpdv
+        } else {
+            coordinate_system(dpdu.normalize()).0 * leaf.width
+        };
+        if !(t.is_finite() && p.is_finite() && dpdv.is_finite()) {
+            return None;
+        }
+        Some((
+            t,
+            CurveHit {
+                p,
+                err: 2.0 * leaf.width,
+                uv: Vec2::new(leaf.u, leaf.v),
+                dpdv,
+            },
+        ))
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn recurse(
         &self,
@@ -645,93 +741,11 @@ impl Analytic for Curve {
     }
 
     /// Closest hit with 0 < t ≤ t_max (world ray; `t` is the same in object
-    /// space).
+    /// space): [`Curve::hit`].
+    #[inline]
     fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, AnalyticHit)> {
-        let (o, d) = self.common.placement.ray_to_object(o, d);
-        let (o, d) = (o.as_vec3(), d.as_vec3());
-        let ray_len = d.length();
-        if !(ray_len > 0.0 && ray_len.is_finite()) {
-            return None;
-        }
-        let dir = d / ray_len;
-        let cp_obj = self.control_points();
-        // The frame's "up" is along the chord, so the projected curve lies
-        // roughly along x and its boxes are thin in y.
-        let mut up = dir.cross(cp_obj[3] - cp_obj[0]);
-        if up.length_squared() == 0.0 {
-            up = coordinate_system(dir).0;
-        }
-        let right = up.normalize().cross(dir);
-        if right.length_squared().is_nan() || right.length_squared() <= 0.0 || !right.is_finite() {
-            return None;
-        }
-        let right = right.normalize();
-        let new_up = dir.cross(right);
-        let to_ray = |p: Vec3| {
-            let q = p - o;
-            Vec3::new(q.dot(right), q.dot(new_up), q.dot(dir))
-        };
-        let cp = cp_obj.map(to_ray);
-        let z_max = ray_len * t_max;
-        if !overlaps(&cp, self.max_width(), z_max) {
-            return None;
-        }
-        // Subdivision depth from the curve's second differences (pbrt-v3's
-        // bound for a flatness within width / 20).
-        let mut l0 = 0.0f32;
-        for i in 0..2 {
-            let dd = (cp[i] - 2.0 * cp[i + 1] + cp[i + 2]).abs();
-            l0 = l0.max(dd.x.max(dd.y).max(dd.z));
-        }
-        let eps = self.common.width[0].max(self.common.width[1]) * 0.05;
-        let depth =
-            (log2_round(std::f32::consts::SQRT_2 * 6.0 * l0 / (8.0 * eps)) / 2).clamp(0, 10);
-        let mut best: Option<(f32, Leaf)> = None;
-        let mut z_best = z_max;
-        self.recurse(
-            &cp,
-            self.u_min,
-            self.u_max,
-            depth,
-            dir,
-            &mut z_best,
-            &mut best,
-        );
-        let (z, leaf) = best?;
-        let t = z / ray_len;
-        let p = o + d * t;
-        let c = &self.common;
-        let dpdu = bezier_derivative(&c.cp, leaf.u);
-        let dpdv = match c.kind {
-            CurveKind::Ribbon => leaf.n_ribbon.cross(dpdu).normalize() * leaf.width,
-            CurveKind::Flat | CurveKind::Cylinder => {
-                // Across the curve in the plane facing the ray.
-                let flat = dir.cross(dpdu).normalize() * leaf.width;
-                if c.kind == CurveKind::Flat {
-                    flat
-                } else {
-                    let theta = lerp(leaf.v, -90.0f32, 90.0).to_radians();
-                    rotate(flat, dpdu.normalize(), -theta)
-                }
-            }
-        };
-        let dpdv = if dpdv.is_finite() && dpdv.length_squared() > 0.0 {
-            dpdv
-        } else {
-            coordinate_system(dpdu.normalize()).0 * leaf.width
-        };
-        if !(t.is_finite() && p.is_finite() && dpdv.is_finite()) {
-            return None;
-        }
-        Some((
-            t,
-            AnalyticHit::Curve(CurveHit {
-                p,
-                err: 2.0 * leaf.width,
-                uv: Vec2::new(leaf.u, leaf.v),
-                dpdv,
-            }),
-        ))
+        self.hit(o, d, t_max)
+            .map(|(t, h)| (t, AnalyticHit::Curve(h)))
     }
 
     /// World point, error bound and oriented normal n̂(dp/du × dp/dv).

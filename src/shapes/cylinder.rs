@@ -104,10 +104,11 @@ impl Cylinder {
 
     /// World-space surface point for an object-space point on the tube,
     /// with pbrt-v3's object-space error bound γ3·|(x, y, 0)|.
+    #[inline]
     fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
         let obj_err = DVec3::new(p_obj.x.abs(), p_obj.y.abs(), 0.0) * gamma(3) as f64;
         let n = self.at.place.normal(DVec3::new(p_obj.x, p_obj.y, 0.0));
-        self.at.place.exact_point(p_obj, obj_err, n)
+        self.at.place.exact_point(p_obj, Some(obj_err), n)
     }
 }
 
@@ -117,11 +118,7 @@ impl Analytic for Cylinder {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.world_to_object.is_finite()
-            && self.radius > 0.0
-            && self.z_max > self.z_min
-            && self.area > 0.0
-            && self.area.is_finite()
+        self.radius > 0.0 && self.z_max > self.z_min && self.at.place.holds(self.area)
     }
 
     fn area(&self) -> f32 {
@@ -129,10 +126,9 @@ impl Analytic for Cylinder {
     }
 
     fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
         self.at
             .place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+            .zone_bounds(self.radius, self.z_min, self.z_max)
     }
 
     /// Closest hit with 0 < t < t_max (pbrt-v3's `Cylinder::Intersect`).

@@ -128,8 +128,9 @@ impl Disk {
 
     /// World-space surface point for an object-space point on the disk:
     /// zero object-space error (z is exact; x, y are f64).
+    #[inline]
     fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
-        self.at.place.exact_point(p_obj, DVec3::ZERO, self.n)
+        self.at.place.exact_point(p_obj, None, self.n)
     }
 }
 
@@ -140,11 +141,7 @@ impl Analytic for Disk {
 
     /// False for singular transforms and empty disks: left out of the scene.
     fn is_valid(&self) -> bool {
-        self.at.place.world_to_object.is_finite()
-            && self.radius > 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
-            && self.n.is_finite()
+        self.radius > 0.0 && self.n.is_finite() && self.at.place.holds(self.area)
     }
 
     fn area(&self) -> f32 {

@@ -236,6 +236,7 @@ impl Hyperboloid {
         (dpdu, dpdv)
     }
 
+    #[inline]
     fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
         self.at
             .place
@@ -253,13 +254,12 @@ impl Analytic for Hyperboloid {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.is_valid()
-            && self.a.is_finite()
+        self.a.is_finite()
             && self.c.is_finite()
             && self.z_max > self.z_min
             && self.r_max.is_finite()
-            && self.area > 0.0
-            && self.area.is_finite()
+            && self.at.place.is_valid()
+            && self.at.place.holds(self.area)
     }
 
     fn bounds(&self) -> Bounds3 {

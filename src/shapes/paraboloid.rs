@@ -160,6 +160,7 @@ impl Paraboloid {
         }
     }
 
+    #[inline]
     fn point_at(&self, p_obj: DVec3, err: DVec3) -> SurfacePoint {
         self.at
             .place
@@ -177,19 +178,17 @@ impl Analytic for Paraboloid {
     }
 
     fn is_valid(&self) -> bool {
-        self.at.place.is_valid()
-            && self.radius > 0.0
+        self.radius > 0.0
             && self.z_max > self.z_min
             && self.z_min >= 0.0
-            && self.area > 0.0
-            && self.area.is_finite()
+            && self.at.place.is_valid()
+            && self.at.place.holds(self.area)
     }
 
     fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
         self.at
             .place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+            .zone_bounds(self.radius, self.z_min, self.z_max)
     }
 
     /// Closest hit with 0 < t < t_max, as pbrt-v3's `Paraboloid::Intersect`

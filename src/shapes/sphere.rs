@@ -155,11 +155,12 @@ impl Sphere {
 
     /// World-space surface point for an object-space point on the sphere:
     /// the object-space error of the reprojected point is pbrt-v3's γ5·|p|.
+    #[inline]
     fn point_at(&self, p_obj: DVec3) -> SurfacePoint {
         let obj_err = p_obj.abs() * gamma(5) as f64;
         self.at
             .place
-            .exact_point(p_obj, obj_err, self.at.place.normal(p_obj))
+            .exact_point(p_obj, Some(obj_err), self.at.place.normal(p_obj))
     }
 
     /// World-area density of `sample_area` at the point with object-space
@@ -202,10 +203,7 @@ impl Analytic for Sphere {
     /// False for singular transforms (e.g. `Scale 0 0 0`): such a sphere has
     /// no area and is left out of the scene.
     fn is_valid(&self) -> bool {
-        self.radius > 0.0
-            && self.at.place.world_to_object.is_finite()
-            && self.area > 0.0
-            && self.area.is_finite()
+        self.radius > 0.0 && self.at.place.holds(self.area)
     }
 
     fn area(&self) -> f32 {
@@ -213,10 +211,9 @@ impl Analytic for Sphere {
     }
 
     fn bounds(&self) -> Bounds3 {
-        let r = self.radius;
         self.at
             .place
-            .bounds(DVec3::new(-r, -r, self.z_min), DVec3::new(r, r, self.z_max))
+            .zone_bounds(self.radius, self.z_min, self.z_max)
     }
 
     /// Closest hit with 0 < t < t_max; returns t and the object-space point.
