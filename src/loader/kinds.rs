@@ -4,13 +4,13 @@
 //! kind's `ParamSpec` list with pbrt-v3's defaults, the unused ones
 //! reported, and a [`Report`] that locates what the kind's builder says.
 
-use super::material::{read_params, Lookup};
-use super::state::closest_name;
-use super::texture::Textures;
+use super::params::Textures;
+use super::params::{read_params, Lookup};
 use super::Ctx;
 use crate::lang::params::ParamList;
 use crate::lang::parser::Name;
 use crate::lang::Loc;
+use crate::scene::kind::closest_name;
 use crate::scene::kind::{self, Kind, Report};
 use crate::scene::ParamValues;
 

@@ -26,6 +26,7 @@ pub mod material;
 pub mod medium;
 pub mod meshfile;
 pub mod options;
+pub mod params;
 pub mod ply;
 pub mod reference;
 pub mod refine;

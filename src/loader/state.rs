@@ -4,8 +4,10 @@
 //! `Shape` statement with the state current at it (transforms and motion,
 //! media, area light, material) is built in `state/shape.rs`.
 
-use super::material::{self, Lookup, MaterialSpec};
-use super::texture::{self as texture, Defined, TextureState, Textures};
+use super::material::{self, MaterialSpec};
+use super::params::Lookup;
+use super::params::Textures;
+use super::texture::{self as texture, Defined, TextureState};
 use super::Ctx;
 use super::{lights, options};
 use crate::bxdf::MAX_BXDFS;

@@ -7,36 +7,19 @@
 
 use super::image::load_image;
 use super::lookup::one;
-use super::material::{read_params, read_params_as, Lookup};
-use super::state::closest_name;
+use super::params::{read_params, read_params_as, Lookup, TexEntry, Textures};
 use super::Ctx;
 use crate::lang::params::{ParamList, ParamType};
 use crate::lang::parser::Name;
 use crate::lang::Loc;
+use crate::scene::kind::closest_name;
 use crate::scene::{Decode, FloatTex, ParamValues, RgbImage, Tex};
 use crate::textures::{
     self, ImageSource, Mapping2D, Mapping3D, MappingUse, MipCache, TexBuilder, TexValue,
     TextureClass, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, TEXTURES, UV_MAPPING_PARAMS,
 };
 use glam::{DMat4, Vec3};
-use std::collections::HashMap;
 use std::sync::Arc;
-
-/// A named texture and where it was defined.
-#[derive(Clone, Debug)]
-pub struct TexEntry<T> {
-    pub tex: Tex<T>,
-    pub loc: Loc,
-    pub class: &'static str,
-}
-
-/// The textures visible at a statement, by name (pbrt-v3 keeps float and
-/// spectrum textures in separate name spaces).
-#[derive(Clone, Debug, Default)]
-pub struct Textures {
-    pub float: HashMap<String, TexEntry<f32>>,
-    pub spectrum: HashMap<String, TexEntry<Vec3>>,
-}
 
 /// A texture a `Texture` statement defined.
 pub enum Defined {
