@@ -282,7 +282,10 @@ fn bad_maps_are_located_warnings_naming_the_file() {
             panic!("{name}: not loaded");
         };
         let msg: String = loaded.warnings.iter().map(|w| format!("{w}\n")).collect();
-        assert!(msg.contains("rendered as without \"mapname\""), "{name}: {msg}");
+        assert!(
+            msg.contains("rendered as without \"mapname\""),
+            "{name}: {msg}"
+        );
         assert!(
             matches!(&loaded.scene.lights[..], [Light::Infinite(i)] if i.map.le(glam::Vec3::X) == glam::Vec3::ONE),
             "{name}: not the constant light"

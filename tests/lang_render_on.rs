@@ -106,7 +106,10 @@ fn strict_fails_early_and_writes_nothing() {
             .env("NO_COLOR", "1")
             .output()
             .unwrap();
-        (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
     };
     let (code, err) = run(false, "default.pfm");
     assert_eq!(code, Some(0), "{err}");
@@ -114,7 +117,12 @@ fn strict_fails_early_and_writes_nothing() {
     assert!(dir.join("default.pfm").exists());
     let (code, err) = run(true, "strict.pfm");
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("× ") && err.contains("scene.pbrt:7:") && err.contains("an error with --strict"), "{err}");
+    assert!(
+        err.contains("× ")
+            && err.contains("scene.pbrt:7:")
+            && err.contains("an error with --strict"),
+        "{err}"
+    );
     assert!(!dir.join("strict.pfm").exists());
     std::fs::remove_dir_all(&dir).ok();
 }

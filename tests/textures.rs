@@ -665,26 +665,26 @@ fn bad_texture_input_warns_with_locations() {
     ] {
         assert!(w.contains(expect), "missing \"{expect}\" in:\n{w}");
     }
-    // An image that cannot be read is an error naming the file.
-    let e = match try_load(
-        "WorldBegin\nTexture \"t\" \"color\" \"imagemap\" \"string filename\" \"nothere.png\"\nWorldEnd",
-        &f,
-    ) {
-        Ok(_) => panic!("loaded with a missing image"),
-        Err(fail) => fail.errors.iter().map(|e| e.to_string()).collect::<Vec<_>>().join("\n"),
-    };
-    assert!(e.contains("nothere.png"), "{e}");
-    // A corrupt image too.
+    // An image that cannot be read, missing or corrupt: a warning naming the
+    // file and the substitute, pbrt-v3's constant grey (an error with
+    // --strict).
     let mut bad = MemFiles::default();
     bad.0.insert(
         dir().join("bad.png"),
         b"\x89PNG\r\n\x1a\nnot really".to_vec(),
     );
-    assert!(try_load(
-        "WorldBegin\nTexture \"t\" \"float\" \"imagemap\" \"string filename\" \"bad.png\"\nWorldEnd",
-        &bad,
-    )
-    .is_err());
+    for file in ["nothere.png", "bad.png"] {
+        let s = load(
+            &format!("WorldBegin\nTexture \"t\" \"color\" \"imagemap\" \"string filename\" \"{file}\"\nWorldEnd"),
+            &bad,
+        );
+        let w = warnings(&s);
+        assert!(
+            w.contains(file) && w.contains("a constant grey texture (0.5) is used instead"),
+            "{w}"
+        );
+        assert!(pbrs::loader::strictly(vec![s]).is_err());
+    }
 }
 
 /// Every class, both types, with every parameter given a value of every

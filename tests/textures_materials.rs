@@ -221,7 +221,11 @@ fn every_textured_parameter_is_read_at_the_hit() {
     for k in surface_kinds() {
         let (m, i, _) = materials(&format!("Material \"{}\"", k.name));
         // (hair always reads the curve's v and dp/du.)
-        assert!(k.name == "hair" || !m[i].needs_geom(), "{} with its defaults", k.name);
+        assert!(
+            k.name == "hair" || !m[i].needs_geom(),
+            "{} with its defaults",
+            k.name
+        );
         for p in textured_params(k) {
             let a = test_value(p);
             let b = a + 0.3;
