@@ -44,7 +44,7 @@ mod subsurface;
 pub use batch::Batch;
 pub use render_scene::{RenderScene, SurfaceMedia};
 use specular::Work;
-pub use sppm::SppmRun;
+pub use sppm::{SppmRun, PIXEL_BYTES as SPPM_PIXEL_BYTES};
 
 /// Rays traced, counted per tile and summed at the end (no shared counters).
 #[derive(Clone, Copy, Debug, Default)]

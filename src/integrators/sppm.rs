@@ -256,6 +256,10 @@ struct Pixel<'a> {
     tau: Vec3,
 }
 
+/// Bytes SPPM keeps per pixel (its state with the visible point's BSDF),
+/// for the driver's memory check before anything is allocated.
+pub const PIXEL_BYTES: u64 = std::mem::size_of::<Pixel<'static>>() as u64;
+
 /// What [`Sppm::render`] needs of the render: the scene, the film's
 /// (cropped) pixel bounds, the seed of the camera pass's Halton sampler and
 /// the worker threads.

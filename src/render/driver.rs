@@ -654,7 +654,14 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
         .max(0.0) as u64;
     let h = ((f.yresolution as f64 * y1 as f64).ceil() - (f.yresolution as f64 * y0 as f64).ceil())
         .max(0.0) as u64;
-    let need = w * h * BYTES_PER_PIXEL;
+    // sppm keeps each pixel's state and visible point besides the film.
+    let per_pixel = match desc.integrator {
+        crate::integrators::IntegratorSettings::Sppm(_) => {
+            BYTES_PER_PIXEL + crate::integrators::SPPM_PIXEL_BYTES
+        }
+        _ => BYTES_PER_PIXEL,
+    };
+    let need = w * h * per_pixel;
     match available_memory_bytes() {
         Some(avail) if need > avail / 10 * 9 => Err(format!(
             "the film needs {:.1} GiB ({w}×{h} pixels), more than the {:.1} GiB of memory available",
