@@ -297,7 +297,8 @@ impl Renderer {
             });
         });
         if let Some(e) = write_error {
-            self.stats
+            // Kept with the scene's notes, which `stats` reports.
+            self.scene
                 .notes
                 .push(format!("sppm: an intermediate image was not written: {e}"));
         }
