@@ -45,6 +45,12 @@ const CASES: &[Case] = &[
         params: "\"integer nsamples\" 8 \"bool cossample\" \"false\"",
         summary: "ambientocclusion, nsamples 8, uniform sampling",
     },
+    Case {
+        kind: "sppm",
+        params:
+            "\"integer iterations\" 4 \"integer photonsperiteration\" 2000 \"float radius\" 0.2",
+        summary: "sppm, iterations 4, photons per iteration 2000, maxdepth 5, radius 0.2",
+    },
 ];
 
 /// A small scene lit by a point light and an area light: a matte floor, a

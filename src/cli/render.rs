@@ -49,8 +49,11 @@ pub fn scenes_label(args: &Args) -> String {
 /// resolution by 4 (at least 1) before the crop window applies; every
 /// sampler but "random" takes 1 sample per pixel (stratified: 1 × 1); the
 /// diffuse area and infinite lights take a quarter of their "nsamples" (at
-/// least 1).
+/// least 1); sppm takes a sixteenth of its iterations (at least 1).
 pub fn apply_quick(desc: &mut SceneDescription) {
+    if let crate::integrators::IntegratorSettings::Sppm(s) = &mut desc.integrator {
+        s.iterations = (s.iterations / 16).max(1);
+    }
     desc.film.xresolution = (desc.film.xresolution / 4).max(1);
     desc.film.yresolution = (desc.film.yresolution / 4).max(1);
     match &mut desc.sampler.kind {

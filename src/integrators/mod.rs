@@ -1,12 +1,15 @@
 //! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
 //! power-heuristic MIS, Russian roulette), `volpath` (the same with
 //! participating media), `directlighting` (strategy all or one, specular
-//! lobes followed recursively) and `whitted`.
+//! lobes followed recursively), `whitted`, `ambientocclusion` and `sppm`
+//! (stochastic progressive photon mapping).
 //!
 //! One file per integrator: [`path`] (with the per-vertex step `path` and
 //! `volpath` share, over the medium the path is in), [`volpath`] (the
-//! medium tracking and transmittance of that step), [`directlighting`] and
-//! [`whitted`]; the recursive specular tree that directlighting and
+//! medium tracking and transmittance of that step), [`directlighting`],
+//! [`whitted`], [`ambientocclusion`] and [`sppm`] (photon mapping, which
+//! has its own render loop, [`sppm::Sppm::render`], that the driver calls
+//! instead of the tile loop); the recursive specular tree that directlighting and
 //! whitted share ([`specular`]); the batch of samples a thread renders
 //! together ([`batch`]: `path` and `volpath` one vertex of every lane at a
 //! time); directlighting's four-lane estimate ([`direct_lanes`]); and what
@@ -41,6 +44,7 @@ mod subsurface;
 pub use batch::Batch;
 pub use render_scene::{RenderScene, SurfaceMedia};
 use specular::Work;
+pub use sppm::{SppmRun, PIXEL_BYTES as SPPM_PIXEL_BYTES};
 
 /// Rays traced, counted per tile and summed at the end (no shared counters).
 #[derive(Clone, Copy, Debug, Default)]
@@ -86,7 +90,7 @@ pub type IntegratorBuild = fn(&ParamValues, &mut dyn Report) -> IntegratorSettin
 /// One integrator kind: its pbrt-v3 name, its parameters, its builder.
 pub type IntegratorKind = Kind<IntegratorBuild>;
 
-/// Every integrator pbrt-v3 knows: the four pbrs renders, then those it
+/// Every integrator pbrt-v3 knows: those pbrs renders, then those it
 /// substitutes by `path` (with the statement's `maxdepth`, and a warning).
 pub static INTEGRATORS: &[IntegratorKind] = &[
     path::KIND,
@@ -94,12 +98,9 @@ pub static INTEGRATORS: &[IntegratorKind] = &[
     directlighting::KIND,
     whitted::KIND,
     ambientocclusion::KIND,
+    sppm::KIND,
     unsupported("bdpt", "bidirectional path tracing is not implemented"),
     unsupported("mlt", "Metropolis light transport is not implemented"),
-    unsupported(
-        "sppm",
-        "stochastic progressive photon mapping is not implemented",
-    ),
 ];
 
 /// `maxdepth`, which every integrator reads.
@@ -333,6 +334,7 @@ integrators! {
     DirectLighting(DirectLightingSettings) => directlighting::DirectLighting,
     Whitted(WhittedSettings) => whitted::Whitted,
     AmbientOcclusion(AmbientOcclusionSettings) => ambientocclusion::AmbientOcclusion,
+    Sppm(SppmSettings) => sppm::Sppm,
 }
 
 /// Without an `Integrator` statement: `path` with pbrt-v3's defaults.

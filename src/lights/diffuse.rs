@@ -19,9 +19,10 @@
 //! vertices ([`TriangleCache`]), with no visit to its mesh.
 
 use super::bvh::LightBounds;
-use super::{contribution_by_sampling, AreaLightKind, LightModel, LightSample};
+use super::{contribution_by_sampling, AreaLightKind, EmittedRay, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray, spawn_ray_to, Bounds3, Ray};
+use crate::geometry::{luminance, spawn_ray, spawn_ray_to, Bounds3, Frame, Ray};
+use crate::sampling::{cosine_hemisphere_pdf, cosine_sample_hemisphere, ONE_MINUS_EPSILON};
 use crate::scene::{ParamSpec, ParamValues, Support};
 use crate::shapes::{sample_triangle_point, SurfacePoint};
 use glam::{Vec2, Vec3};
@@ -210,6 +211,43 @@ impl LightModel for DiffuseLight {
                 geom.quadrics[i as usize].pdf_from(r.p, r.p_error, r.n, ray.d)
             }
         }
+    }
+
+    /// pbrt-v3's: a point uniform by area on the shape (`u1`), a direction
+    /// by cosine around its normal (`u2`; for a two-sided light `u2.x`
+    /// first chooses the side).
+    fn sample_le(&self, u1: Vec2, u2: Vec2, geom: &Aggregate) -> Option<EmittedRay> {
+        let s = match self.shape {
+            AreaShape::Triangle { mesh, tri } => geom.meshes[mesh as usize].sample_area(tri, u1),
+            AreaShape::Analytic(i) => geom.quadrics[i as usize].sample_area(u1)?,
+        };
+        let (w, pdf_dir) = if self.two_sided {
+            let (x, flip) = if u2.x < 0.5 {
+                ((u2.x * 2.0).min(ONE_MINUS_EPSILON), false)
+            } else {
+                (((u2.x - 0.5) * 2.0).min(ONE_MINUS_EPSILON), true)
+            };
+            let mut w = cosine_sample_hemisphere(Vec2::new(x, u2.y));
+            if flip {
+                w.z = -w.z;
+            }
+            (w, 0.5 * cosine_hemisphere_pdf(w.z.abs()))
+        } else {
+            let w = cosine_sample_hemisphere(u2);
+            (w, cosine_hemisphere_pdf(w.z))
+        };
+        let n = s.point.n;
+        let w = Frame::from_normal(n).from_local(w);
+        if !(s.pdf > 0.0 && pdf_dir > 0.0) {
+            return None;
+        }
+        Some(EmittedRay {
+            le: self.emitted(n, w),
+            ray: spawn_ray(s.point.p, s.point.p_error, n, w),
+            n,
+            pdf_pos: s.pdf,
+            pdf_dir,
+        })
     }
 
     /// pbrt-v4's: the shape's bounds, its normal's cone (the whole sphere

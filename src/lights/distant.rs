@@ -13,7 +13,7 @@
 //! Power is `L`·π r², r the scene's bounding radius (set when the scene is
 //! built, [`LightModel::preprocess`]).
 
-use super::{LightKind, LightModel, LightSample};
+use super::{disk_ray, EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
 use crate::geometry::spawn_ray_to_point;
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
@@ -98,6 +98,19 @@ impl LightModel for DistantLight {
             wi: self.w,
             pdf: 1.0,
             shadow: spawn_ray_to_point(r.p, r.p_error, r.n, far),
+        })
+    }
+
+    /// pbrt-v3's: a ray along the light's direction from a point uniform
+    /// on the disk of the scene's bounding sphere facing the light.
+    fn sample_le(&self, u1: Vec2, _u2: Vec2, geom: &Aggregate) -> Option<EmittedRay> {
+        let (ray, pdf_pos) = disk_ray(geom, self.scene_radius, self.w, u1)?;
+        Some(EmittedRay {
+            le: self.l,
+            ray,
+            n: ray.d,
+            pdf_pos,
+            pdf_dir: 1.0,
         })
     }
 

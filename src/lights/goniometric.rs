@@ -19,9 +19,10 @@
 //! average (its MIP lookup at (½, ½) with width ½, as pbrt-v3).
 
 use super::bvh::LightBounds;
-use super::{LightKind, LightModel, LightSample};
+use super::{EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3};
+use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Ray};
+use crate::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
 use crate::scene::{Decode, ParamSpec, ParamValues, Report, RgbImage, Support};
 use crate::shapes::SurfacePoint;
 use crate::textures::{MipMap, Wrap};
@@ -206,6 +207,18 @@ impl LightModel for GoniometricLight {
             wi,
             pdf: 1.0,
             shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
+        })
+    }
+
+    /// pbrt-v3's: a direction uniform over the sphere.
+    fn sample_le(&self, u1: Vec2, _u2: Vec2, _geom: &Aggregate) -> Option<EmittedRay> {
+        let d = uniform_sample_sphere(u1);
+        Some(EmittedRay {
+            le: self.intensity * self.scale(d),
+            ray: Ray::new(self.p, d),
+            n: d,
+            pdf_pos: 1.0,
+            pdf_dir: uniform_sphere_pdf(),
         })
     }
 

@@ -36,7 +36,7 @@
 //! normalised (pbrt-v3 leaves them as transformed, which differs only for a
 //! transform that scales).
 
-use super::{LightKind, LightModel, LightSample};
+use super::{disk_ray, EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
 use crate::geometry::spawn_ray;
 use crate::geometry::{luminance, Ray};
@@ -182,6 +182,21 @@ impl LightModel for InfiniteLight {
     #[inline]
     fn pdf_li_ray(&self, _r: &SurfacePoint, ray: &Ray, _geom: &Aggregate) -> f32 {
         self.map.pdf(ray.d)
+    }
+
+    /// pbrt-v3's: a direction as `sample_li` samples it (`u1`), the ray
+    /// coming from it through a point uniform on the disk of the scene's
+    /// bounding sphere facing it (`u2`).
+    fn sample_le(&self, u1: Vec2, u2: Vec2, geom: &Aggregate) -> Option<EmittedRay> {
+        let (wi, le, pdf_dir) = self.map.sample(u1)?;
+        let (ray, pdf_pos) = disk_ray(geom, self.scene_radius, wi, u2)?;
+        (pdf_dir > 0.0).then_some(EmittedRay {
+            le,
+            ray,
+            n: ray.d,
+            pdf_pos,
+            pdf_dir,
+        })
     }
 
     fn preprocess(&mut self, geom: &Aggregate) {

@@ -38,6 +38,7 @@ use crate::scene::{Kind, ParamValues, Report};
 use crate::shapes::SurfacePoint;
 use bvh::LightBounds;
 use glam::{DMat4, Vec2, Vec3};
+use std::f32::consts::PI;
 
 /// What a `LightSource` kind builds from its parameters and the CTM
 /// (light-to-world); `None` when pbrt-v3's checks refuse the light (the
@@ -77,6 +78,23 @@ pub struct LightSample {
     pub pdf: f32,
     /// The shadow ray to test; unoccluded means the light is seen.
     pub shadow: Ray,
+}
+
+/// A ray leaving a light, as pbrt-v3's `Sample_Le` samples it (photon
+/// emission for `sppm`, light subpaths for bidirectional methods).
+#[derive(Clone, Copy, Debug)]
+pub struct EmittedRay {
+    /// Emitted radiance along the ray (area and infinite lights; the
+    /// distant light's radiance) or intensity (point-like lights).
+    pub le: Vec3,
+    pub ray: Ray,
+    /// The normal at the ray's origin (the ray's direction where the light
+    /// has no surface).
+    pub n: Vec3,
+    /// Density of the origin by area (1 for a point).
+    pub pdf_pos: f32,
+    /// Density of the direction by solid angle (1 for a distant light).
+    pub pdf_dir: f32,
 }
 
 /// What every light type does (pbrt-v3's `Light` interface). The defaults
@@ -134,6 +152,11 @@ pub trait LightModel {
     /// not tested here: the caller traces `shadow`.
     fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Aggregate) -> Option<LightSample>;
 
+    /// A ray leaving the light from `u1` (its origin) and `u2` (its
+    /// direction), pbrt-v3's `Sample_Le`; `None` when nothing is emitted or
+    /// a density is 0. Every light kind has its own.
+    fn sample_le(&self, u1: Vec2, u2: Vec2, geom: &Aggregate) -> Option<EmittedRay>;
+
     /// Solid-angle density of `sample_li` producing direction `wi` from `r`
     /// (pbrt-v3's `Pdf_Li`); 0 when `wi` cannot come from this light.
     #[inline]
@@ -157,6 +180,25 @@ pub trait LightModel {
     /// What the light needs of the built scene (pbrt-v3's `Preprocess`:
     /// the scene's bounding radius for distant and infinite lights).
     fn preprocess(&mut self, _geom: &Aggregate) {}
+}
+
+/// A ray coming from direction `w` (unit, towards the light) into the
+/// scene: its origin uniform (from `u`) on the disk of radius `radius`
+/// (the scene's bounding radius) around the scene's centre, perpendicular
+/// to `w`, moved out by `radius` along `w`, and its density by area
+/// (pbrt-v3's distant and infinite `Sample_Le`). `None` for an empty scene.
+pub(crate) fn disk_ray(geom: &Aggregate, radius: f32, w: Vec3, u: Vec2) -> Option<(Ray, f32)> {
+    if radius <= 0.0 || radius.is_nan() {
+        return None;
+    }
+    let center = geom.bounds.bounding_sphere().0;
+    let f = crate::geometry::Frame::from_normal(w);
+    let cd = crate::sampling::concentric_sample_disk(u);
+    let p_disk = center + radius * (cd.x * f.s + cd.y * f.t);
+    Some((
+        Ray::new(p_disk + radius * w, -w),
+        1.0 / (PI * radius * radius),
+    ))
 }
 
 /// [`LightModel::contribution`] by one `sample_li` from a point with no
@@ -238,6 +280,11 @@ macro_rules! lights {
             #[inline]
             pub fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Aggregate) -> Option<LightSample> {
                 match self { $(Light::$variant(l) => l.sample_li(r, u, geom),)* }
+            }
+            /// See [`LightModel::sample_le`].
+            #[inline]
+            pub fn sample_le(&self, u1: Vec2, u2: Vec2, geom: &Aggregate) -> Option<EmittedRay> {
+                match self { $(Light::$variant(l) => l.sample_le(u1, u2, geom),)* }
             }
             #[inline]
             pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Aggregate) -> f32 {

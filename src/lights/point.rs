@@ -11,9 +11,10 @@
 //! CTM scales or rotates).
 
 use super::bvh::LightBounds;
-use super::{LightKind, LightModel, LightSample};
+use super::{EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3};
+use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Ray};
+use crate::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
 use crate::scene::{ParamSpec, ParamValues, Support};
 use crate::shapes::SurfacePoint;
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -83,6 +84,18 @@ impl LightModel for PointLight {
             wi: d / d2.sqrt(),
             pdf: 1.0,
             shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
+        })
+    }
+
+    /// pbrt-v3's: a direction uniform over the sphere.
+    fn sample_le(&self, u1: Vec2, _u2: Vec2, _geom: &Aggregate) -> Option<EmittedRay> {
+        let d = uniform_sample_sphere(u1);
+        Some(EmittedRay {
+            le: self.intensity,
+            ray: Ray::new(self.p, d),
+            n: d,
+            pdf_pos: 1.0,
+            pdf_dir: uniform_sphere_pdf(),
         })
     }
 

@@ -24,9 +24,10 @@
 
 use super::bvh::LightBounds;
 use super::goniometric::{light_frame, LightMap};
-use super::{LightKind, LightModel, LightSample};
+use super::{EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3};
+use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame, Ray};
+use crate::sampling::{uniform_cone_pdf, uniform_sample_cone};
 use crate::scene::{Decode, ParamSpec, ParamValues, Report, Support};
 use crate::shapes::SurfacePoint;
 use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
@@ -162,6 +163,25 @@ impl LightModel for ProjectionLight {
             wi,
             pdf: 1.0,
             shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
+        })
+    }
+
+    /// A direction uniform over the cone around the frustum (directions
+    /// outside the frustum carry no intensity). pbrt-v3 samples the cone of
+    /// `cos_total_width`, whose tangent is tan(fov/2)·√(1 + 1/aspect²):
+    /// when the map is wider than tall that cone misses the frustum's
+    /// corners (its half-diagonal has tangent tan(fov/2)·√(aspect² + 1)),
+    /// and their light would never be emitted; this cone is the frustum's.
+    fn sample_le(&self, u1: Vec2, _u2: Vec2, _geom: &Aggregate) -> Option<EmittedRay> {
+        let tan_diag = self.screen[1].hypot(self.screen[3]) / self.inv_tan;
+        let cos_max = 1.0 / (1.0 + tan_diag * tan_diag).sqrt();
+        let d = Frame::from_normal(self.axis).from_local(uniform_sample_cone(u1, cos_max));
+        Some(EmittedRay {
+            le: self.intensity * self.projection(d),
+            ray: Ray::new(self.p, d),
+            n: d,
+            pdf_pos: 1.0,
+            pdf_dir: uniform_cone_pdf(cos_max),
         })
     }
 

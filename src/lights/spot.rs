@@ -18,9 +18,10 @@
 //! of (cos θ − cos total)/(cos falloff − cos total) between.
 
 use super::bvh::{safe_acos, LightBounds};
-use super::{LightKind, LightModel, LightSample};
+use super::{EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame};
+use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame, Ray};
+use crate::sampling::{uniform_cone_pdf, uniform_sample_cone};
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
 use crate::shapes::SurfacePoint;
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -118,6 +119,22 @@ impl SpotLight {
     }
 }
 
+impl SpotLight {
+    /// pbrt-v3's `Falloff` at the cosine `cos` of a direction leaving the
+    /// light with the axis.
+    #[inline]
+    fn falloff(&self, cos: f32) -> f32 {
+        if cos < self.cos_total {
+            0.0
+        } else if cos > self.cos_falloff_start {
+            1.0
+        } else {
+            let delta = (cos - self.cos_total) / (self.cos_falloff_start - self.cos_total);
+            (delta * delta) * (delta * delta)
+        }
+    }
+}
+
 impl LightModel for SpotLight {
     #[inline]
     fn is_delta(&self) -> bool {
@@ -136,20 +153,25 @@ impl LightModel for SpotLight {
             return None;
         }
         let wi = d / d2.sqrt();
-        let cos = self.frame.to_local(-wi).z;
-        let falloff = if cos < self.cos_total {
-            0.0
-        } else if cos > self.cos_falloff_start {
-            1.0
-        } else {
-            let delta = (cos - self.cos_total) / (self.cos_falloff_start - self.cos_total);
-            (delta * delta) * (delta * delta)
-        };
+        let falloff = self.falloff(self.frame.to_local(-wi).z);
         Some(LightSample {
             li: self.intensity * falloff / d2,
             wi,
             pdf: 1.0,
             shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
+        })
+    }
+
+    /// pbrt-v3's: a direction uniform over the cone of `coneangle`.
+    fn sample_le(&self, u1: Vec2, _u2: Vec2, _geom: &Aggregate) -> Option<EmittedRay> {
+        let local = uniform_sample_cone(u1, self.cos_total);
+        let d = self.frame.from_local(local);
+        Some(EmittedRay {
+            le: self.intensity * self.falloff(local.z),
+            ray: Ray::new(self.p, d),
+            n: d,
+            pdf_pos: 1.0,
+            pdf_dir: uniform_cone_pdf(self.cos_total),
         })
     }
 

@@ -85,6 +85,10 @@ pub struct Renderer {
     stats: RenderStats,
     /// Samples in flight per thread (1: the scalar loop).
     batch: usize,
+    /// The image file, for integrators that write images as they go
+    /// (`sppm`'s `imagewritefrequency`).
+    output: std::path::PathBuf,
+    seed: u64,
 }
 
 impl Renderer {
@@ -118,6 +122,8 @@ impl Renderer {
             pool,
             stats,
             batch,
+            output: desc.film.filename.clone(),
+            seed: opts.seed,
         })
     }
 
@@ -155,6 +161,9 @@ impl Renderer {
         region: Option<Bounds2i>,
         on_chunk: &mut dyn FnMut(&ChunkDone),
     ) {
+        if let Integrator::Sppm(_) = self.integrator {
+            return self.render_sppm(on_chunk);
+        }
         let t1 = Instant::now();
         let mut tiles = self.film.tiles(16);
         if let Some(r) = region {
@@ -253,6 +262,51 @@ impl Renderer {
         self.stats.render_time += t1.elapsed();
     }
 
+    /// `sppm`'s own loop of iterations over the whole film: the film is
+    /// set to the image after every iteration (`on_chunk` is called with
+    /// the iterations as its groups), and the image file is written
+    /// (atomically) where `imagewritefrequency` asks. The range of samples
+    /// and the region of the other integrators do not apply.
+    fn render_sppm(&mut self, on_chunk: &mut dyn FnMut(&ChunkDone)) {
+        let Integrator::Sppm(sppm) = &self.integrator else {
+            return;
+        };
+        let t1 = Instant::now();
+        let run = crate::integrators::SppmRun {
+            scene: &self.scene,
+            pixel_bounds: self.film.pixel_bounds(),
+            seed: self.seed,
+            pool: &self.pool,
+        };
+        let total = sppm.settings().iterations as usize;
+        let whole = [self.film.pixel_bounds()];
+        let (film, output) = (&mut self.film, &self.output);
+        let mut write_error = None;
+        let rays = sppm.render(&run, &mut |k, rgb, write| {
+            film.set_pixels(rgb);
+            if write && (k as usize) < total {
+                if let Err(e) = crate::image::io::write_image(output, &film.image()) {
+                    write_error = Some(e);
+                }
+            }
+            on_chunk(&ChunkDone {
+                done: k as usize,
+                total,
+                tiles: &whole,
+                film,
+            });
+        });
+        if let Some(e) = write_error {
+            // Kept with the scene's notes, which `stats` reports.
+            self.scene
+                .notes
+                .push(format!("sppm: an intermediate image was not written: {e}"));
+        }
+        self.stats.rays.add(&rays);
+        self.stats.samples += self.film.pixel_bounds().area().max(0) as u64 * total as u64;
+        self.stats.render_time += t1.elapsed();
+    }
+
     /// The sampler's samples per pixel.
     pub fn samples_per_pixel(&self) -> u32 {
         self.sampler.samples_per_pixel()
@@ -342,6 +396,11 @@ pub fn render_part(
     path: &std::path::Path,
 ) -> Result<RenderStats, String> {
     let mut r = Renderer::new(desc, opts)?;
+    if let Integrator::Sppm(_) = r.integrator {
+        return Err(format!(
+            "{kind}: sppm's iterations depend on each other (each shrinks the radii the next uses), so a frame cannot be split into parts; render it whole"
+        ));
+    }
     let spp = r.samples_per_pixel();
     let header = PartHeader::new(desc, r.film(), opts.seed, kind);
     match kind {
@@ -596,7 +655,14 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
         .max(0.0) as u64;
     let h = ((f.yresolution as f64 * y1 as f64).ceil() - (f.yresolution as f64 * y0 as f64).ceil())
         .max(0.0) as u64;
-    let need = w * h * BYTES_PER_PIXEL;
+    // sppm keeps each pixel's state and visible point besides the film.
+    let per_pixel = match desc.integrator {
+        crate::integrators::IntegratorSettings::Sppm(_) => {
+            BYTES_PER_PIXEL + crate::integrators::SPPM_PIXEL_BYTES
+        }
+        _ => BYTES_PER_PIXEL,
+    };
+    let need = w * h * per_pixel;
     match available_memory_bytes() {
         Some(avail) if need > avail / 10 * 9 => Err(format!(
             "the film needs {:.1} GiB ({w}×{h} pixels), more than the {:.1} GiB of memory available",

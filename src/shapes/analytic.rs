@@ -183,6 +183,11 @@ impl AnalyticShape {
     pub fn area_density(&self, p_obj: DVec3) -> f32 {
         each!(self, s => s.area_density(p_obj))
     }
+    /// A point sampled uniformly by area (density by area; `None` for
+    /// shapes that cannot be sampled, curves).
+    pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
+        each!(self, s => s.sample_area(u))
+    }
     /// A point sampled as seen from a reference point; density by solid
     /// angle.
     #[inline]

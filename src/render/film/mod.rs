@@ -192,6 +192,16 @@ impl Film {
         self.pixels[(o.y * w + o.x) as usize]
     }
 
+    /// Sets every pixel to `rgb` (row order over the pixel bounds), with
+    /// filter weight 1: the image is then `max(0, rgb) × scale` (pbrt-v3's
+    /// `Film::SetImage`, for integrators that compute pixels directly).
+    pub fn set_pixels(&mut self, rgb: &[Vec3]) {
+        for (p, v) in self.pixels.iter_mut().zip(rgb) {
+            p.contrib = v.as_dvec3().to_array();
+            p.weight = 1.0;
+        }
+    }
+
     /// Resets all sums to zero.
     pub fn clear(&mut self) {
         self.pixels.fill(PixelSums::default());

@@ -1,0 +1,772 @@
+//! `sppm`: pbrt-v3's SPPMIntegrator, stochastic progressive photon
+//! mapping. Each iteration (1) follows one camera path per pixel through
+//! specular bounces to its first diffuse vertex (or a glossy one at the
+//! last depth), adding emission and direct lighting (one light chosen
+//! uniformly, pbrt-v3's UniformSampleOneLight) on the way, and keeps that
+//! vertex as the pixel's visible point; (2) puts the visible points in a
+//! hash grid; (3) traces `photonsperiteration` photons from lights chosen
+//! by power (each light's [`crate::lights::LightModel::sample_le`]), each
+//! photon vertex after the first adding its power times the visible
+//! point's BSDF to every visible point within the pixel's radius; (4)
+//! shrinks each pixel's radius by pbrt-v3's rule (γ = 2/3). The image is
+//! the direct light averaged over iterations plus τ / (N_p · π · r²).
+//!
+//! | parameter | type | default | |
+//! |---|---|---|---|
+//! | `iterations` | integer | 64 | iterations (≥ 1); `numiterations` is read when it is absent |
+//! | `photonsperiteration` | integer | −1 | photons per iteration (−1: one per pixel) |
+//! | `maxdepth` | integer | 5 | bounces of camera paths and photon paths |
+//! | `radius` | float | 1 | initial search radius (> 0), in world units |
+//! | `imagewritefrequency` | integer | never | write the image every this many iterations |
+//! | `pixelbounds` | | | ignored, with a warning |
+//!
+//! As pbrt-v3, the camera pass uses its own Halton sampler of
+//! `iterations` samples per pixel (iteration i takes sample i; the scene's
+//! `Sampler` is not used), and photon i of iteration k takes the unscrambled
+//! radical inverses of index k·photonsperiteration + i, one prime base per
+//! dimension. The image has no pixel filter (pbrt-v3 sets the film's pixels
+//! directly). Unlike pbrt-v3, which adds photons with floating-point
+//! atomics, photons are traced in fixed chunks and their contributions
+//! added to the pixels in photon order, so the image does not depend on the
+//! thread count. Photons cross transmissive surfaces as importance (the
+//! radiance-mode (η_i/η_t)² of dielectric transmission is undone).
+
+use super::common::{emitted, escaped, light_sampler, shade};
+use super::directlighting::sample_one_light;
+use super::{
+    max_depth, Integrate, IntegratorKind, IntegratorSettings, RayCounts, Scratch, MAX_DEPTH,
+    MAX_PASS_THROUGH, PIXEL_BOUNDS,
+};
+use crate::geometry::{luminance, spawn_ray, Bounds2i, Bounds3, Ray, RayDiff};
+use crate::integrators::RenderScene;
+use crate::lights::LightSampler;
+use crate::materials::{Bsdf, BxdfFlags};
+use crate::samplers::lowdiscrepancy::{radical_inverse, DigitBase, PRIMES};
+use crate::samplers::{CameraSample, Sampler};
+use crate::scene::kind::{Report, Support};
+use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues, SamplerDesc, SamplerKind};
+use glam::{DVec3, IVec2, IVec3, Vec2, Vec3};
+use rayon::prelude::*;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec::int_opt("iterations", "iterations (≥ 1; default 64)"),
+    ParamSpec::int_opt(
+        "numiterations",
+        "iterations, read when \"iterations\" is absent",
+    ),
+    ParamSpec::int(
+        "photonsperiteration",
+        -1,
+        "photons traced per iteration (-1: the number of pixels)",
+    ),
+    MAX_DEPTH,
+    ParamSpec::float("radius", 1.0, "initial photon search radius (> 0)"),
+    ParamSpec::int_opt(
+        "imagewritefrequency",
+        "write the image every this many iterations (≥ 1; default: at the end only)",
+    ),
+    PIXEL_BOUNDS,
+];
+
+pub const KIND: IntegratorKind = IntegratorKind {
+    name: "sppm",
+    aliases: &[],
+    support: Support::Supported,
+    params: PARAMS,
+    doc: "stochastic progressive photon mapping: visible points from camera paths, photons from lights chosen by power, per-pixel radius reduction",
+    build: |p, r| IntegratorSettings::Sppm(SppmSettings::read(p, r)),
+};
+
+/// SPPM sees no media and no subsurface scattering (as pbrt-v3's).
+pub const RENDERS_MEDIA: bool = false;
+pub const SAMPLES_SUBSURFACE: bool = false;
+
+/// `sppm`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SppmSettings {
+    pub iterations: u32,
+    /// Photons per iteration; 0: one per pixel of the (cropped) film.
+    pub photons_per_iteration: u32,
+    pub max_depth: u32,
+    pub radius: f32,
+    /// Write the image after every this many iterations (0: at the end).
+    pub write_frequency: u32,
+}
+
+impl Default for SppmSettings {
+    fn default() -> Self {
+        SppmSettings {
+            iterations: 64,
+            photons_per_iteration: 0,
+            max_depth: 5,
+            radius: 1.0,
+            write_frequency: 0,
+        }
+    }
+}
+
+/// The most photons per iteration (pbrt-v3 counts them in an `int`).
+const MAX_PHOTONS: i32 = i32::MAX;
+
+impl SppmSettings {
+    /// The settings of a statement's parameters, with pbrt-v3's defaults;
+    /// values pbrt-v3 would misuse are warnings, and the default is used
+    /// (a negative `maxdepth` is an error, as for every integrator).
+    pub fn read(p: &ParamValues, r: &mut dyn Report) -> Self {
+        let d = SppmSettings::default();
+        let (name, n) = match (p.int_opt("iterations"), p.int_opt("numiterations")) {
+            (Some(n), _) => ("iterations", n),
+            (None, Some(n)) => ("numiterations", n),
+            (None, None) => ("iterations", d.iterations as i32),
+        };
+        let iterations = if n < 1 {
+            r.warn(
+                Some(name),
+                format!("\"{name}\" is {n}: it must be ≥ 1; 64 is used"),
+                "no iterations",
+            );
+            d.iterations
+        } else {
+            n as u32
+        };
+        let np = p.int("photonsperiteration");
+        let photons_per_iteration = match np {
+            -1 => 0,
+            1..=MAX_PHOTONS => np as u32,
+            _ => {
+                r.warn(
+                    Some("photonsperiteration"),
+                    format!("\"photonsperiteration\" is {np}: it must be ≥ 1 (or -1, one per pixel); one per pixel is used"),
+                    "no photons",
+                );
+                0
+            }
+        };
+        let radius = p.float("radius");
+        let radius = if radius > 0.0 && radius.is_finite() {
+            radius
+        } else {
+            r.warn(
+                Some("radius"),
+                format!("\"radius\" is {radius}: it must be a positive number; 1 is used"),
+                "bad radius",
+            );
+            d.radius
+        };
+        let write_frequency = match p.int_opt("imagewritefrequency") {
+            None => 0,
+            Some(f) if f >= 1 => f as u32,
+            Some(f) => {
+                r.warn(
+                    Some("imagewritefrequency"),
+                    format!("\"imagewritefrequency\" is {f}: it must be ≥ 1; the image is written at the end only"),
+                    "bad frequency",
+                );
+                0
+            }
+        };
+        SppmSettings {
+            iterations,
+            photons_per_iteration,
+            max_depth: max_depth(p, r),
+            radius,
+            write_frequency,
+        }
+    }
+
+    pub fn summary(&self) -> String {
+        let photons = match self.photons_per_iteration {
+            0 => "one per pixel".to_string(),
+            n => n.to_string(),
+        };
+        format!(
+            "iterations {}, photons per iteration {photons}, maxdepth {}, radius {}",
+            self.iterations, self.max_depth, self.radius
+        )
+    }
+}
+
+/// The runtime `sppm`: its settings and its two light distributions
+/// (uniform for direct lighting at visible points, by power for photons).
+pub struct Sppm {
+    settings: SppmSettings,
+    /// Boxed: the runtime enum's variants stay small.
+    direct: Box<LightSampler>,
+    power: Box<LightSampler>,
+}
+
+impl Sppm {
+    pub fn new(settings: &SppmSettings, scene: &RenderScene, _scalar: bool) -> Self {
+        Sppm {
+            settings: *settings,
+            direct: Box::new(light_sampler(LightSampleStrategy::Uniform, scene)),
+            power: Box::new(light_sampler(LightSampleStrategy::Power, scene)),
+        }
+    }
+
+    pub fn settings(&self) -> &SppmSettings {
+        &self.settings
+    }
+}
+
+impl Integrate for Sppm {
+    fn notes(&self) -> Vec<String> {
+        vec![format!(
+            "sppm: {} (its own render loop; the scene's sampler is not used)",
+            self.settings.summary()
+        )]
+    }
+
+    fn light_sampler(&self) -> Option<&LightSampler> {
+        Some(&self.power)
+    }
+
+    /// SPPM has no per-ray estimate: it renders through
+    /// [`Sppm::render`], which the driver calls for this kind.
+    fn li(
+        &self,
+        _ray: Ray,
+        _time: f32,
+        _diff: Option<RayDiff>,
+        _scene: &RenderScene,
+        _sampler: &mut Sampler,
+        _scratch: &mut Scratch,
+    ) -> Vec3 {
+        Vec3::ZERO
+    }
+}
+
+/// A pixel's visible point: where its camera path met a diffuse surface.
+struct VisiblePoint<'a> {
+    p: Vec3,
+    wo: Vec3,
+    bsdf: Bsdf<'a>,
+    beta: Vec3,
+}
+
+/// What SPPM keeps per pixel (pbrt-v3's `SPPMPixel`).
+struct Pixel<'a> {
+    radius: f32,
+    /// Emitted and directly sampled light, summed over iterations.
+    ld: Vec3,
+    /// This iteration's visible point.
+    vp: Option<VisiblePoint<'a>>,
+    /// Photons accumulated so far (γ-weighted) and the flux they carried.
+    n: f32,
+    tau: Vec3,
+}
+
+/// Bytes SPPM keeps per pixel (its state with the visible point's BSDF),
+/// for the driver's memory check before anything is allocated.
+pub const PIXEL_BYTES: u64 = std::mem::size_of::<Pixel<'static>>() as u64;
+
+/// What [`Sppm::render`] needs of the render: the scene, the film's
+/// (cropped) pixel bounds, the seed of the camera pass's Halton sampler and
+/// the worker threads.
+pub struct SppmRun<'r> {
+    pub scene: &'r RenderScene,
+    pub pixel_bounds: Bounds2i,
+    pub seed: u64,
+    pub pool: &'r rayon::ThreadPool,
+}
+
+/// Photons per chunk: the unit of parallel work whose contributions are
+/// added in order.
+const PHOTON_CHUNK: u32 = 8192;
+
+impl Sppm {
+    /// Renders all iterations. `done(k, image)` is called after iteration
+    /// k (1-based) with the radiance of every pixel of `run.pixel_bounds`
+    /// in row order, and whether pbrt-v3 would write the image then.
+    /// Returns the rays traced.
+    pub fn render(&self, run: &SppmRun, done: &mut dyn FnMut(u32, &[Vec3], bool)) -> RayCounts {
+        let s = &self.settings;
+        let pb = run.pixel_bounds;
+        let n_pixels = pb.area().max(0) as usize;
+        let photons = if s.photons_per_iteration > 0 {
+            s.photons_per_iteration
+        } else {
+            n_pixels.min(MAX_PHOTONS as usize) as u32
+        };
+        let mut pixels: Vec<Pixel> = (0..n_pixels)
+            .map(|_| Pixel {
+                radius: s.radius,
+                ld: Vec3::ZERO,
+                vp: None,
+                n: 0.0,
+                tau: Vec3::ZERO,
+            })
+            .collect();
+        let desc = SamplerDesc {
+            kind: SamplerKind::Halton,
+            pixel_samples: s.iterations,
+            sample_pixel_center: false,
+        };
+        let sampler = Sampler::new(&desc, pb, run.seed);
+        let bases: Vec<DigitBase> = PRIMES.iter().map(|&p| DigitBase::new(p)).collect();
+        let mut counts = RayCounts::default();
+        let mut image = vec![Vec3::ZERO; n_pixels];
+        for iter in 0..s.iterations {
+            counts.add(&self.camera_pass(run, &sampler, &mut pixels, iter));
+            let grid = Grid::new(&pixels);
+            let (acc, c) = self.photon_pass(run, &grid, &pixels, &bases, iter, photons);
+            counts.add(&c);
+            for (p, (phi, m)) in pixels.iter_mut().zip(acc) {
+                update_pixel(p, phi, m);
+            }
+            let k = iter + 1;
+            let write = k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
+            let np = k as u64 * photons as u64;
+            for (l, p) in image.iter_mut().zip(&pixels) {
+                *l = p.ld / k as f32;
+                if np > 0 && p.radius > 0.0 {
+                    *l += p.tau / (np as f32 * std::f32::consts::PI * p.radius * p.radius);
+                }
+            }
+            done(k, &image, write);
+        }
+        counts
+    }
+
+    /// Step (1): each pixel's camera path, rows in parallel (each pixel's
+    /// path depends only on its own samples).
+    fn camera_pass<'a>(
+        &self,
+        run: &SppmRun<'a>,
+        sampler: &Sampler,
+        pixels: &mut [Pixel<'a>],
+        iter: u32,
+    ) -> RayCounts {
+        let pb = run.pixel_bounds;
+        let w = pb.width().max(1) as usize;
+        let scene = run.scene;
+        let rows: Vec<RayCounts> = run.pool.install(|| {
+            pixels
+            .par_chunks_mut(w)
+            .enumerate()
+            .map(|(row, px)| {
+                let mut sampler = sampler.clone();
+                let mut scratch = Scratch::default();
+                let y = pb.min.y + row as i32;
+                for (i, p) in px.iter_mut().enumerate() {
+                    let pixel = IVec2::new(pb.min.x + i as i32, y);
+                    sampler.start_pixel_sample(pixel, iter);
+                    self.visible_point(scene, &mut sampler, &mut scratch, pixel, p);
+                }
+                scratch.counts()
+            })
+            .collect()
+        });
+        let mut c = RayCounts::default();
+        rows.iter().for_each(|r| c.add(r));
+        c
+    }
+
+    /// One pixel's camera path (pbrt-v3's loop "Follow camera ray path
+    /// until a visible point is created").
+    fn visible_point<'a>(
+        &self,
+        scene: &'a RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+        pixel: IVec2,
+        px: &mut Pixel<'a>,
+    ) {
+        let lens = scene.camera.uses_lens() || scene.camera.is_moving();
+        let cs: CameraSample = sampler.camera_sample(pixel, lens);
+        let (mut ray, weight) = scene.camera.generate_ray(&cs);
+        if weight <= 0.0 || weight.is_nan() {
+            return;
+        }
+        let time = scene.camera.time(&cs);
+        let max_depth = self.settings.max_depth;
+        let mut beta = Vec3::ONE;
+        let mut specular_bounce = false;
+        let (mut depth, mut crossed) = (0, 0);
+        while depth < max_depth {
+            scratch.counts.closest += 1;
+            let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
+                px.ld += beta * escaped(scene, ray.d);
+                return;
+            };
+            let mut s = scene.aggregate.surface_at(&hit, time);
+            let material = &scene.materials[s.material as usize];
+            if material.is_none() {
+                crossed += 1;
+                if crossed > MAX_PASS_THROUGH {
+                    return;
+                }
+                ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+                continue;
+            }
+            let mut bsdf = Bsdf::empty();
+            shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
+            let wo = -ray.d;
+            if depth == 0 || specular_bounce {
+                px.ld += beta * emitted(scene, &s, wo);
+            }
+            px.ld += beta * sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, &self.direct);
+            let diffuse = bsdf.num_components(BxdfFlags(
+                BxdfFlags::DIFFUSE.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
+            )) > 0;
+            let glossy = bsdf.num_components(BxdfFlags(
+                BxdfFlags::GLOSSY.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
+            )) > 0;
+            if diffuse || (glossy && depth + 1 == max_depth) {
+                px.vp = Some(VisiblePoint {
+                    p: s.point.p,
+                    wo,
+                    bsdf,
+                    beta,
+                });
+                return;
+            }
+            if depth + 1 < max_depth {
+                let Some(bs) = bsdf.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
+                    return;
+                };
+                if bs.pdf == 0.0 || bs.f == Vec3::ZERO {
+                    return;
+                }
+                specular_bounce = bs.is_specular();
+                beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
+                let y = luminance(beta);
+                if y < 0.25 {
+                    let continue_prob = y.min(1.0);
+                    if sampler.get_1d() > continue_prob {
+                        return;
+                    }
+                    beta /= continue_prob;
+                }
+                ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+            }
+            depth += 1;
+        }
+    }
+
+    /// Step (3): photons in fixed chunks traced in parallel, each chunk's
+    /// contributions (pixel, flux) recorded in photon order and added
+    /// chunk by chunk in order: each pixel's flux and photon count.
+    fn photon_pass(
+        &self,
+        run: &SppmRun,
+        grid: &Grid,
+        pixels: &[Pixel],
+        bases: &[DigitBase],
+        iter: u32,
+        photons: u32,
+    ) -> (Vec<(DVec3, u32)>, RayCounts) {
+        let mut counts = RayCounts::default();
+        let mut acc = vec![(DVec3::ZERO, 0u32); pixels.len()];
+        if grid.is_empty() || run.scene.lights.is_empty() {
+            return (acc, counts);
+        }
+        let chunks = photons.div_ceil(PHOTON_CHUNK);
+        // Chunks in flight at once: enough for every thread, few enough
+        // that their records stay small.
+        let group = (run.pool.current_num_threads().max(1) * 4) as u32;
+        let mut all: Vec<(Vec<(u32, Vec3)>, RayCounts)> = Vec::new();
+        let mut first = 0;
+        while first < chunks {
+            let last = (first + group).min(chunks);
+            all.clear();
+            run.pool.install(|| {
+            (first..last)
+                .into_par_iter()
+                .map(|c| {
+                    let start = c * PHOTON_CHUNK;
+                    let end = (start + PHOTON_CHUNK).min(photons);
+                    let mut recs = Vec::new();
+                    let mut counts = RayCounts::default();
+                    for i in start..end {
+                        let index = iter as u64 * photons as u64 + i as u64;
+                        self.trace_photon(run.scene, grid, pixels, bases, index, &mut recs, &mut counts);
+                    }
+                    (recs, counts)
+                })
+                .collect_into_vec(&mut all)
+            });
+            for (recs, c) in all.drain(..) {
+                counts.add(&c);
+                for (i, phi) in recs {
+                    let a = &mut acc[i as usize];
+                    a.0 += phi.as_dvec3();
+                    a.1 += 1;
+                }
+            }
+            first = last;
+        }
+        (acc, counts)
+    }
+}
+
+/// pbrt-v3's per-pixel update after an iteration's photons: the radius
+/// shrinks so that the pixel keeps γ = 2/3 of the new photons, τ is
+/// rescaled to the new disc; the visible point is dropped.
+fn update_pixel(p: &mut Pixel, phi: DVec3, m: u32) {
+    if m > 0 {
+        let gamma = 2.0f32 / 3.0;
+        let n_new = p.n + gamma * m as f32;
+        let r_new = p.radius * (n_new / (p.n + m as f32)).sqrt();
+        let beta = p.vp.as_ref().map_or(Vec3::ZERO, |v| v.beta);
+        p.tau = (p.tau + beta * phi.as_vec3()) * (r_new * r_new) / (p.radius * p.radius);
+        p.n = n_new;
+        p.radius = r_new;
+    }
+    p.vp = None;
+}
+
+/// The radical inverses of one photon's index, dimension by dimension.
+struct Halton<'b> {
+    bases: &'b [DigitBase],
+    index: u64,
+    dim: usize,
+}
+
+impl Halton<'_> {
+    #[inline]
+    fn next(&mut self) -> f32 {
+        let b = &self.bases[self.dim % self.bases.len()];
+        self.dim += 1;
+        radical_inverse(b, self.index)
+    }
+    #[inline]
+    fn next_2d(&mut self) -> Vec2 {
+        let x = self.next();
+        Vec2::new(x, self.next())
+    }
+}
+
+impl Sppm {
+    /// One photon (pbrt-v3's "Follow photon path for photonIndex"): its
+    /// contributions are pushed to `recs`.
+    #[allow(clippy::too_many_arguments)]
+    fn trace_photon(
+        &self,
+        scene: &RenderScene,
+        grid: &Grid,
+        pixels: &[Pixel],
+        bases: &[DigitBase],
+        index: u64,
+        recs: &mut Vec<(u32, Vec3)>,
+        counts: &mut RayCounts,
+    ) {
+        let mut h = Halton {
+            bases,
+            index,
+            dim: 0,
+        };
+        let u = h.next();
+        let Some((light, light_pmf)) =
+            self.power
+                .sample(Vec3::ZERO, Vec3::ZERO, u, &scene.lights, &scene.aggregate)
+        else {
+            return;
+        };
+        let u_light0 = h.next_2d();
+        let u_light1 = h.next_2d();
+        let u_time = h.next();
+        let time = scene.camera.time(&CameraSample {
+            time: u_time,
+            ..CameraSample::default()
+        });
+        let Some(e) = scene.lights[light as usize].sample_le(u_light0, u_light1, &scene.aggregate)
+        else {
+            return;
+        };
+        if !(e.pdf_pos > 0.0 && e.pdf_dir > 0.0) || e.le == Vec3::ZERO {
+            return;
+        }
+        let mut beta = e.n.dot(e.ray.d).abs() * e.le / (light_pmf * e.pdf_pos * e.pdf_dir);
+        if beta == Vec3::ZERO || !beta.is_finite() {
+            return;
+        }
+        let mut ray = e.ray;
+        let (mut depth, mut crossed) = (0, 0);
+        while depth < self.settings.max_depth {
+            counts.closest += 1;
+            let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
+                return;
+            };
+            let mut s = scene.aggregate.surface_at(&hit, time);
+            if depth > 0 {
+                grid.gather(s.point.p, -ray.d, beta, pixels, recs);
+            }
+            let material = &scene.materials[s.material as usize];
+            if material.is_none() {
+                crossed += 1;
+                if crossed > MAX_PASS_THROUGH {
+                    return;
+                }
+                ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+                continue;
+            }
+            let mut bsdf = Bsdf::empty();
+            shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
+            let wo = -ray.d;
+            let Some(bs) = bsdf.sample(wo, h.next_2d(), BxdfFlags::ALL) else {
+                return;
+            };
+            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+                return;
+            }
+            let bnew = beta * bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf * importance(&bsdf, &bs, wo);
+            let q = (1.0 - luminance(bnew) / luminance(beta)).max(0.0);
+            if h.next() < q {
+                return;
+            }
+            beta = bnew / (1.0 - q);
+            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+            depth += 1;
+        }
+    }
+}
+
+/// The factor that turns a sampled transmission through a dielectric,
+/// whose BSDF carries radiance's (η_i/η_t)², into importance's (pbrt-v3's
+/// `TransportMode::Importance`): (η_t/η_i)², by the side `wo` is on.
+#[inline]
+fn importance(bsdf: &Bsdf, bs: &crate::materials::BsdfSample, wo: Vec3) -> f32 {
+    if !bs.is_transmission() || bs.flags.intersects(BxdfFlags::DIFFUSE) || bsdf.eta == 1.0 {
+        return 1.0;
+    }
+    let eta2 = bsdf.eta * bsdf.eta;
+    if wo.dot(bsdf.frame.n) > 0.0 {
+        eta2
+    } else {
+        1.0 / eta2
+    }
+}
+
+/// The hash grid over visible points (pbrt-v3's): cells of about the
+/// largest radius over the visible points' bounds, hashed into as many
+/// buckets as pixels; each bucket lists, in pixel order, the pixels whose
+/// search disc reaches one of its cells.
+struct Grid {
+    bounds: Bounds3,
+    res: IVec3,
+    /// Bucket b lists `entries[starts[b]..starts[b + 1]]`.
+    starts: Vec<u32>,
+    entries: Vec<u32>,
+}
+
+impl Grid {
+    fn new(pixels: &[Pixel]) -> Grid {
+        let mut bounds = Bounds3::EMPTY;
+        let mut max_radius = 0.0f32;
+        for p in pixels {
+            if let Some(vp) = visible(p) {
+                bounds = bounds
+                    .union_point(vp.p - Vec3::splat(p.radius))
+                    .union_point(vp.p + Vec3::splat(p.radius));
+                max_radius = max_radius.max(p.radius);
+            }
+        }
+        let size = pixels.len().max(1);
+        let mut grid = Grid {
+            bounds,
+            res: IVec3::ONE,
+            starts: vec![0; size + 1],
+            entries: Vec::new(),
+        };
+        if max_radius <= 0.0 {
+            return grid;
+        }
+        let diag = bounds.max - bounds.min;
+        let max_diag = diag.max_element();
+        let base = (max_diag / max_radius) as i32;
+        grid.res = IVec3::new(
+            ((base as f32 * diag.x / max_diag) as i32).max(1),
+            ((base as f32 * diag.y / max_diag) as i32).max(1),
+            ((base as f32 * diag.z / max_diag) as i32).max(1),
+        );
+        // Count, then fill: buckets list pixels in pixel order.
+        for pass in 0..2 {
+            let mut fill = grid.starts.clone();
+            for (i, p) in pixels.iter().enumerate() {
+                let Some(vp) = visible(p) else { continue };
+                let r = Vec3::splat(p.radius);
+                let (lo, _) = grid.cell(vp.p - r);
+                let (hi, _) = grid.cell(vp.p + r);
+                for z in lo.z..=hi.z {
+                    for y in lo.y..=hi.y {
+                        for x in lo.x..=hi.x {
+                            let b = hash(IVec3::new(x, y, z), size);
+                            if pass == 0 {
+                                grid.starts[b + 1] += 1;
+                            } else {
+                                grid.entries[fill[b] as usize] = i as u32;
+                                fill[b] += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            if pass == 0 {
+                for b in 0..size {
+                    grid.starts[b + 1] += grid.starts[b];
+                }
+                grid.entries = vec![0; grid.starts[size] as usize];
+            }
+        }
+        grid
+    }
+
+    fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// pbrt-v3's `ToGrid`: the cell of `p` (clamped to the grid) and
+    /// whether `p` is inside the grid's bounds.
+    #[inline]
+    fn cell(&self, p: Vec3) -> (IVec3, bool) {
+        let ext = self.bounds.max - self.bounds.min;
+        let o = p - self.bounds.min;
+        let off = Vec3::new(
+            if ext.x > 0.0 { o.x / ext.x } else { o.x },
+            if ext.y > 0.0 { o.y / ext.y } else { o.y },
+            if ext.z > 0.0 { o.z / ext.z } else { o.z },
+        );
+        let c = IVec3::new(
+            (self.res.x as f32 * off.x) as i32,
+            (self.res.y as f32 * off.y) as i32,
+            (self.res.z as f32 * off.z) as i32,
+        );
+        let inside = c.cmpge(IVec3::ZERO).all() && c.cmplt(self.res).all();
+        (c.clamp(IVec3::ZERO, self.res - IVec3::ONE), inside)
+    }
+
+    /// A photon at `p` arriving from `wi` with flux `beta`: a record for
+    /// every visible point within its pixel's radius.
+    #[inline]
+    fn gather(&self, p: Vec3, wi: Vec3, beta: Vec3, pixels: &[Pixel], recs: &mut Vec<(u32, Vec3)>) {
+        let (c, inside) = self.cell(p);
+        if !inside {
+            return;
+        }
+        let b = hash(c, self.starts.len() - 1);
+        let (lo, hi) = (self.starts[b] as usize, self.starts[b + 1] as usize);
+        for &i in &self.entries[lo..hi] {
+            let px = &pixels[i as usize];
+            let Some(vp) = visible(px) else { continue };
+            if vp.p.distance_squared(p) > px.radius * px.radius {
+                continue;
+            }
+            let phi = beta * vp.bsdf.f(vp.wo, wi, BxdfFlags::ALL);
+            recs.push((i, phi));
+        }
+    }
+}
+
+/// The pixel's visible point if it has one that carries light.
+#[inline]
+fn visible<'p, 'a>(p: &'p Pixel<'a>) -> Option<&'p VisiblePoint<'a>> {
+    p.vp.as_ref().filter(|v| v.beta != Vec3::ZERO)
+}
+
+/// pbrt-v3's grid hash.
+#[inline]
+fn hash(p: IVec3, size: usize) -> usize {
+    let h = (p.x.wrapping_mul(73856093)) ^ (p.y.wrapping_mul(19349663)) ^ (p.z.wrapping_mul(83492791));
+    (h as u32 as usize) % size
+}
