@@ -19,9 +19,9 @@
 //! average (its MIP lookup at (½, ½) with width ½, as pbrt-v3).
 
 use super::bvh::LightBounds;
-use super::{EmittedRay, LightKind, LightModel, LightSample};
+use super::{sample_at_point, EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Ray};
+use crate::geometry::{luminance, Bounds3, Ray};
 use crate::sampling::{uniform_sample_sphere, uniform_sphere_pdf};
 use crate::scene::{Decode, ParamSpec, ParamValues, Report, RgbImage, Support};
 use crate::shapes::SurfacePoint;
@@ -196,18 +196,7 @@ impl LightModel for GoniometricLight {
 
     #[inline]
     fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
-        let d = self.p - r.p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = d / d2.sqrt();
-        Some(LightSample {
-            li: self.intensity * self.scale(-wi) / d2,
-            wi,
-            pdf: 1.0,
-            shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
-        })
+        sample_at_point(self.p, r, |w| self.intensity * self.scale(w))
     }
 
     /// pbrt-v3's: a direction uniform over the sphere.

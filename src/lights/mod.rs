@@ -201,6 +201,30 @@ pub(crate) fn disk_ray(geom: &Aggregate, radius: f32, w: Vec3, u: Vec2) -> Optio
     ))
 }
 
+/// pbrt-v3's `Sample_Li` of a light at the point `p` (point, spot,
+/// goniometric and projection lights): the direction to it with density
+/// 1, and `towards(w)`, the light's intensity in the direction `w` leaving
+/// it, over the squared distance.
+#[inline]
+pub(super) fn sample_at_point(
+    p: Vec3,
+    r: &SurfacePoint,
+    towards: impl FnOnce(Vec3) -> Vec3,
+) -> Option<LightSample> {
+    let d = p - r.p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    let wi = d / d2.sqrt();
+    Some(LightSample {
+        li: towards(-wi) / d2,
+        wi,
+        pdf: 1.0,
+        shadow: crate::geometry::spawn_ray_to_point(r.p, r.p_error, r.n, p),
+    })
+}
+
 /// [`LightModel::contribution`] by one `sample_li` from a point with no
 /// normal and no error bounds (pbrt-v3 also ignores visibility here).
 pub fn contribution_by_sampling<L: LightModel + ?Sized>(

@@ -24,9 +24,9 @@
 
 use super::bvh::LightBounds;
 use super::goniometric::{light_frame, LightMap};
-use super::{EmittedRay, LightKind, LightModel, LightSample};
+use super::{sample_at_point, EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame, Ray};
+use crate::geometry::{luminance, Bounds3, Frame, Ray};
 use crate::sampling::{uniform_cone_pdf, uniform_sample_cone};
 use crate::scene::{Decode, ParamSpec, ParamValues, Report, Support};
 use crate::shapes::SurfacePoint;
@@ -152,18 +152,7 @@ impl LightModel for ProjectionLight {
 
     #[inline]
     fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
-        let d = self.p - r.p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = d / d2.sqrt();
-        Some(LightSample {
-            li: self.intensity * self.projection(-wi) / d2,
-            wi,
-            pdf: 1.0,
-            shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
-        })
+        sample_at_point(self.p, r, |w| self.intensity * self.projection(w))
     }
 
     /// A direction uniform over the cone around the frustum (directions

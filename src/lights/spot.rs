@@ -18,9 +18,9 @@
 //! of (cos θ − cos total)/(cos falloff − cos total) between.
 
 use super::bvh::{safe_acos, LightBounds};
-use super::{EmittedRay, LightKind, LightModel, LightSample};
+use super::{sample_at_point, EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
-use crate::geometry::{luminance, spawn_ray_to_point, Bounds3, Frame, Ray};
+use crate::geometry::{luminance, Bounds3, Frame, Ray};
 use crate::sampling::{uniform_cone_pdf, uniform_sample_cone};
 use crate::scene::{ParamSpec, ParamValues, Report, Support};
 use crate::shapes::SurfacePoint;
@@ -147,18 +147,8 @@ impl LightModel for SpotLight {
 
     #[inline]
     fn sample_li(&self, r: &SurfacePoint, _u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
-        let d = self.p - r.p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = d / d2.sqrt();
-        let falloff = self.falloff(self.frame.to_local(-wi).z);
-        Some(LightSample {
-            li: self.intensity * falloff / d2,
-            wi,
-            pdf: 1.0,
-            shadow: spawn_ray_to_point(r.p, r.p_error, r.n, self.p),
+        sample_at_point(self.p, r, |w| {
+            self.intensity * self.falloff(self.frame.to_local(w).z)
         })
     }
 

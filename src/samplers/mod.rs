@@ -328,6 +328,60 @@ fn next_below(x: f32) -> f32 {
     }
 }
 
+/// pbrt-v3's `GlobalSampler`, for the sample arrays: a sequence whose values
+/// are indexed by a global sample number, where entry k of the current
+/// sample's array of n values is the pixel's sample `sample_index · n + k`
+/// (as `GlobalSampler::StartPixel` lays them out), at the array's
+/// dimensions from `ARRAY_START_DIM` on (the 1D arrays first, then two
+/// dimensions per 2D array). Halton and Sobol' answer it.
+pub(crate) trait GlobalSequence {
+    /// The first dimension of the sample arrays (pbrt-v3's `arrayStartDim`).
+    const ARRAY_START_DIM: u32;
+    fn arrays(&mut self) -> &mut ArrayStore;
+    /// The index of the current sample in its pixel.
+    fn sample_index(&self) -> u32;
+    /// The global index of the pixel's sample `sample_num`.
+    fn index_for_sample(&self, sample_num: u64) -> u64;
+    /// Dimension `dim` of the global sample `index`.
+    fn sample_dimension(&mut self, index: u64, dim: u32) -> f32;
+}
+
+/// The current sample's next 1D array of `n` values of a global sequence.
+#[inline]
+pub(crate) fn global_1d_array<S: GlobalSequence>(s: &mut S, n: u32) -> Option<&[f32]> {
+    let i = s.arrays().next_1d;
+    if s.arrays().sizes_1d.get(i) == Some(&n) {
+        let mut data = std::mem::take(&mut s.arrays().data_1d[i]);
+        let first = s.sample_index() as u64 * n as u64;
+        for (k, v) in data.iter_mut().enumerate() {
+            let index = s.index_for_sample(first + k as u64);
+            *v = s.sample_dimension(index, S::ARRAY_START_DIM + i as u32);
+        }
+        s.arrays().data_1d[i] = data;
+    }
+    s.arrays().get_1d(n, 0)
+}
+
+/// The current sample's next 2D array of `n` values of a global sequence.
+#[inline]
+pub(crate) fn global_2d_array<S: GlobalSequence>(s: &mut S, n: u32) -> Option<&[Vec2]> {
+    let i = s.arrays().next_2d;
+    if s.arrays().sizes_2d.get(i) == Some(&n) {
+        let mut data = std::mem::take(&mut s.arrays().data_2d[i]);
+        let dim = S::ARRAY_START_DIM + s.arrays().sizes_1d.len() as u32 + 2 * i as u32;
+        let first = s.sample_index() as u64 * n as u64;
+        for (k, v) in data.iter_mut().enumerate() {
+            let index = s.index_for_sample(first + k as u64);
+            *v = Vec2::new(
+                s.sample_dimension(index, dim),
+                s.sample_dimension(index, dim + 1),
+            );
+        }
+        s.arrays().data_2d[i] = data;
+    }
+    s.arrays().get_2d(n, 0)
+}
+
 /// Requested sample arrays and their current contents.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ArrayStore {

@@ -13,7 +13,10 @@ use super::sobolmatrices::{
     sobol_interval_to_index, sobol_matrices, sobol_sample, SobolMatrices, MAX_LOG2_RESOLUTION,
     NUM_SOBOL_DIMENSIONS,
 };
-use super::{count, ArrayStore, SamplerKindEntry, PIXELSAMPLES_16};
+use super::{
+    count, global_1d_array, global_2d_array, ArrayStore, GlobalSequence, SamplerKindEntry,
+    PIXELSAMPLES_16,
+};
 use crate::geometry::Bounds2i;
 use crate::sampling::rng::{hash_to_unit, mix64, ONE_MINUS_EPSILON};
 use crate::scene::{ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind, Support};
@@ -192,41 +195,33 @@ impl SobolSampler {
         p
     }
 
-    /// Entry k of this sample's array is sample `index * n + k` of the
-    /// pixel, as pbrt-v3's `GlobalSampler::StartPixel` lays them out.
     #[inline]
     pub fn get_1d_array(&mut self, n: u32) -> Option<&[f32]> {
-        let i = self.arrays.next_1d;
-        if i < self.arrays.sizes_1d.len() && self.arrays.sizes_1d[i] == n {
-            let mut data = std::mem::take(&mut self.arrays.data_1d[i]);
-            let first = self.sample_index as u64 * n as u64;
-            for (k, v) in data.iter_mut().enumerate() {
-                *v = self.sample_dimension(
-                    self.index_for_sample(first + k as u64),
-                    ARRAY_START_DIM + i as u32,
-                );
-            }
-            self.arrays.data_1d[i] = data;
-        }
-        self.arrays.get_1d(n, 0)
+        global_1d_array(self, n)
     }
 
     #[inline]
     pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
-        let i = self.arrays.next_2d;
-        if i < self.arrays.sizes_2d.len() && self.arrays.sizes_2d[i] == n {
-            let mut data = std::mem::take(&mut self.arrays.data_2d[i]);
-            let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
-            let first = self.sample_index as u64 * n as u64;
-            for (k, v) in data.iter_mut().enumerate() {
-                let idx = self.index_for_sample(first + k as u64);
-                *v = Vec2::new(
-                    self.sample_dimension(idx, dim),
-                    self.sample_dimension(idx, dim + 1),
-                );
-            }
-            self.arrays.data_2d[i] = data;
-        }
-        self.arrays.get_2d(n, 0)
+        global_2d_array(self, n)
+    }
+}
+
+impl GlobalSequence for SobolSampler {
+    const ARRAY_START_DIM: u32 = ARRAY_START_DIM;
+    #[inline]
+    fn arrays(&mut self) -> &mut ArrayStore {
+        &mut self.arrays
+    }
+    #[inline]
+    fn sample_index(&self) -> u32 {
+        self.sample_index
+    }
+    #[inline]
+    fn index_for_sample(&self, sample_num: u64) -> u64 {
+        SobolSampler::index_for_sample(self, sample_num)
+    }
+    #[inline]
+    fn sample_dimension(&mut self, index: u64, dim: u32) -> f32 {
+        SobolSampler::sample_dimension(self, index, dim)
     }
 }
