@@ -972,3 +972,40 @@ fn partial_images_are_written_whole_while_rendering() {
     ok(&run(pbrs().args(["-q", "--outfile"]).arg(&plain).arg(&s)));
     assert_eq!(bytes(&plain), bytes(&o));
 }
+
+/// `--spp` reaches the sampler as its kind takes it: `sobol`, `02sequence`
+/// and `maxmindist` round up to a power of two with pbrt-v3's warning (the
+/// summary's sample count shows what was taken); `halton` takes any count.
+#[test]
+fn spp_flag_is_rounded_as_the_sampler_rounds_it() {
+    let d = tmp("spp-round");
+    for (sampler, warning) in [
+        ("sobol", "rounded up to 8 for SobolSampler"),
+        ("02sequence", "rounded up to power of 2 (from 6 to 8)"),
+        ("maxmindist", "rounded up to 8 for MaxMinDistSampler"),
+        ("halton", ""),
+    ] {
+        let text = scene(
+            "Film \"image\" \"integer xresolution\" 8 \"integer yresolution\" 8",
+            &format!("Sampler \"{sampler}\" \"integer pixelsamples\" 4"),
+        );
+        let f = write(&d, &format!("{sampler}.pbrt"), &text);
+        let out = d.join(format!("{sampler}.pfm"));
+        let o = run(pbrs().arg(&f).args(["--spp", "6", "--outfile"]).arg(&out));
+        ok(&o);
+        let e = stderr(&o);
+        if warning.is_empty() {
+            assert!(!e.contains("--spp 6:"), "{sampler}: {e}");
+        } else {
+            assert!(
+                e.contains("warning: --spp 6: ") && e.contains(warning),
+                "{sampler}: {e}"
+            );
+        }
+        let spp = if warning.is_empty() { 6 } else { 8 };
+        assert!(
+            e.contains(&format!("8x8 px, {spp} spp")),
+            "{sampler}: {spp} spp not in {e}"
+        );
+    }
+}

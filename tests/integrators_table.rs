@@ -185,3 +185,29 @@ WorldEnd
         );
     }
 }
+
+/// pbrt-v3's AOIntegrator takes the sampler's `RoundCount` of `nsamples`
+/// and says so when it differs: the pixel samplers round up to a power of
+/// two, the others take the count as it is.
+#[test]
+fn ambient_occlusion_says_when_the_sampler_rounds_nsamples() {
+    let text = |sampler: &str, n: u32| {
+        format!(
+            "Sampler \"{sampler}\" \"integer pixelsamples\" 4\nIntegrator \"ambientocclusion\" \"integer nsamples\" {n}\nWorldBegin\nShape \"sphere\"\nWorldEnd\n"
+        )
+    };
+    for sampler in ["02sequence", "lowdiscrepancy", "maxmindist"] {
+        let w = warning_text(&load_text(&text(sampler, 12)));
+        assert!(
+            w.contains("Taking 16 samples, not 12 as specified"),
+            "{sampler}: {w}"
+        );
+        assert!(w.contains(":2:"), "located at the Integrator line: {w}");
+        let w = warning_text(&load_text(&text(sampler, 16)));
+        assert!(!w.contains("Taking"), "{sampler}: {w}");
+    }
+    for sampler in ["halton", "sobol", "random", "stratified"] {
+        let w = warning_text(&load_text(&text(sampler, 12)));
+        assert!(!w.contains("Taking"), "{sampler}: {w}");
+    }
+}

@@ -116,7 +116,11 @@ fn apply_overrides(
         if spp == 0 || spp > MAX_SPP {
             return Err(format!("--spp must be between 1 and {MAX_SPP}, not {spp}"));
         }
-        desc.sampler.pixel_samples = spp;
+        if let Some(w) = crate::samplers::override_spp(&mut desc.sampler, spp) {
+            if args.warnings() {
+                eprintln!("warning: --spp {spp}: {w}");
+            }
+        }
     }
     if let Some(c) = &args.cropwindow {
         if c.len() != 4 || !c.iter().all(|v| v.is_finite()) {

@@ -742,6 +742,20 @@ impl<'s, 'c> Builder<'s, 'c> {
         let filter = options::filter(self.ctx, ent(self.filter));
         let sampler = options::sampler(self.ctx, ent(self.sampler));
         let integrator = options::integrator(self.ctx, ent(self.integrator));
+        if let IntegratorSettings::AmbientOcclusion(ao) = &integrator {
+            // pbrt-v3's AOIntegrator: the sampler's RoundCount, with its warning.
+            let taken = crate::samplers::round_count(&sampler, ao.n_samples);
+            if taken != ao.n_samples {
+                if let Some((name, params)) = ent(self.integrator) {
+                    let loc = params.get("nsamples").map_or(name.loc, |p| p.loc);
+                    self.ctx.warn(
+                        loc,
+                        format!("Taking {taken} samples, not {} as specified", ao.n_samples),
+                        "rounded by the sampler",
+                    );
+                }
+            }
+        }
         if let Some(loc) = self.first_medium_interface {
             // pbrt-v3's warning for integrators without volume scattering.
             let name = (!integrator.renders_media()).then(|| integrator.name());

@@ -106,6 +106,46 @@ macro_rules! dispatch {
     };
 }
 
+/// The array size a sampler of `desc` takes for `n` wanted values
+/// (pbrt-v3's `RoundCount`, as [`Sampler::round_count`]).
+pub fn round_count(desc: &SamplerDesc, n: u32) -> u32 {
+    match desc.kind {
+        SamplerKind::ZeroTwoSequence { .. } | SamplerKind::MaxMinDist { .. } => {
+            n.max(1).next_power_of_two()
+        }
+        _ => n,
+    }
+}
+
+/// Sets the samples per pixel that `--spp` asks for, as the sampler kind
+/// takes them: the pixel samplers and `sobol` round up to a power of two
+/// (`maxmindist` at most [`maxmindist::MAX_SPP`]). The warning pbrt-v3's
+/// constructor gives when the count changes, if it does.
+pub fn override_spp(desc: &mut SamplerDesc, n: u32) -> Option<String> {
+    let n = n.max(1);
+    let (spp, warning) = match desc.kind {
+        SamplerKind::Sobol => {
+            let p = n.next_power_of_two();
+            (p, format!("Non power-of-two sample count rounded up to {p} for SobolSampler."))
+        }
+        SamplerKind::ZeroTwoSequence { .. } => {
+            let p = n.next_power_of_two();
+            (p, format!("Pixel samples being rounded up to power of 2 (from {n} to {p})."))
+        }
+        SamplerKind::MaxMinDist { .. } if n > maxmindist::MAX_SPP => (
+            maxmindist::MAX_SPP,
+            format!("No more than {} samples per pixel are supported with MaxMinDistSampler. Rounding down.", maxmindist::MAX_SPP),
+        ),
+        SamplerKind::MaxMinDist { .. } => {
+            let p = n.next_power_of_two();
+            (p, format!("Non power-of-two sample count rounded up to {p} for MaxMinDistSampler."))
+        }
+        _ => (n, String::new()),
+    };
+    desc.pixel_samples = spp;
+    (spp != n).then_some(warning)
+}
+
 impl Sampler {
     /// Builds the sampler for `desc`. `sample_bounds` is the film's sample
     /// bounds; `seed` changes scrambling and random streams (seed 0 is
