@@ -320,25 +320,27 @@ fn lane_ld(
 /// arrays left), light by light: light sample, then BSDF sample.
 #[inline]
 pub(super) fn draw_samples(sampler: &mut Sampler, count: usize) -> ArrayVec<Vec2, 8> {
-    let mut out = ArrayVec::new();
     let mut both = [Vec2::ZERO; 8];
-    if sampler.get_2d_arrays1(&mut both[..2 * count]) {
-        for &u in &both[..2 * count] {
-            out.push(u);
-        }
-        return out;
+    draw_samples_into(sampler, &mut both[..2 * count]);
+    both[..2 * count].iter().copied().collect()
+}
+
+/// [`draw_samples`] into `out`, whose length is twice the light count.
+#[inline]
+pub(super) fn draw_samples_into(sampler: &mut Sampler, out: &mut [Vec2]) {
+    if sampler.get_2d_arrays1(out) {
+        return;
     }
-    for _ in 0..count {
+    for pair in out.chunks_exact_mut(2) {
         let got_light = sampler.get_2d_array1();
         let got_scatter = sampler.get_2d_array1();
         let (a, b) = match (got_light, got_scatter) {
             (Some(a), Some(b)) => (a, b),
             _ => (sampler.get_2d(), sampler.get_2d()),
         };
-        out.push(a);
-        out.push(b);
+        pair[0] = a;
+        pair[1] = b;
     }
-    out
 }
 
 /// The sum over all lights of EstimateDirect at `s`, whose BSDF is the

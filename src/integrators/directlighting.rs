@@ -333,7 +333,9 @@ impl DirectLighting {
             scratch.counts.closest += 1;
             let wo = -ray.d;
             for pack in packs {
-                d.u.extend_from_slice(&direct_lanes::draw_samples(sampler, pack.count));
+                let start = d.u.len();
+                d.u.resize(start + 2 * pack.count, Vec2::ZERO);
+                direct_lanes::draw_samples_into(sampler, &mut d.u[start..]);
             }
             if 1 < settings.max_depth {
                 sampler.skip_2d();

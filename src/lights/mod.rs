@@ -227,6 +227,7 @@ pub(super) fn sample_at_point(
 
 /// [`LightModel::contribution`] by one `sample_li` from a point with no
 /// normal and no error bounds (pbrt-v3 also ignores visibility here).
+#[inline(never)]
 pub fn contribution_by_sampling<L: LightModel + ?Sized>(
     light: &L,
     p: Vec3,

@@ -283,7 +283,7 @@ impl Material {
     /// `out` (`out.frame.n`) is then the bumped shading normal, which the
     /// integrators use for the cosine terms (pbrt-v3's `isect.shading.n`
     /// after `Bump`).
-    #[inline]
+    #[inline(always)]
     pub fn bsdf_into<'a>(&'a self, sc: &ShadingContext, ctx: &BsdfContext<'a>, out: &mut Bsdf<'a>) {
         match self.leading_bump() {
             Some(b) => self.bumped_bsdf_into(b, sc, ctx, out),
