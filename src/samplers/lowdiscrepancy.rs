@@ -305,6 +305,11 @@ pub struct PermutationTables {
     perms: Vec<u16>,
     pairs: Vec<u16>,
     dims: Vec<ScrambledDim>,
+    /// Read by the AVX2 block only (builds without AVX2 take the scalar loop).
+    #[cfg_attr(
+        not(all(target_arch = "x86_64", target_feature = "avx2")),
+        allow(dead_code)
+    )]
     lanes: BlockLanes,
     late: OnceLock<LateTables>,
     /// The generator as the first `EAGER_PRIMES` permutations left it.
