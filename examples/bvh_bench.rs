@@ -39,6 +39,7 @@ fn grid(n: u32) -> TriangleMesh {
         n: None,
         uv: None,
         indices,
+        face_indices: None,
         flip_normal: false,
         reverse_orientation: false,
         material: 0,

@@ -15,6 +15,7 @@ fn mesh(p: Vec<Vec3>, indices: Vec<u32>) -> TriangleMesh {
         n: None,
         uv: None,
         indices,
+        face_indices: None,
         flip_normal: false,
         reverse_orientation: false,
         material: 0,

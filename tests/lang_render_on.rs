@@ -38,6 +38,11 @@ const CASES: &[Case] = &[
         substitute: "Material \"matte\" \"rgb Kd\" [0.5 0.5 0.5]\nShape \"sphere\"",
     },
     Case {
+        broken: "Texture \"t\" \"spectrum\" \"ptex\" \"string filename\" \"no-such.ptx\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"",
+        warning: "cannot read Ptex file",
+        substitute: "Material \"matte\" \"rgb Kd\" [0 0 0]\nShape \"sphere\"",
+    },
+    Case {
         broken: "LightSource \"infinite\" \"rgb L\" [0.2 0.3 0.4] \"string mapname\" \"no-such-sky.exr\"\nShape \"sphere\"",
         warning: "rendered as without \"mapname\"",
         substitute: "LightSource \"infinite\" \"rgb L\" [0.2 0.3 0.4]\nShape \"sphere\"",

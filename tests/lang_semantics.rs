@@ -529,7 +529,7 @@ fn unsupported_shapes_and_directives_warn_and_load() {
         "{w}"
     );
     assert!(!w.contains("not supported by pbrs; ignored"), "{w}");
-    assert!(w.contains("texture class \"ptex\" is not supported"), "{w}");
+    assert!(w.contains("cannot read Ptex file"), "{w}");
 }
 
 #[test]

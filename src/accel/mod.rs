@@ -258,6 +258,7 @@ impl Placement {
             shading_dpdv: l * g.shading_dpdv,
             shading_dndu: n * g.shading_dndu,
             shading_dndv: n * g.shading_dndv,
+            face_index: g.face_index,
             ..DiffGeom::ZERO
         }
     }

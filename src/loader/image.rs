@@ -31,6 +31,7 @@
 use super::Ctx;
 use crate::lang::Loc;
 use crate::scene::{Decode, RgbImage, SampleDepth, MAX_IMAGE_PIXELS};
+use crate::textures::ptex_file::PtexFile;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -42,6 +43,8 @@ use std::sync::Arc;
 pub struct ImageCache {
     raw: HashMap<PathBuf, Result<Arc<RgbImage>, String>>,
     decoded: HashMap<(PathBuf, Decode), Arc<RgbImage>>,
+    /// Ptex files read so far (`ptex` textures).
+    ptex: HashMap<PathBuf, Result<Arc<PtexFile>, String>>,
     /// Files actually read (for tests of the cache).
     reads: usize,
 }
@@ -100,6 +103,55 @@ pub fn load_image(
             None
         }
     }
+}
+
+/// The Ptex file `filename` (read once per scene), or `None` after a
+/// located warning that names the file and says what is used instead: a
+/// file that cannot be read or is malformed, or (as pbrt-v3) one with
+/// other than 1 or 3 channels. A triangle-mesh file warns that it is
+/// point-sampled.
+pub fn load_ptex(
+    ctx: &mut Ctx,
+    loc: Loc,
+    filename: &str,
+    substitute: &str,
+) -> Option<Arc<PtexFile>> {
+    let path = ctx.resolve(loc, filename);
+    let file = match ctx.images.ptex.get(&path) {
+        Some(r) => r.clone(),
+        None => {
+            ctx.images.reads += 1;
+            let r = ctx
+                .loader
+                .load(&path)
+                .and_then(|bytes| PtexFile::parse(&bytes))
+                .map(Arc::new);
+            ctx.images.ptex.insert(path.clone(), r.clone());
+            r
+        }
+    };
+    let file = match file {
+        Ok(f) if f.nchannels == 1 || f.nchannels == 3 => f,
+        Ok(f) => {
+            ctx.warn(loc, format!("Ptex file \"{}\" has {} channels: only one and three channel ptex textures are supported (as pbrt-v3): {substitute}", path.display(), f.nchannels), "this Ptex file");
+            return None;
+        }
+        Err(e) => {
+            ctx.warn(
+                loc,
+                format!(
+                    "cannot read Ptex file \"{}\": {e}: {substitute} (as pbrt-v3, which renders on)",
+                    path.display()
+                ),
+                "this Ptex file",
+            );
+            return None;
+        }
+    };
+    if file.triangles {
+        ctx.warn(loc, format!("Ptex file \"{}\" is of a triangle mesh: pbrs point-samples it (pbrt-v3 uses the Ptex library's triangle filter)", path.display()), "point-sampled");
+    }
+    Some(file)
 }
 
 /// Decodes an image file's bytes; the format comes from `name`'s extension.

@@ -5,7 +5,7 @@
 //! textures defined before, of the type the parameter needs), its mapping,
 //! and its images. Also the shapes' `alpha` and `shadowalpha` textures.
 
-use super::image::load_image;
+use super::image::{load_image, load_ptex};
 use super::lookup::one;
 use super::params::{read_params, read_params_as, Lookup, TexEntry, Textures};
 use super::Ctx;
@@ -14,6 +14,7 @@ use crate::lang::parser::Name;
 use crate::lang::Loc;
 use crate::scene::kind::closest_name;
 use crate::scene::{Decode, FloatTex, ParamValues, RgbImage, Tex};
+use crate::textures::ptex_file::PtexFile;
 use crate::textures::{
     self, ImageSource, Mapping2D, Mapping3D, MappingUse, MipCache, TexBuilder, TexValue,
     TextureClass, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, TEXTURES, UV_MAPPING_PARAMS,
@@ -53,6 +54,9 @@ impl ImageSource for Images<'_> {
             Decode::Raw,
             "a constant grey texture (0.5) is used instead",
         )
+    }
+    fn ptex(&mut self, path: &str, substitute: &str) -> Option<Arc<PtexFile>> {
+        load_ptex(self.ctx, self.loc, path, substitute)
     }
 }
 

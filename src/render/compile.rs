@@ -393,6 +393,7 @@ fn world_mesh(m: &scene::MeshData, to_world: DMat4, s: &ShapeDesc, material: u32
         n,
         uv: m.uvs.clone(),
         indices: m.indices.clone(),
+        face_indices: m.face_indices.clone(),
         flip_normal: reverse ^ (lin.determinant() < 0.0),
         reverse_orientation: reverse,
         material,

@@ -275,6 +275,8 @@ pub struct MeshData {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex uv (same length as positions) if given.
     pub uvs: Option<Vec<Vec2>>,
+    /// Per-triangle Ptex face ids (`faceIndices`; one per triangle) if given.
+    pub face_indices: Option<Vec<i32>>,
 }
 
 impl MeshData {

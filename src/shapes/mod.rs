@@ -226,6 +226,8 @@ pub struct DiffGeom {
     pub dvdx: f32,
     pub dudy: f32,
     pub dvdy: f32,
+    /// The Ptex face of the hit (a mesh's `faceIndices`; 0 without them).
+    pub face_index: i32,
 }
 
 impl DiffGeom {
@@ -246,6 +248,7 @@ impl DiffGeom {
         dvdx: 0.0,
         dudy: 0.0,
         dvdy: 0.0,
+        face_index: 0,
     };
 }
 

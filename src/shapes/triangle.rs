@@ -16,6 +16,8 @@ pub struct TriangleMesh {
     pub n: Option<Vec<Vec3>>,
     pub uv: Option<Vec<Vec2>>,
     pub indices: Vec<u32>,
+    /// Per-triangle Ptex face ids (pbrt-v3's `faceIndices`).
+    pub face_indices: Option<Vec<i32>>,
     /// ReverseOrientation XOR the transform swaps handedness.
     pub flip_normal: bool,
     /// ReverseOrientation alone: pbrt-v3 flips interpolated shading normals
@@ -50,7 +52,11 @@ impl TriangleMesh {
             return true;
         };
         let point = self.surface_point(tri, b);
-        let geom = self.diff_geom(tri, b, point.n);
+        // pbrt-v3's alpha test sees face 0 whatever the mesh's faceIndices.
+        let geom = DiffGeom {
+            face_index: 0,
+            ..self.diff_geom(tri, b, point.n)
+        };
         let hit = SurfaceHit {
             point,
             material: self.material,
@@ -182,6 +188,7 @@ impl TriangleMesh {
             dpdv,
             shading_dpdu: dpdu,
             shading_dpdv: dpdv,
+            face_index: self.face_indices.as_ref().map_or(0, |f| f[tri as usize]),
             ..DiffGeom::default()
         };
         if let Some(normals) = &self.n {

@@ -7,6 +7,7 @@
 //! | `indices` | integer[]   | required (but for a single triangle)   |
 //! | `N`       | normal[]    | none (one per vertex, else dropped)    |
 //! | `uv`/`st` | point2[]    | none (one per vertex, else dropped)    |
+//! | `faceIndices` | integer[] | none (one per triangle, else dropped): the Ptex face of each triangle |
 //!
 //! `alpha` and `shadowalpha` (float textures) are read with the graphics
 //! state by the loader, as for every triangle mesh it reads from a file.
@@ -31,6 +32,11 @@ pub const PARAMS: &[ParamSpec] = &[
         Elem::Point2,
         "the same as `uv` (pbrt-v3's older name)",
     ),
+    ParamSpec::list(
+        "faceIndices",
+        Elem::Int,
+        "the Ptex face of each triangle (`ptex` textures)",
+    ),
 ];
 
 pub const KIND: ShapeKind = ShapeKind {
@@ -38,7 +44,7 @@ pub const KIND: ShapeKind = ShapeKind {
     aliases: &[],
     support: Support::Supported,
     params: PARAMS,
-    doc: "a triangle mesh given in the scene file (alpha/shadowalpha textures). Index count not a multiple of 3, an index negative or ≥ vertex count, no P: error. N or uv count mismatch: warning, dropped. S, faceIndices: unused warning",
+    doc: "a triangle mesh given in the scene file (alpha/shadowalpha textures). Index count not a multiple of 3, an index negative or ≥ vertex count, no P: error. N, uv or faceIndices count mismatch: warning, dropped. S: unused warning",
     build: |p, r| mesh(p, r).map(|m| Surface::TriangleMesh(Arc::new(m))),
 };
 
@@ -107,11 +113,28 @@ fn mesh(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<MeshData> {
         }
         None => None,
     };
+    let face_indices = if p.has("faceIndices") {
+        let f = p.floats("faceIndices");
+        let nt = indices.len() / 3;
+        if f.len() != nt {
+            r.warn(Some("faceIndices"), format!("number of face indices, {}, doesn't match number of faces, {nt}: faceIndices dropped (as pbrt-v3)", f.len()), "count mismatch");
+            None
+        } else {
+            Some(
+                f.iter()
+                    .map(|&x| x.clamp(i32::MIN as f64, i32::MAX as f64) as i32)
+                    .collect(),
+            )
+        }
+    } else {
+        None
+    };
     Some(MeshData {
         positions,
         indices,
         normals,
         uvs,
+        face_indices,
     })
 }
 

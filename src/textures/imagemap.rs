@@ -72,6 +72,10 @@ pub trait ImageSource {
     /// pbrt-v3's `ReadImage`), or `None` after a located warning (the
     /// texture is then constant grey, as pbrt-v3's).
     fn image(&mut self, path: &str) -> Option<Arc<RgbImage>>;
+    /// The Ptex file of a file name as written in the scene, with 1 or 3
+    /// channels, or `None` after a located warning naming the file and
+    /// `substitute`.
+    fn ptex(&mut self, path: &str, substitute: &str) -> Option<Arc<super::ptex_file::PtexFile>>;
 }
 
 /// What makes two image textures share a MIP map (pbrt-v3's `TexInfo`).

@@ -27,6 +27,8 @@ mod mipmap;
 mod mix;
 pub mod noise;
 mod ptex;
+pub mod ptex_file;
+pub mod ptex_filter;
 mod scale;
 mod uv;
 mod windy;
@@ -41,6 +43,7 @@ pub use mapping::{Mapping2D, Mapping3D, MAPPING_KINDS, PLANAR_MAPPING_PARAMS, UV
 pub use marble::Marble;
 pub use mipmap::{ewa_weights, lanczos, resample_weights, MipMap, Wrap, MAX_TEXELS};
 pub use mix::Mix;
+pub use ptex::PtexTexture;
 pub use scale::Scale;
 pub use uv::UvTexture;
 pub use windy::Windy;
@@ -225,6 +228,7 @@ pub enum Class<T> {
     Windy(Windy),
     /// Spectrum only (pbrt-v3 has no float `marble`).
     Marble(Marble),
+    Ptex(PtexTexture<T>),
 }
 
 static NEXT_ID: AtomicU32 = AtomicU32::new(1);
@@ -252,6 +256,7 @@ impl<T> Texture<T> {
             Class::Wrinkled(_) => "wrinkled",
             Class::Windy(_) => "windy",
             Class::Marble(_) => "marble",
+            Class::Ptex(_) => "ptex",
         }
     }
 }
@@ -273,6 +278,7 @@ impl<T: TexValue> Texture<T> {
             Class::Wrinkled(t) => T::splat(t.eval(sc)),
             Class::Windy(t) => T::splat(t.eval(sc)),
             Class::Marble(t) => T::from_rgb(t.eval(sc)),
+            Class::Ptex(t) => t.eval(sc),
         }
     }
 }

@@ -101,6 +101,7 @@ impl Heightfield {
             indices,
             normals: None,
             uvs: Some(uvs),
+            face_indices: None,
         })
     }
 }

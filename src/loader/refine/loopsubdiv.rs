@@ -602,5 +602,6 @@ fn limit_mesh(mut lim: Level, ring: &mut Vec<DVec3>) -> Result<MeshData, Problem
         indices,
         normals: Some(normals),
         uvs: None,
+        face_indices: None,
     })
 }

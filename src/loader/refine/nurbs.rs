@@ -359,6 +359,7 @@ impl Nurbs {
             indices,
             normals: Some(normals),
             uvs: Some(uvs),
+            face_indices: None,
         })
     }
 }
