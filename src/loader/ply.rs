@@ -367,9 +367,21 @@ fn read_faces(
     mesh.indices
         .reserve(el.count.saturating_mul(3).min(r.left()));
     let nverts = mesh.positions.len();
+    // pbrt-v3's `face_indices`: a Ptex face per face (both triangles of a
+    // quad get it).
+    let fi = el
+        .props
+        .iter()
+        .position(|p| p.list.is_none() && p.name == "face_indices" && p.ty.is_integer());
+    let mut face_indices: Vec<i32> = Vec::new();
+    let mut face_index = 0;
     let mut poly: Vec<f64> = Vec::with_capacity(8);
     for f in 0..el.count {
         for (k, p) in el.props.iter().enumerate() {
+            if Some(k) == fi {
+                face_index = r.read(p.ty)?.clamp(i32::MIN as f64, i32::MAX as f64) as i32;
+                continue;
+            }
             if Some(k) == li {
                 poly.clear();
                 let n = r.read(p.list.expect("list"))?;
@@ -398,12 +410,20 @@ fn read_faces(
         }
         let p: Vec<u32> = poly.iter().map(|&v| v as u32).collect();
         match p.len() {
-            3 => mesh.indices.extend_from_slice(&p),
-            4 => mesh
-                .indices
-                .extend_from_slice(&[p[0], p[1], p[2], p[0], p[2], p[3]]),
+            3 => {
+                mesh.indices.extend_from_slice(&p);
+                face_indices.push(face_index);
+            }
+            4 => {
+                mesh.indices
+                    .extend_from_slice(&[p[0], p[1], p[2], p[0], p[2], p[3]]);
+                face_indices.extend_from_slice(&[face_index, face_index]);
+            }
             _ => skipped += 1,
         }
+    }
+    if fi.is_some() {
+        mesh.face_indices = Some(face_indices);
     }
     Ok(skipped)
 }
@@ -445,6 +465,23 @@ mod tests {
             d.extend_from_slice(&i.to_le_bytes());
         }
         d
+    }
+
+    #[test]
+    fn face_indices_per_triangle() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar uint vertex_indices\nproperty int face_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 7\n3 0 2 3 -2\n";
+        let m = read_ply(text.as_bytes()).unwrap().mesh;
+        assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 3]);
+        assert_eq!(m.face_indices, Some(vec![7, 7, -2]));
+        let plain = read_ply(
+            text.replace("property int face_indices\n", "")
+                .replace(" 7\n", "\n")
+                .replace(" -2\n", "\n")
+                .as_bytes(),
+        )
+        .unwrap()
+        .mesh;
+        assert_eq!(plain.face_indices, None);
     }
 
     #[test]
