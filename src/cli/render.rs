@@ -413,8 +413,14 @@ fn render_one(
             p.chunk(c);
         }
     };
+    let cuts = crate::scene::bounds::cuts();
     let result = render_observed(&desc, &opts, &mut on_chunk);
     bar.finish_and_clear();
+    if args.warnings() {
+        for w in crate::scene::bounds::cut_warnings(cuts, crate::scene::bounds::cuts()) {
+            eprintln!("warning: {w}");
+        }
+    }
     let partial_result = partial.map(PartialWriter::finish);
     let (image, stats) = match result {
         Ok(r) => r,
