@@ -416,8 +416,15 @@ fn render_one(
     let cuts = crate::scene::bounds::cuts();
     let result = render_observed(&desc, &opts, &mut on_chunk);
     bar.finish_and_clear();
+    let cut = crate::scene::bounds::cut_warnings(cuts, crate::scene::bounds::cuts());
+    if args.strict && !cut.is_empty() {
+        return fail(format!(
+            "{} (an error with --strict); no image was written",
+            cut.join("; ")
+        ));
+    }
     if args.warnings() {
-        for w in crate::scene::bounds::cut_warnings(cuts, crate::scene::bounds::cuts()) {
+        for w in cut {
             eprintln!("warning: {w}");
         }
     }
