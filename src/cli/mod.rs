@@ -170,6 +170,19 @@ pub enum Command {
     Merge(merge::MergeArgs),
 }
 
+/// `--nthreads` beyond the machine's cores is clamped to them, with a
+/// warning: more threads than cores only add memory (each has its tiles'
+/// buffers) and the image does not depend on the count.
+fn clamp_threads(args: &mut Args) {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if let Some(n) = args.threads.filter(|&n| n > cores) {
+        if args.warnings() {
+            eprintln!("warning: --nthreads {n} is more than the machine's {cores} cores: {cores} threads are used");
+        }
+        args.threads = Some(cores);
+    }
+}
+
 /// Runs the command line; returns the process exit status.
 pub fn main() -> i32 {
     run(std::env::args_os().collect())
@@ -184,6 +197,7 @@ pub fn run(argv: Vec<OsString>) -> i32 {
         Some(Command::Merge(m)) => return merge::run(m),
         None => {}
     }
+    clamp_threads(&mut args);
     if args.scenes.is_empty() {
         use std::io::IsTerminal;
         if std::io::stdin().is_terminal() {

@@ -417,8 +417,21 @@ fn render_one(
             p.chunk(c);
         }
     };
+    let cuts = crate::scene::bounds::cuts();
     let result = render_observed(&desc, &opts, &mut on_chunk);
     bar.finish_and_clear();
+    let cut = crate::scene::bounds::cut_warnings(cuts, crate::scene::bounds::cuts());
+    if args.strict && !cut.is_empty() {
+        return fail(format!(
+            "{} (an error with --strict); no image was written",
+            cut.join("; ")
+        ));
+    }
+    if args.warnings() {
+        for w in cut {
+            eprintln!("warning: {w}");
+        }
+    }
     let partial_result = partial.map(PartialWriter::finish);
     let (image, stats) = match result {
         Ok(r) => r,

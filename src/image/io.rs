@@ -291,6 +291,21 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<Image, String> {
 
 /// Reads the first RGB(A) layer of an EXR (alpha dropped).
 pub fn read_exr(path: &Path) -> Result<Image, String> {
+    // The declared size is bounded before the pixels are allocated.
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    for h in meta.headers.iter() {
+        let (w, hh) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
+        if w.checked_mul(hh)
+            .is_none_or(|n| n > super::MAX_IMAGE_PIXELS)
+        {
+            return Err(format!(
+                "{}: the image declares {w}×{hh} pixels, more than pbrs reads ({} pixels)",
+                path.display(),
+                super::MAX_IMAGE_PIXELS
+            ));
+        }
+    }
     let img = exr::prelude::read_first_rgba_layer_from_file(
         path,
         |res, _| Image::new(res.width() as u32, res.height() as u32),

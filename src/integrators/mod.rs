@@ -133,7 +133,15 @@ const fn unsupported(name: &'static str, why: &'static str) -> IntegratorKind {
     }
 }
 
-/// pbrt-v3's `maxdepth`, checked: a negative one is an error (and 5 is used).
+/// The deepest `maxdepth` pbrs follows: 100 times the depth at which
+/// pbrt-v3's Halton and Sobol samplers run out of dimensions (1000) and
+/// abort, and the depth its stress scenes use. It bounds the work of a
+/// sample in a closed room of perfect mirrors, and what `directlighting`
+/// requests from the sampler per depth.
+pub const MAX_DEPTH_BOUND: u32 = 100_000;
+
+/// pbrt-v3's `maxdepth`, checked: a negative one is an error (and 5 is
+/// used); one beyond [`MAX_DEPTH_BOUND`] is clamped with a warning.
 fn max_depth(p: &ParamValues, r: &mut dyn Report) -> u32 {
     let md = p.int("maxdepth");
     if md < 0 {
@@ -143,6 +151,13 @@ fn max_depth(p: &ParamValues, r: &mut dyn Report) -> u32 {
             "negative depth",
         );
         5
+    } else if md as u32 > MAX_DEPTH_BOUND {
+        r.warn(
+            Some("maxdepth"),
+            format!("\"maxdepth\" is {md}: pbrs follows paths at most {MAX_DEPTH_BOUND} deep, which is used"),
+            "depth clamped",
+        );
+        MAX_DEPTH_BOUND
     } else {
         md as u32
     }

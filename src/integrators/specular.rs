@@ -13,6 +13,7 @@ use crate::geometry::{spawn_ray, Ray, RayDiff};
 use crate::integrators::RenderScene;
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
+use crate::scene::bounds::{note_cut, Cut, MAX_TREE_VERTICES};
 use crate::shapes::DiffGeom;
 use glam::Vec3;
 
@@ -83,7 +84,13 @@ pub(super) fn specular_tree_li<'a>(
     });
     let mut l = Vec3::ZERO;
     let mut first = first;
+    let mut vertices = 0u32;
     while let Some(w) = root.take().or_else(|| stack.pop()) {
+        vertices += 1;
+        if vertices > MAX_TREE_VERTICES {
+            note_cut(Cut::Tree);
+            break;
+        }
         scratch.counts.closest += 1;
         let (hit, s, mut geom) = match std::mem::replace(&mut first, First::Trace) {
             First::Shaded { hit, s, geom } => (hit, s, geom),

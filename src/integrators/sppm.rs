@@ -108,6 +108,10 @@ impl Default for SppmSettings {
 /// The most photons per iteration (pbrt-v3 counts them in an `int`).
 const MAX_PHOTONS: i32 = i32::MAX;
 
+/// The most photons per iteration a statement may ask for (2^24, the bound
+/// of `pixelsamples`): an iteration's time stays bounded.
+const MAX_PHOTONS_PARAM: i32 = 1 << 24;
+
 impl SppmSettings {
     /// The settings of a statement's parameters, with pbrt-v3's defaults;
     /// values pbrt-v3 would misuse are warnings, and the default is used
@@ -132,7 +136,15 @@ impl SppmSettings {
         let np = p.int("photonsperiteration");
         let photons_per_iteration = match np {
             -1 => 0,
-            1..=MAX_PHOTONS => np as u32,
+            1..=MAX_PHOTONS_PARAM => np as u32,
+            _ if np > MAX_PHOTONS_PARAM => {
+                r.warn(
+                    Some("photonsperiteration"),
+                    format!("\"photonsperiteration\" is {np}: pbrs traces at most {MAX_PHOTONS_PARAM} photons per iteration (the bound of \"pixelsamples\"), which is used"),
+                    "photons clamped",
+                );
+                MAX_PHOTONS_PARAM as u32
+            }
             _ => {
                 r.warn(
                     Some("photonsperiteration"),

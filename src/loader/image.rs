@@ -77,7 +77,17 @@ pub fn load_image(
                 .loader
                 .load(&path)
                 .and_then(|bytes| decode_image(&bytes, &path))
-                .map(Arc::new);
+                .map(|img| {
+                    let (img, bad) = clamp_texels(img);
+                    if bad > 0 {
+                        ctx.warn(
+                            loc,
+                            format!("image \"{}\" has {bad} texel values that are NaN, infinite or negative: they are read as 0", path.display()),
+                            "texels clamped",
+                        );
+                    }
+                    Arc::new(img)
+                });
             ctx.images.raw.insert(path.clone(), r.clone());
             r
         }
@@ -154,6 +164,22 @@ pub fn load_ptex(
     Some(file)
 }
 
+/// The image with every NaN, infinite or negative value set to 0 (such
+/// values would become dropped samples, or break a light's sampling
+/// distribution), and how many there were.
+fn clamp_texels(img: RgbImage) -> (RgbImage, usize) {
+    let ok = |v: f32| v.is_finite() && v >= 0.0;
+    let bad: usize = img
+        .pixels()
+        .iter()
+        .map(|p| p.to_array().into_iter().filter(|&v| !ok(v)).count())
+        .sum();
+    if bad == 0 {
+        return (img, 0);
+    }
+    (img.map_channels(|v| if ok(v) { v } else { 0.0 }), bad)
+}
+
 /// Decodes an image file's bytes; the format comes from `name`'s extension.
 pub fn decode_image(bytes: &[u8], name: &Path) -> Result<RgbImage, String> {
     let ext = name
@@ -166,8 +192,8 @@ pub fn decode_image(bytes: &[u8], name: &Path) -> Result<RgbImage, String> {
     }
     let run = || {
         match ext.as_str() {
-        "png" => decode_with_image_crate(bytes, image::ImageFormat::Png),
-        "tga" => decode_with_image_crate(bytes, image::ImageFormat::Tga),
+        "png" => check_png_chunks(bytes).and_then(|()| decode_with_image_crate(bytes, image::ImageFormat::Png)),
+        "tga" => check_tga_runs(bytes).and_then(|()| decode_with_image_crate(bytes, image::ImageFormat::Tga)),
         "hdr" => decode_with_image_crate(bytes, image::ImageFormat::Hdr),
         "exr" => decode_exr(bytes),
         "pfm" => decode_pfm(bytes),
@@ -183,6 +209,127 @@ pub fn decode_image(bytes: &[u8], name: &Path) -> Result<RgbImage, String> {
         Ok(r) => r,
         Err(_) => Err("the image decoder failed on this file (corrupt data)".into()),
     }
+}
+
+/// Images above this many pixels must not claim more than
+/// [`MAX_COMPRESSION`] decoded bytes per byte of file.
+const BOMB_PIXELS: u64 = 1 << 24;
+
+/// The most decoded bytes (3 a pixel) per file byte of an image above
+/// [`BOMB_PIXELS`]: photographs and rendered maps compress 2–20×; a file
+/// beyond this is a decompression bomb (a small file that claims a huge
+/// flat image), refused before anything is decoded.
+const MAX_COMPRESSION: u64 = 256;
+
+/// [`check_size`] and the decompression-bomb test against the file's size.
+fn check_claim(w: u64, h: u64, file_bytes: usize) -> Result<(), String> {
+    check_size(w, h)?;
+    let n = w * h;
+    if n > BOMB_PIXELS && n * 3 > MAX_COMPRESSION * file_bytes as u64 {
+        return Err(format!(
+            "the image claims {w}×{h} pixels from a file of {file_bytes} bytes (more than {MAX_COMPRESSION}× compression): refused as a decompression bomb"
+        ));
+    }
+    Ok(())
+}
+
+/// PNG's chunk structure and CRCs (the decoder ignores a bad CRC): a
+/// corrupt file is an error, not an image of whatever the bytes decode to.
+fn check_png_chunks(bytes: &[u8]) -> Result<(), String> {
+    const SIG: &[u8] = b"\x89PNG\r\n\x1a\n";
+    if !bytes.starts_with(SIG) {
+        return Err("not a PNG file (no PNG signature)".into());
+    }
+    let mut at = SIG.len();
+    while at + 12 <= bytes.len() {
+        let len =
+            u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]) as usize;
+        let name = String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned();
+        let end = at + 8 + len;
+        if len > i32::MAX as usize || end + 4 > bytes.len() {
+            return Err(format!(
+                "chunk {name} at byte {at} runs past the end of the file (truncated or corrupt)"
+            ));
+        }
+        let stored =
+            u32::from_be_bytes([bytes[end], bytes[end + 1], bytes[end + 2], bytes[end + 3]]);
+        if crc32(&bytes[at + 4..end]) != stored {
+            return Err(format!(
+                "chunk {name} at byte {at} has a bad CRC (the file is corrupt)"
+            ));
+        }
+        if name == "IEND" {
+            return Ok(());
+        }
+        at = end + 4;
+    }
+    Err("the file ends before its IEND chunk (truncated)".into())
+}
+
+/// The CRC-32 of PNG chunks.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                (c >> 1) ^ 0xEDB8_8320
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+/// A run-length encoded TGA's packets (the decoder lets a run overrun the
+/// image and truncates it): every packet must fit in the image's pixels,
+/// and the data must hold them all.
+fn check_tga_runs(bytes: &[u8]) -> Result<(), String> {
+    if bytes.len() < 18 {
+        return Err(format!("truncated TGA header ({} bytes)", bytes.len()));
+    }
+    let u16_at = |i: usize| u16::from_le_bytes([bytes[i], bytes[i + 1]]) as u64;
+    let image_type = bytes[2];
+    if !matches!(image_type, 9..=11) {
+        return Ok(());
+    }
+    let (w, h) = (u16_at(12), u16_at(14));
+    check_claim(w, h, bytes.len())?;
+    let pixel_bytes = (bytes[16] as usize).div_ceil(8).max(1);
+    let map_bytes = if bytes[1] != 0 {
+        u16_at(5) as usize * (bytes[7] as usize).div_ceil(8)
+    } else {
+        0
+    };
+    let mut at = 18 + bytes[0] as usize + map_bytes;
+    let (total, mut done) = (w * h, 0u64);
+    while done < total {
+        let Some(&head) = bytes.get(at) else {
+            return Err(format!(
+                "the run-length data ends after {done} of {total} pixels (truncated)"
+            ));
+        };
+        let count = (head & 0x7f) as u64 + 1;
+        if done + count > total {
+            return Err(format!(
+                "a run-length packet at byte {at} runs past the image's {total} pixels (corrupt)"
+            ));
+        }
+        at += 1 + if head & 0x80 != 0 {
+            pixel_bytes
+        } else {
+            count as usize * pixel_bytes
+        };
+        done += count;
+    }
+    if at > bytes.len() {
+        return Err(format!(
+            "the run-length data ends before its last packet ({at} bytes needed, the file has {})",
+            bytes.len()
+        ));
+    }
+    Ok(())
 }
 
 fn check_size(w: u64, h: u64) -> Result<(), String> {
@@ -215,7 +362,7 @@ fn decode_with_image_crate(bytes: &[u8], format: image::ImageFormat) -> Result<R
     reader.limits(limits);
     let decoder = reader.into_decoder().map_err(|e| e.to_string())?;
     let (w, h) = decoder.dimensions();
-    check_size(w as u64, h as u64)?;
+    check_claim(w as u64, h as u64, bytes.len())?;
     let img = DynamicImage::from_decoder(decoder).map_err(|e| e.to_string())?;
     let n = w as usize * h as usize;
     let lut = unorm8_table();
@@ -280,9 +427,12 @@ fn decode_exr(bytes: &[u8]) -> Result<RgbImage, String> {
     use exr::prelude::{AnyChannel, FlatSamples};
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
         .map_err(|e| e.to_string())?;
+    if meta.headers.iter().all(|h| h.deep) {
+        return Err("the file holds only deep data (pbrs reads flat images)".into());
+    }
     for h in meta.headers.iter() {
         let (w, hh) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
-        check_size(w, hh)?;
+        check_claim(w, hh, bytes.len())?;
         let channels = h.channels.list.len() as u64;
         // Every channel is held as one sample a pixel while reading.
         if w * hh * channels.max(1) > 4 * MAX_IMAGE_PIXELS {
@@ -609,20 +759,5 @@ mod tests {
             "a.hdr"
         )
         .is_err());
-    }
-
-    fn crc32(bytes: &[u8]) -> u32 {
-        let mut c = !0u32;
-        for &b in bytes {
-            c ^= b as u32;
-            for _ in 0..8 {
-                c = if c & 1 != 0 {
-                    (c >> 1) ^ 0xEDB8_8320
-                } else {
-                    c >> 1
-                };
-            }
-        }
-        !c
     }
 }

@@ -131,6 +131,7 @@ pub fn read_gltf(
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     continue;
                 }
+                check_accessors(&prim, mesh.index(), &buffers)?;
                 let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
                 let read = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                     let p: Vec<[f32; 3]> = reader.read_positions()?.collect();
@@ -204,6 +205,88 @@ pub fn read_gltf(
         return Err("the default scene has no triangle primitives".into());
     }
     finish(out, normals, uvs)
+}
+
+/// Checks what the gltf crate's reader takes on trust: each accessor pbrs
+/// reads has the component type and shape its use allows (positions and
+/// normals float VEC3, texture coordinates float or normalized unsigned
+/// VEC2, indices unsigned SCALAR), a buffer view, no sparse storage, and
+/// every element inside its view and buffer (so a count is never larger
+/// than the bytes behind it).
+fn check_accessors(prim: &gltf::Primitive, mesh: usize, buffers: &[Vec<u8>]) -> Result<(), String> {
+    use gltf::accessor::{DataType as D, Dimensions};
+    use gltf::mesh::Semantic;
+    let uses: [(&str, Option<gltf::Accessor>, &[D], Dimensions); 4] = [
+        (
+            "POSITION",
+            prim.get(&Semantic::Positions),
+            &[D::F32],
+            Dimensions::Vec3,
+        ),
+        (
+            "NORMAL",
+            prim.get(&Semantic::Normals),
+            &[D::F32],
+            Dimensions::Vec3,
+        ),
+        (
+            "TEXCOORD_0",
+            prim.get(&Semantic::TexCoords(0)),
+            &[D::F32, D::U8, D::U16],
+            Dimensions::Vec2,
+        ),
+        (
+            "indices",
+            prim.indices(),
+            &[D::U8, D::U16, D::U32],
+            Dimensions::Scalar,
+        ),
+    ];
+    for (what, acc, types, dims) in uses {
+        let Some(a) = acc else { continue };
+        let bad = |why: String| {
+            Err(format!(
+                "mesh {mesh}: the {what} accessor ({}) {why}",
+                a.index()
+            ))
+        };
+        if !types.contains(&a.data_type()) || a.dimensions() != dims {
+            return bad(format!(
+                "is {:?} {:?}, but {what} must be {dims:?} of {types:?}",
+                a.dimensions(),
+                a.data_type()
+            ));
+        }
+        if a.sparse().is_some() {
+            return bad("is sparse, which pbrs does not read".into());
+        }
+        let Some(view) = a.view() else {
+            return bad("has no buffer view".into());
+        };
+        let buffer_len = buffers.get(view.buffer().index()).map_or(0, Vec::len);
+        let view_end = view.offset().checked_add(view.length());
+        if view_end.is_none_or(|e| e > buffer_len) {
+            return bad(format!(
+                "has a buffer view of {} bytes at {}, past its buffer's {buffer_len} bytes",
+                view.length(),
+                view.offset()
+            ));
+        }
+        let size = a.size();
+        let stride = view.stride().unwrap_or(size).max(size);
+        let need = (a.count() as u64)
+            .checked_sub(1)
+            .map_or(Some(0), |n| n.checked_mul(stride as u64))
+            .and_then(|b| b.checked_add((a.offset() + size) as u64));
+        if a.count() > 0 && need.is_none_or(|n| n > view.length() as u64) {
+            return bad(format!(
+                "claims {} elements, more than its buffer view's {} bytes hold",
+                a.count(),
+                view.length()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The gltf crate's validation, after checking the accessor indices it

@@ -279,6 +279,40 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadFailure> {
 /// to the current directory.
 pub const STDIN_NAME: &str = "<stdin>";
 
+/// The largest scene file pbrs reads (1 GiB): the text is held in memory
+/// while it is parsed, so an endless input (standard input that never
+/// ends, `/dev/zero`) stops here with an error instead of growing without
+/// bound. Bigger geometry belongs in PLY files, which are read by count.
+pub const MAX_SCENE_BYTES: u64 = 1 << 30;
+
+/// Reads at most [`MAX_SCENE_BYTES`] of scene text from `r`: `Err` says why
+/// it is not scene text (too large, a NUL byte) or why it could not be read.
+fn read_scene_bytes(mut r: impl std::io::Read) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = match r.read(&mut buf) {
+            Ok(0) => return Ok(out),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e.to_string()),
+        };
+        if let Some(i) = buf[..n].iter().position(|&b| b == 0) {
+            return Err(format!(
+                "it holds a NUL byte at offset {}: it is not scene text",
+                out.len() + i
+            ));
+        }
+        if out.len() as u64 + n as u64 > MAX_SCENE_BYTES {
+            return Err(format!(
+                "it is larger than {} MiB, the most pbrs reads as scene text (put big meshes in PLY files)",
+                MAX_SCENE_BYTES >> 20
+            ));
+        }
+        out.extend_from_slice(&buf[..n]);
+    }
+}
+
 /// Reads one scene file named on the command line; `-` is standard input.
 pub fn read_scene_input(path: &Path) -> Result<(PathBuf, Arc<str>), LoadFailure> {
     let stdin = path.as_os_str() == "-";
@@ -287,16 +321,16 @@ pub fn read_scene_input(path: &Path) -> Result<(PathBuf, Arc<str>), LoadFailure>
     } else {
         path.to_path_buf()
     };
-    // The user named this file, so a pipe is fine here (unlike Include targets).
+    // The user named this file, so a pipe or a device is read (unlike
+    // Include targets), up to the size limit.
     let read = if stdin {
-        let mut b = Vec::new();
-        // One byte past the limit is enough to know it is too large.
-        let mut limited = std::io::Read::take(std::io::stdin().lock(), u32::MAX as u64);
-        std::io::Read::read_to_end(&mut limited, &mut b).map(|_| b)
+        read_scene_bytes(std::io::stdin().lock())
     } else {
-        std::fs::read(path)
+        std::fs::File::open(path)
+            .map_err(|e| e.to_string())
+            .and_then(read_scene_bytes)
     };
-    let text = match read.map_err(|e| e.to_string()) {
+    let text = match read {
         Ok(b) => b,
         Err(e) => {
             return Err(plain_failure(
@@ -305,12 +339,6 @@ pub fn read_scene_input(path: &Path) -> Result<(PathBuf, Arc<str>), LoadFailure>
             ))
         }
     };
-    if text.len() >= u32::MAX as usize {
-        return Err(plain_failure(
-            &shown,
-            format!("scene file \"{}\" is larger than 4 GiB", shown.display()),
-        ));
-    }
     match to_text(text) {
         Ok(t) => Ok((shown, t)),
         Err(at) => Err(plain_failure(

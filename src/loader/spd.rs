@@ -63,10 +63,36 @@ pub fn parse(text: &str) -> SpdFile {
         ));
         values.pop();
     }
+    notes.extend(shape_notes(&values));
     SpdFile {
         pairs: values,
         notes,
     }
+}
+
+/// Notes on pairs that are numbers but not a spectrum as measured: a
+/// wavelength that is not positive, wavelengths out of increasing order
+/// (pbrt-v3 sorts them silently; so does pbrs, with this note), negative
+/// values (kept, as pbrt-v3).
+fn shape_notes(pairs: &[f64]) -> Vec<String> {
+    let mut notes = Vec::new();
+    let lambdas: Vec<f64> = pairs.iter().step_by(2).copied().collect();
+    if let Some(l) = lambdas.iter().find(|&&l| l <= 0.0) {
+        notes.push(format!(
+            "wavelength {l} nm is not positive (wavelengths are in nanometres)"
+        ));
+    }
+    if let Some(i) = (1..lambdas.len()).find(|&i| lambdas[i] < lambdas[i - 1]) {
+        notes.push(format!(
+            "wavelengths are not in increasing order ({} nm after {} nm): the pairs are sorted (as pbrt-v3)",
+            lambdas[i],
+            lambdas[i - 1]
+        ));
+    }
+    if let Some(v) = pairs.iter().skip(1).step_by(2).find(|&&v| v < 0.0) {
+        notes.push(format!("value {v} is negative: kept (as pbrt-v3)"));
+    }
+    notes
 }
 
 fn shorten(s: &str) -> String {

@@ -213,6 +213,18 @@ impl<'s, 'c> Builder<'s, 'c> {
         }
     }
 
+    /// [`Self::apply`] for a transform statement at `loc`: a result that
+    /// is not finite (numbers whose product overflows) is a located error
+    /// and the transform is left as it was.
+    fn apply_at(&mut self, loc: Loc, f: impl Fn(DMat4) -> DMat4) {
+        let next = self.ctm.map(&f);
+        if (0..2).any(|i| self.active[i] && !next[i].is_finite()) {
+            self.ctx.error(loc, "the transform is not finite (its numbers overflow when combined with the current transform)", "this transform", None);
+            return;
+        }
+        self.apply(f);
+    }
+
     fn world_only(kind: DirKind) -> bool {
         use DirKind as K;
         matches!(
@@ -317,11 +329,11 @@ impl<'s, 'c> Builder<'s, 'c> {
             K::Identity => self.apply(|_| DMat4::IDENTITY),
             K::Translate => {
                 let t = DMat4::from_translation(DVec3::new(nums[0], nums[1], nums[2]));
-                self.apply(|m| m * t);
+                self.apply_at(s.loc, |m| m * t);
             }
             K::Scale => {
                 let t = DMat4::from_scale(DVec3::new(nums[0], nums[1], nums[2]));
-                self.apply(|m| m * t);
+                self.apply_at(s.loc, |m| m * t);
             }
             K::Rotate => {
                 let axis = DVec3::new(nums[1], nums[2], nums[3]);
@@ -330,10 +342,10 @@ impl<'s, 'c> Builder<'s, 'c> {
                     return;
                 }
                 let t = DMat4::from_axis_angle(axis.normalize(), nums[0].to_radians());
-                self.apply(|m| m * t);
+                self.apply_at(s.loc, |m| m * t);
             }
             K::LookAt => match look_at(nums) {
-                Some(t) => self.apply(|m| m * t),
+                Some(t) => self.apply_at(s.loc, |m| m * t),
                 None => self.ctx.warn(s.loc, "degenerate LookAt (eye equals look, or up is parallel to the view direction): ignored, as pbrt-v3 does", "this LookAt"),
             },
             K::Transform | K::ConcatTransform => {
@@ -341,9 +353,9 @@ impl<'s, 'c> Builder<'s, 'c> {
                 a.copy_from_slice(nums);
                 let t = DMat4::from_cols_array(&a);
                 if s.kind == K::Transform {
-                    self.apply(|_| t);
+                    self.apply_at(s.loc, |_| t);
                 } else {
-                    self.apply(|m| m * t);
+                    self.apply_at(s.loc, |m| m * t);
                 }
             }
             K::CoordinateSystem => {

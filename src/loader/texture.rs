@@ -179,6 +179,17 @@ fn build<T: TexValue>(
         textures,
     };
     let (values, _) = read_params_as(ctx, k.params, &l, T::IS_FLOAT);
+    if k.params.iter().any(|s| s.name == "octaves") {
+        let n = values.int("octaves");
+        if n > textures::MAX_OCTAVES {
+            let at = params.get("octaves").map_or(class.loc, |q| q.values_loc);
+            ctx.warn(
+                at,
+                format!("\"octaves\" is {n}: pbrs sums at most {} octaves (past them the frequency 1.99^k overflows a float), which is used", textures::MAX_OCTAVES),
+                "octaves clamped",
+            );
+        }
+    }
     let two_d = match k.build.mapping {
         MappingUse::TwoD => true,
         MappingUse::ByDimension => values.int("dimension") == 2,

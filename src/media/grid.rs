@@ -20,6 +20,7 @@
 use super::{fix, Coefficients, Density, Medium, MediumInput, MediumType, Support, COMMON};
 use crate::geometry::{gamma, Ray};
 use crate::samplers::Sampler;
+use crate::scene::bounds::{note_cut, Cut, MAX_TRACKING_STEPS};
 use crate::scene::{ParamSpec, ParamValues, Report};
 use glam::{DMat4, Mat4, Vec3};
 use std::sync::Arc;
@@ -247,14 +248,15 @@ impl Grid {
     }
 
     /// Delta tracking: the weight σs/σt and the world ray parameter of a
-    /// scattering event, or weight 1 and none.
+    /// scattering event, or weight 1 and none; weight 0 and none past
+    /// [`MAX_TRACKING_STEPS`] steps (counted).
     pub fn sample(&self, ray: &Ray, sampler: &mut Sampler) -> (Vec3, Option<f32>) {
         let Some((o, d, t_min, t_max, len)) = self.overlap(ray) else {
             return (Vec3::ONE, None);
         };
         let step = self.inv_max_density / self.sigma_t;
         let mut t = t_min;
-        loop {
+        for _ in 0..MAX_TRACKING_STEPS {
             t -= (1.0 - sampler.get_1d()).ln() * step;
             if t.is_nan() || t >= t_max {
                 return (Vec3::ONE, None);
@@ -263,16 +265,19 @@ impl Grid {
                 return (self.sigma_s / self.sigma_t, Some(t / len));
             }
         }
+        note_cut(Cut::Tracking);
+        (Vec3::ZERO, None)
     }
 
-    /// Ratio tracking with pbrt-v3's Russian roulette.
+    /// Ratio tracking with pbrt-v3's Russian roulette; 0 past
+    /// [`MAX_TRACKING_STEPS`] steps (counted).
     pub fn tr(&self, ray: &Ray, sampler: &mut Sampler) -> Vec3 {
         let Some((o, d, t_min, t_max, _)) = self.overlap(ray) else {
             return Vec3::ONE;
         };
         let step = self.inv_max_density / self.sigma_t;
         let (mut tr, mut t) = (1.0f32, t_min);
-        loop {
+        for _ in 0..MAX_TRACKING_STEPS {
             t -= (1.0 - sampler.get_1d()).ln() * step;
             if t.is_nan() || t >= t_max {
                 return Vec3::splat(tr);
@@ -288,5 +293,7 @@ impl Grid {
                 tr /= 1.0 - q;
             }
         }
+        note_cut(Cut::Tracking);
+        Vec3::ZERO
     }
 }

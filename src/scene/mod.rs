@@ -6,6 +6,7 @@
 //! Transforms are `f64` so that long chains of scene-file transforms do not lose
 //! precision before the render core converts geometry to `f32` world space.
 
+pub mod bounds;
 mod fourier;
 pub mod image;
 pub mod kind;

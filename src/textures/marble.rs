@@ -65,7 +65,7 @@ fn build(b: &mut TexBuilder) -> Result<Tex<Vec3>, String> {
         b.name,
         Class::Marble(Marble {
             mapping: b.mapping3d,
-            octaves: b.params.int("octaves"),
+            octaves: b.params.int("octaves").min(super::noise::MAX_OCTAVES),
             omega: b.params.float("roughness"),
             scale: b.params.float("scale"),
             variation: b.params.float("variation"),

@@ -26,6 +26,7 @@ mod marble;
 mod mipmap;
 mod mix;
 pub mod noise;
+pub use noise::MAX_OCTAVES;
 mod ptex;
 pub mod ptex_file;
 pub mod ptex_filter;

@@ -183,6 +183,11 @@ mod tests {
     }
 }
 
+/// The most octaves `fbm`, `wrinkled` and `marble` sum (a larger
+/// `octaves` is clamped, with the loader's warning): octave k has
+/// frequency 1.99^k, which overflows a float past 128.
+pub const MAX_OCTAVES: i32 = 128;
+
 /// What `fbm` and `wrinkled` share: the 3D mapping, the most octaves, and
 /// the amplitude factor per octave (their parameters, [`OCTAVE_PARAMS`]).
 #[derive(Clone, Copy, Debug)]
@@ -206,7 +211,7 @@ impl Octaves {
     pub fn read(b: &super::TexBuilder) -> Octaves {
         Octaves {
             mapping: b.mapping3d,
-            octaves: b.params.int("octaves"),
+            octaves: b.params.int("octaves").min(MAX_OCTAVES),
             omega: b.params.float("roughness"),
         }
     }

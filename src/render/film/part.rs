@@ -337,11 +337,36 @@ pub fn write_samples_part(path: &Path, header: &PartHeader, film: &Film) -> Resu
     crate::image::io::write_atomic(path, &bytes)
 }
 
+/// A part's declared data windows, bounded before any pixel is read: at
+/// most a film's largest resolution (32768 × 32768) and within the memory
+/// budget for its channels (held as f32 or u32 while reading, and then as
+/// the part's sums).
+fn check_part_size(path: &Path) -> Result<(), String> {
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| format!("cannot read the part (missing, truncated or corrupt EXR): {e}"))?;
+    for h in meta.headers.iter() {
+        let (w, hh) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
+        let n = w * hh;
+        if w > 32768 || hh > 32768 {
+            return Err(format!(
+                "the part's data window is {w}×{hh} pixels, larger than a film can be (32768×32768)"
+            ));
+        }
+        let channels = h.channels.list.len() as u64;
+        crate::scene::memory::check_budget(
+            &format!("the part ({w}×{hh} pixels of {channels} channels)"),
+            n * (4 * channels + std::mem::size_of::<PixelSums>() as u64),
+        )?;
+    }
+    Ok(())
+}
+
 /// Reads a part file; an error names the file and says what is wrong
 /// (unreadable, truncated or corrupt, not a pbrs part, missing channels).
 pub fn read_part(path: &Path) -> Result<Part, String> {
     use exr::prelude::*;
     let fail = |e: String| format!("{}: {e}", path.display());
+    check_part_size(path).map_err(fail)?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
