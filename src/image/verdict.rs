@@ -43,20 +43,19 @@ impl Verdict {
         if self.nonfinite > 0 {
             out.push(format!("{} non-finite pixels", self.nonfinite));
         }
-        // Negated comparisons: a NaN metric fails.
-        if !(c.relative_mse <= b.max_relative_mse) {
+        if !within(c.relative_mse, b.max_relative_mse) {
             out.push(format!(
                 "relative MSE {:.4e} > {:.4e}",
                 c.relative_mse, b.max_relative_mse
             ));
         }
-        if !(c.block_error <= b.max_block_error) {
+        if !within(c.block_error, b.max_block_error) {
             out.push(format!(
                 "block error {:.4e} > {:.4e}",
                 c.block_error, b.max_block_error
             ));
         }
-        if !(self.mean_difference <= b.max_mean_difference) {
+        if !within(self.mean_difference, b.max_mean_difference) {
             out.push(format!(
                 "mean difference {:.3e} > {:.3e}",
                 self.mean_difference, b.max_mean_difference
@@ -81,6 +80,11 @@ impl Verdict {
             c.mean_r
         )
     }
+}
+
+/// `x ≤ max`; a NaN figure is out of bounds.
+fn within(x: f64, max: f64) -> bool {
+    x <= max
 }
 
 /// Largest relative difference of the per-channel means of a comparison.

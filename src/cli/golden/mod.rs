@@ -77,21 +77,66 @@ pub struct SceneResult {
     pub images: Option<(Image, Image)>,
 }
 
+impl SceneResult {
+    /// The verdict's figures as multiples of the expected noise: relative
+    /// MSE, block error, and the mean difference in standard deviations.
+    pub fn ratios(&self) -> Option<[f64; 3]> {
+        let v = match &self.outcome {
+            Outcome::Passed(v) | Outcome::Failed(v) => v,
+            _ => return None,
+        };
+        let u = self.unit.unwrap_or(v.bounds);
+        let c = &v.comparison;
+        Some([
+            c.relative_mse / u.max_relative_mse,
+            c.block_error / u.max_block_error,
+            v.mean_difference / u.max_mean_difference,
+        ])
+    }
+}
+
 pub fn run(args: &TestArgs) -> i32 {
     let t0 = Instant::now();
-    let entries = match manifest::scenes(&args.dir) {
-        Ok(e) => e,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
     for out in args.junit.iter() {
         if let Err(e) = check_writable(out) {
             eprintln!("error: --junit {e}");
             return 2;
         }
     }
+    let results = match check(args) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let status = report::status(&results);
+    report::print_table(&results, t0.elapsed().as_secs_f64(), args.quiet);
+    let mut extra = 0;
+    if let Some(f) = &args.junit {
+        if let Err(e) = report::write_junit(f, &args.dir, &results) {
+            eprintln!("error: {e}");
+            extra = 2;
+        }
+    }
+    if let Some(d) = &args.report {
+        match report::write_html(d, &args.dir, &results) {
+            Ok(p) if !args.quiet => eprintln!("report: {}", p.display()),
+            Ok(_) => {}
+            Err(e) => {
+                eprintln!("error: {e}");
+                extra = 2;
+            }
+        }
+    }
+    status.max(extra)
+}
+
+/// Renders and judges (or, with `--update`, writes the goldens of) every
+/// scene of the folder, printing a line per scene; an error when the folder
+/// or its golden.toml is unusable.
+pub fn check(args: &TestArgs) -> Result<Vec<SceneResult>, String> {
+    let entries = manifest::scenes(&args.dir)?;
     let golden_dir = args.dir.join("golden");
     let bar = progress_bar(args.quiet);
     let mut results = Vec::new();
@@ -114,26 +159,7 @@ pub fn run(args: &TestArgs) -> i32 {
         results.push(r);
     }
     bar.finish_and_clear();
-    let status = report::status(&results);
-    report::print_table(&results, t0.elapsed().as_secs_f64(), args.quiet);
-    let mut extra = 0;
-    if let Some(f) = &args.junit {
-        if let Err(e) = report::write_junit(f, &args.dir, &results) {
-            eprintln!("error: {e}");
-            extra = 2;
-        }
-    }
-    if let Some(d) = &args.report {
-        match report::write_html(d, &args.dir, &results) {
-            Ok(p) if !args.quiet => eprintln!("report: {}", p.display()),
-            Ok(_) => {}
-            Err(e) => {
-                eprintln!("error: {e}");
-                extra = 2;
-            }
-        }
-    }
-    status.max(extra)
+    Ok(results)
 }
 
 fn check_writable(path: &Path) -> Result<(), String> {

@@ -21,20 +21,8 @@ pub fn status(results: &[SceneResult]) -> i32 {
         .unwrap_or(0)
 }
 
-/// The verdict's figures as multiples of the expected noise: relative MSE,
-/// block error, and the mean difference in standard deviations.
-fn ratios(r: &SceneResult, v: &Verdict) -> [f64; 3] {
-    let u = r.unit.unwrap_or(v.bounds);
-    let c = &v.comparison;
-    [
-        c.relative_mse / u.max_relative_mse,
-        c.block_error / u.max_block_error,
-        v.mean_difference / u.max_mean_difference,
-    ]
-}
-
 fn figures(r: &SceneResult, v: &Verdict) -> String {
-    let [m, b, s] = ratios(r, v);
+    let [m, b, s] = r.ratios().unwrap_or_default();
     let c = &v.comparison;
     format!(
         "relative MSE {:.3e} = {m:.2}× noise (max {:.2}), block error {:.3e} = {b:.2}× noise (max {:.2}), mean difference {:.3e} = {s:.2} σ (max {:.2}), non-finite pixels {}",
@@ -88,7 +76,7 @@ pub fn print_table(results: &[SceneResult], seconds: f64, quiet: bool) {
     for r in results {
         let (word, cols) = match &r.outcome {
             Outcome::Passed(v) | Outcome::Failed(v) => {
-                let [m, b, s] = ratios(r, v);
+                let [m, b, s] = r.ratios().unwrap_or_default();
                 let word = if v.passed() { "pass" } else { "FAIL" };
                 (
                     word,
@@ -207,7 +195,7 @@ pub fn write_html(out: &Path, dir: &Path, results: &[SceneResult]) -> Result<Pat
         let name = xml(&r.entry.name);
         let (word, cols) = match &r.outcome {
             Outcome::Passed(v) | Outcome::Failed(v) => {
-                let [m, b, sd] = ratios(r, v);
+                let [m, b, sd] = r.ratios().unwrap_or_default();
                 let w = if v.passed() { "pass" } else { "FAIL" };
                 (
                     w,
