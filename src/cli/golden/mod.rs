@@ -163,11 +163,13 @@ pub fn check(args: &TestArgs) -> Result<Vec<SceneResult>, String> {
 }
 
 fn check_writable(path: &Path) -> Result<(), String> {
-    // check_output_path wants an image extension; probe the directory alone.
+    // check_output_path wants an image extension; probe the directory alone
+    // (made first: CI's report folders often do not exist yet).
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     check_output_path(&dir.join(".pbrs-probe.png"))
         .map_err(|_| format!("{}: cannot write in {}", path.display(), dir.display()))
 }

@@ -2,7 +2,7 @@
 //! the HTML report.
 
 use super::{Outcome, SceneResult};
-use crate::image::compare::false_colour_difference;
+use crate::image::compare::false_colour_difference_scaled;
 use crate::image::io::{write_atomic, write_image};
 use crate::image::verdict::Verdict;
 use std::fmt::Write as _;
@@ -222,10 +222,13 @@ pub fn write_html(out: &Path, dir: &Path, results: &[SceneResult]) -> Result<Pat
         let name = xml(&r.entry.name);
         match (&r.outcome, &r.images) {
             (Outcome::Failed(v), Some((img, golden))) => {
+                // White at 3× the per-pixel noise expected between a render
+                // and the golden: noise stays dark blue, changes stand out.
+                let white = r.unit.map_or(0.5, |u| 3.0 * u.max_relative_mse.sqrt()) as f32;
                 let files = [
                     ("golden", golden.clone()),
                     ("render", img.clone()),
-                    ("difference", false_colour_difference(img, golden)),
+                    ("difference", false_colour_difference_scaled(img, golden, white)),
                 ];
                 for (kind, im) in &files {
                     write_image(&out.join(format!("{}-{kind}.png", r.entry.name)), im)?;
@@ -240,7 +243,7 @@ pub fn write_html(out: &Path, dir: &Path, results: &[SceneResult]) -> Result<Pat
                     let f = xml(&format!("{}-{kind}.png", r.entry.name));
                     let _ = writeln!(s, "<figure><img src=\"{f}\" alt=\"{kind}\"><figcaption>{kind}</figcaption></figure>");
                 }
-                s.push_str("<p>difference: per-pixel relative error, black 0, blue, green, yellow, red, white ≥ 0.5</p>\n");
+                let _ = writeln!(s, "<p>difference: per-pixel relative error, black 0, blue, green, yellow, red, white ≥ {white:.3} (3× the expected noise)</p>");
             }
             (Outcome::Error(e), _) => {
                 let _ = writeln!(
