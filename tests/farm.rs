@@ -447,7 +447,12 @@ fn command_line_tiles_and_merge_give_the_full_render_and_refuse_to_overwrite() {
     };
     let mut c = pbrs();
     common_args(&mut c);
-    run_ok(c.arg("--outfile").arg(dir.join("full.exr")));
+    // The merge writes no render metadata: the single render leaves it out.
+    run_ok(
+        c.arg("--reproducible")
+            .arg("--outfile")
+            .arg(dir.join("full.exr")),
+    );
     let mut parts = Vec::new();
     for k in 0..3 {
         let p = dir.join(format!("part-{k}.exr"));
@@ -469,7 +474,11 @@ fn command_line_tiles_and_merge_give_the_full_render_and_refuse_to_overwrite() {
     // PNG from the merge equals the full render's PNG.
     let mut c = pbrs();
     common_args(&mut c);
-    run_ok(c.arg("--outfile").arg(dir.join("full.png")));
+    run_ok(
+        c.arg("--reproducible")
+            .arg("--outfile")
+            .arg(dir.join("full.png")),
+    );
     run_ok(merge_cmd().arg(dir.join("merged.png")).args(&parts));
     assert!(
         std::fs::read(dir.join("merged.png")).unwrap()

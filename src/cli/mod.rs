@@ -14,6 +14,8 @@ mod cat;
 mod check;
 pub mod converge;
 pub mod display;
+pub mod golden;
+pub mod img;
 pub mod merge;
 mod render;
 
@@ -65,9 +67,15 @@ pub struct Args {
     /// as a plymesh (pbrt-v3's --toply).
     #[arg(long, help_heading = "Scene tools")]
     pub toply: bool,
-    /// Output image (.exr, .png or .pfm); overrides the Film's filename.
+    /// Output image (.exr, .png or .pfm; also .hdr, .tga); overrides the
+    /// Film's filename. EXR and PNG files record pbrs's version, the scene,
+    /// spp, integrator, seed and render time (`pbrs img info` shows them).
     #[arg(long, short = 'o', value_name = "FILE")]
     pub outfile: Option<PathBuf>,
+    /// Write no metadata into the image: the file then depends on its pixels
+    /// alone (byte-identical across runs, thread counts and `pbrs merge`).
+    #[arg(long)]
+    pub reproducible: bool,
     /// Samples per pixel; overrides the sampler's pixelsamples (pbrt-v4).
     #[arg(long, value_name = "N")]
     pub spp: Option<u32>,
@@ -168,6 +176,12 @@ pub enum Command {
     /// Merge the parts of a frame (--tile/--tiles or --spp-range renders)
     /// into its image: tiles give the single-machine image bit for bit.
     Merge(merge::MergeArgs),
+    /// Golden-image regression tests: render the scenes of DIR and compare
+    /// each with DIR/golden/NAME.exr (--update writes the goldens). Exit 0
+    /// all pass, 1 a scene regressed, 2 bad input.
+    Test(golden::TestArgs),
+    /// Image tools: diff, convert, info.
+    Img(img::ImgArgs),
 }
 
 /// `--nthreads` beyond the machine's cores is clamped to them, with a
@@ -195,6 +209,8 @@ pub fn run(argv: Vec<OsString>) -> i32 {
     match &args.command {
         Some(Command::Converge(c)) => return converge::run(c),
         Some(Command::Merge(m)) => return merge::run(m),
+        Some(Command::Test(t)) => return golden::run(t),
+        Some(Command::Img(i)) => return img::run(i),
         None => {}
     }
     clamp_threads(&mut args);

@@ -4,7 +4,9 @@
 
 use super::display::Display;
 use super::Args;
-use crate::image::io::{check_output_path, format_for_path, write_image, ImageFormat};
+use crate::image::io::{
+    check_output_path, format_for_path, write_image, write_image_with, ImageFormat,
+};
 use crate::image::Image;
 use crate::loader::{load_scene_files_each, print_diagnostics, strictly};
 use crate::render::driver::{
@@ -437,7 +439,18 @@ fn render_one(
         Ok(r) => r,
         Err(e) => return fail(e),
     };
-    if let Err(e) = write_image(&out, &image) {
+    let metadata = if args.reproducible {
+        Vec::new()
+    } else {
+        crate::image::meta::render_metadata(
+            &scenes_label(args),
+            desc.sampler.pixel_samples,
+            desc.integrator.name(),
+            args.seed,
+            stats.render_time.as_secs_f64(),
+        )
+    };
+    if let Err(e) = write_image_with(&out, &image, &metadata) {
         return fail(format!("cannot write {}: {e}", out.display()));
     }
     if let Some(d) = display {

@@ -1,5 +1,8 @@
 //! Image files: EXR (float32 RGB), PFM (little-endian, rows bottom to top as
-//! the format specifies) and PNG (8-bit sRGB, clamped, as pbrt-v3 writes it).
+//! the format specifies), PNG (8-bit sRGB, clamped, as pbrt-v3 writes it),
+//! and for `pbrs img convert` Radiance HDR (RGBE) and TGA (8-bit sRGB).
+//! EXR and PNG files can carry [`Metadata`] (EXR text attributes, PNG text
+//! chunks).
 //! Writes are atomic: the file is written under a temporary name in the same
 //! directory and renamed into place, so a failure never leaves a partial
 //! image behind.
@@ -15,7 +18,30 @@ pub enum ImageFormat {
     Exr,
     Pfm,
     Png,
+    Hdr,
+    Tga,
 }
+
+impl ImageFormat {
+    pub fn name(self) -> &'static str {
+        match self {
+            ImageFormat::Exr => "EXR",
+            ImageFormat::Pfm => "PFM",
+            ImageFormat::Png => "PNG",
+            ImageFormat::Hdr => "HDR",
+            ImageFormat::Tga => "TGA",
+        }
+    }
+
+    /// Whether the format stores 8-bit sRGB values (clamped to [0, 1]).
+    pub fn is_8bit(self) -> bool {
+        matches!(self, ImageFormat::Png | ImageFormat::Tga)
+    }
+}
+
+/// Text metadata written into an image: `(key, value)` pairs, as EXR text
+/// attributes or PNG text chunks (other formats have no place for it).
+pub type Metadata = [(String, String)];
 
 /// The format implied by the extension (case-insensitive).
 pub fn format_for_path(path: &Path) -> Result<ImageFormat, String> {
@@ -27,12 +53,14 @@ pub fn format_for_path(path: &Path) -> Result<ImageFormat, String> {
         Some("exr") => Ok(ImageFormat::Exr),
         Some("pfm") => Ok(ImageFormat::Pfm),
         Some("png") => Ok(ImageFormat::Png),
+        Some("hdr") => Ok(ImageFormat::Hdr),
+        Some("tga") => Ok(ImageFormat::Tga),
         Some(e) => Err(format!(
-            "{}: unsupported image format \".{e}\" (use .exr, .pfm or .png)",
+            "{}: unsupported image format \".{e}\" (use .exr, .pfm, .png, .hdr or .tga)",
             path.display()
         )),
         None => Err(format!(
-            "{}: no file extension to choose the image format (use .exr, .pfm or .png)",
+            "{}: no file extension to choose the image format (use .exr, .pfm, .png, .hdr or .tga)",
             path.display()
         )),
     }
@@ -93,13 +121,22 @@ pub fn check_output_path(path: &Path) -> Result<(), String> {
 
 /// Writes `img` in the format given by the extension of `path`, atomically.
 pub fn write_image(path: &Path, img: &Image) -> Result<(), String> {
+    write_image_with(path, img, &[])
+}
+
+/// [`write_image`] with `metadata` in the header (EXR and PNG; ignored by
+/// the other formats). Empty metadata writes exactly [`write_image`]'s bytes.
+pub fn write_image_with(path: &Path, img: &Image, metadata: &Metadata) -> Result<(), String> {
     let format = format_for_path(path)?;
     check_image(img)?;
     let bytes = match format {
-        ImageFormat::Pfm => encode_pfm(img),
-        ImageFormat::Png => encode_png(img).map_err(|e| format!("{}: {e}", path.display()))?,
-        ImageFormat::Exr => encode_exr(img).map_err(|e| format!("{}: {e}", path.display()))?,
-    };
+        ImageFormat::Pfm => Ok(encode_pfm(img)),
+        ImageFormat::Png => encode_png(img, metadata),
+        ImageFormat::Exr => encode_exr(img, metadata),
+        ImageFormat::Hdr => encode_hdr(img),
+        ImageFormat::Tga => encode_tga(img),
+    }
+    .map_err(|e| format!("{}: {e}", path.display()))?;
     write_atomic(path, &bytes)
 }
 
@@ -166,24 +203,79 @@ pub fn to_8bit(v: f32) -> u8 {
     (255.0 * srgb_encode(v) + 0.5).clamp(0.0, 255.0) as u8
 }
 
-fn encode_png(img: &Image) -> Result<Vec<u8>, String> {
+fn encode_png(img: &Image, metadata: &Metadata) -> Result<Vec<u8>, String> {
     use image::ImageEncoder;
     let rgb: Vec<u8> = img.data.iter().map(|&v| to_8bit(v)).collect();
     let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
+    if metadata.is_empty() {
+        image::codecs::png::PngEncoder::new(&mut out)
+            .write_image(&rgb, img.width, img.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| e.to_string())?;
+        return Ok(out);
+    }
+    let mut enc = png::Encoder::new(&mut out, img.width, img.height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    for (k, v) in metadata {
+        // tEXt holds Latin-1; other text goes in a UTF-8 iTXt chunk.
+        if v.is_ascii() {
+            enc.add_text_chunk(k.clone(), v.clone())
+        } else {
+            enc.add_itxt_chunk(k.clone(), v.clone())
+        }
+        .map_err(|e| e.to_string())?;
+    }
+    let mut w = enc.write_header().map_err(|e| e.to_string())?;
+    w.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    w.finish().map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+fn encode_tga(img: &Image) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let rgb: Vec<u8> = img.data.iter().map(|&v| to_8bit(v)).collect();
+    let mut out = Vec::new();
+    image::codecs::tga::TgaEncoder::new(&mut out)
         .write_image(&rgb, img.width, img.height, image::ExtendedColorType::Rgb8)
         .map_err(|e| e.to_string())?;
     Ok(out)
 }
 
-fn encode_exr(img: &Image) -> Result<Vec<u8>, String> {
-    use exr::prelude::{Image as ExrImage, SpecificChannels, WritableImage};
+fn encode_hdr(img: &Image) -> Result<Vec<u8>, String> {
+    // RGBE holds no negative or non-finite value: those are written as 0.
+    let px: Vec<image::Rgb<f32>> = img
+        .data
+        .chunks_exact(3)
+        .map(|c| {
+            let f = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
+            image::Rgb([f(c[0]), f(c[1]), f(c[2])])
+        })
+        .collect();
+    let mut out = Vec::new();
+    image::codecs::hdr::HdrEncoder::new(&mut out)
+        .encode(&px, img.width as usize, img.height as usize)
+        .map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+fn encode_exr(img: &Image, metadata: &Metadata) -> Result<Vec<u8>, String> {
+    use exr::prelude::{AttributeValue, Image as ExrImage, SpecificChannels, Text, WritableImage};
     let w = img.width as usize;
     let channels = SpecificChannels::rgb(|exr::math::Vec2(x, y): exr::math::Vec2<usize>| {
         let i = 3 * (y * w + x);
         (img.data[i], img.data[i + 1], img.data[i + 2])
     });
-    let image = ExrImage::from_channels((img.width as usize, img.height as usize), channels);
+    let mut image = ExrImage::from_channels((img.width as usize, img.height as usize), channels);
+    for (k, v) in metadata {
+        let (Some(k), Some(v)) = (Text::new_or_none(k), Text::new_or_none(v)) else {
+            return Err(format!("metadata {k:?} cannot be written as EXR text"));
+        };
+        image
+            .layer_data
+            .attributes
+            .other
+            .insert(k, AttributeValue::Text(v));
+    }
     let mut cursor = Cursor::new(Vec::new());
     // Sequential: the exr crate's parallel compression writes blocks in
     // completion order, which would make the file depend on timing.
@@ -195,12 +287,14 @@ fn encode_exr(img: &Image) -> Result<Vec<u8>, String> {
     Ok(cursor.into_inner())
 }
 
-/// Reads an image by extension (`.pfm` or `.exr`).
+/// Reads an image by extension (`.pfm`, `.exr` or `.png`; the others
+/// through [`super::meta::read_any`]).
 pub fn read_image(path: &Path) -> Result<Image, String> {
     match format_for_path(path)? {
         ImageFormat::Pfm => read_pfm(path),
         ImageFormat::Exr => read_exr(path),
         ImageFormat::Png => read_png(path),
+        ImageFormat::Hdr | ImageFormat::Tga => super::meta::read_any(path).map(|r| r.image),
     }
 }
 

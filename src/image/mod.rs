@@ -1,12 +1,15 @@
 //! Linear RGB float images: the type ([`Image`]), its files ([`io`]: EXR, PFM,
-//! PNG, written atomically) and the project's comparison metrics
-//! ([`compare`]). The film develops into one; the loader reads texture
+//! PNG, HDR, TGA, written atomically; [`meta`]: any of them read with its
+//! metadata), the project's comparison metrics ([`compare`]) and the golden
+//! verdict built on them ([`verdict`]). The film develops into one; the loader reads texture
 //! and reference images with [`io`].
 
 use glam::Vec3;
 
 pub mod compare;
 pub mod io;
+pub mod meta;
+pub mod verdict;
 
 /// Largest image (width × height) any reader accepts: 2^27 texels, e.g. a
 /// 16384 × 8192 environment map, 1.5 GiB as RGB f32. Checked against the

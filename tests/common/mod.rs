@@ -4,6 +4,7 @@
 
 use pbrs::image::compare::{compare, false_colour_difference, Comparison};
 use pbrs::image::io::{read_image, write_image};
+use pbrs::image::verdict;
 use pbrs::image::Image;
 use pbrs::loader::load_scene;
 use pbrs::render::driver::{render, RenderOptions, RenderStats};
@@ -84,7 +85,8 @@ pub fn pbrt_64(stem: &str) -> Image {
     .expect("pbrt-v3 64 spp")
 }
 
-/// Acceptance bounds for a render compared with a converged reference.
+/// Acceptance bounds for a render compared with a converged reference
+/// (judged by `pbrs::image::verdict`, the verdict `pbrs test` uses).
 #[derive(Clone, Copy, Debug)]
 pub struct Bounds {
     pub max_relative_mse: f64,
@@ -113,32 +115,33 @@ pub fn output_dir(name: &str) -> PathBuf {
     d
 }
 
-/// Whether `img` is within `b` of `reference`.
-pub fn within(img: &Image, reference: &Image, b: Bounds) -> bool {
-    let c = compare(img, reference);
-    let mean_diff = (0..3)
-        .map(|i| ((c.mean_a[i] - c.mean_r[i]) / c.mean_r[i].abs().max(1e-6)).abs())
-        .fold(0.0f64, f64::max);
-    c.relative_mse <= b.max_relative_mse
-        && c.block_error <= b.max_block_error
-        && mean_diff <= b.max_mean_difference
+impl From<Bounds> for verdict::Bounds {
+    fn from(b: Bounds) -> verdict::Bounds {
+        verdict::Bounds {
+            max_relative_mse: b.max_relative_mse,
+            max_block_error: b.max_block_error,
+            max_mean_difference: b.max_mean_difference,
+        }
+    }
+}
+
+/// Whether `img` is within `b` of `reference` (and has no non-finite pixel).
+pub fn within(img: &Image, reference: &Image, b: impl Into<verdict::Bounds>) -> bool {
+    verdict::judge(img, reference, b.into()).passed()
 }
 
 /// Compares and asserts; on failure writes render, reference and a
 /// false-colour difference image next to the test output.
-pub fn assert_matches(name: &str, img: &Image, reference: &Image, b: Bounds) -> Comparison {
-    let c = compare(img, reference);
-    let mean_diff = (0..3)
-        .map(|i| ((c.mean_a[i] - c.mean_r[i]) / c.mean_r[i].abs().max(1e-6)).abs())
-        .fold(0.0f64, f64::max);
-    eprintln!(
-        "{name}: relative MSE {:.5} (max {:.5}), block error {:.5} (max {:.5}), mean difference {:.4} (max {:.4}); means {:?} vs {:?}",
-        c.relative_mse, b.max_relative_mse, c.block_error, b.max_block_error, mean_diff, b.max_mean_difference, c.mean_a, c.mean_r
-    );
-    let ok = c.relative_mse <= b.max_relative_mse
-        && c.block_error <= b.max_block_error
-        && mean_diff <= b.max_mean_difference;
-    if !ok {
+pub fn assert_matches(
+    name: &str,
+    img: &Image,
+    reference: &Image,
+    b: impl Into<verdict::Bounds>,
+) -> Comparison {
+    let v = verdict::judge(img, reference, b.into());
+    eprintln!("{name}: {}", v.summary());
+    let c = v.comparison;
+    if !v.passed() {
         let d = output_dir(name);
         let _ = write_image(&d.join("render.exr"), img);
         let _ = write_image(&d.join("render.png"), img);

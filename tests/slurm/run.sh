@@ -116,7 +116,8 @@ log "slurm $(sinfo -V | awk '{ print $2 }') up: node localhost, $cpus CPUs"
 # The single-machine render.
 t=$(now)
 # shellcheck disable=SC2086
-"$pbrs" "$scene" $flags --outfile "$work/full.exr"
+# --reproducible: no render metadata (the merged frame has none), so cmp can compare.
+"$pbrs" "$scene" $flags --reproducible --outfile "$work/full.exr"
 single=$(secs "$t" "$(now)")
 log "single-machine render: $single s"
 
