@@ -238,10 +238,16 @@ fn extreme_cases() -> Vec<Case> {
         &["case.pbrt:8:", "not finite"],
     ));
     out.push(render(
+        "f32 overflow",
+        scene("", "Scale 1e30 1e30 1e30 Scale 1e30 1 1 Shape \"sphere\""),
+        1,
+        &["case.pbrt:8:", "not finite"],
+    ));
+    out.push(render(
         "lookat overflow",
         scene(
             "",
-            "Scale 1e300 1e300 1e300 LookAt 1e300 0 0  0 0 0  0 1 0 Shape \"sphere\"",
+            "Scale 1e30 1e30 1e30 LookAt 1e300 0 0  0 0 0  0 1 0 Shape \"sphere\"",
         ),
         0,
         &["case.pbrt:8:", "degenerate LookAt"],

@@ -214,12 +214,18 @@ impl<'s, 'c> Builder<'s, 'c> {
     }
 
     /// [`Self::apply`] for a transform statement at `loc`: a result that
-    /// is not finite (numbers whose product overflows) is a located error
+    /// is not finite as an f32 (the render core's precision; numbers whose
+    /// product overflows) is a located error
     /// and the transform is left as it was.
     fn apply_at(&mut self, loc: Loc, f: impl Fn(DMat4) -> DMat4) {
         let next = self.ctm.map(&f);
-        if (0..2).any(|i| self.active[i] && !next[i].is_finite()) {
-            self.ctx.error(loc, "the transform is not finite (its numbers overflow when combined with the current transform)", "this transform", None);
+        let fits = |m: &DMat4| {
+            m.to_cols_array()
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= f32::MAX as f64)
+        };
+        if (0..2).any(|i| self.active[i] && !fits(&next[i])) {
+            self.ctx.error(loc, "the transform is not finite in single precision (its numbers overflow a 32-bit float, alone or combined with the current transform)", "this transform", None);
             return;
         }
         self.apply(f);
