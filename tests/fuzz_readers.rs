@@ -261,3 +261,19 @@ fn farm_parts() {
     });
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn ptex_files() {
+    // Parsed, then looked up at a few points of every face (the lookup
+    // reads the faces the parse left for first use).
+    check("ptex", &[".ptx"], |_, b| {
+        if let Ok(f) = pbrs::textures::ptex_file::PtexFile::parse(b) {
+            let filter = pbrs::textures::ptex_filter::BicubicFilter::new(0.0);
+            for face in 0..f.faces.len().min(64) as i32 {
+                for (u, v, w) in [(0.5, 0.5, 0.01), (0.0, 1.0, 0.3), (0.99, 0.01, 2.0)] {
+                    let _ = filter.eval(&f, face, u, v, w, 0.0, 0.0, w);
+                }
+            }
+        }
+    });
+}
