@@ -123,7 +123,7 @@ fn png_round_trip() {
 #[test]
 fn unknown_extension_is_rejected_without_writing() {
     let dir = scratch("ext");
-    for name in ["a.tga", "a", "a.hdr"] {
+    for name in ["a.bmp", "a", "a.jpg"] {
         let p = dir.join(name);
         assert!(check_output_path(&p).is_err());
         assert!(write_image(&p, &test_image()).is_err());

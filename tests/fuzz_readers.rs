@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 const ITERATIONS: usize = 300;
 const SECONDS_PER_READER: f64 = 20.0;
 
+static LAST_PANIC: std::sync::Mutex<String> = std::sync::Mutex::new(String::new());
 static PANICS: AtomicUsize = AtomicUsize::new(0);
 
 /// xorshift64*: the mutations are the same on every machine.
@@ -142,8 +143,9 @@ fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
 
 /// Runs `read` on every mutation of every seed; the failures found.
 fn fuzz(name: &str, exts: &[&str], read: impl Fn(&Path, &[u8])) -> Vec<String> {
-    std::panic::set_hook(Box::new(|_| {
+    std::panic::set_hook(Box::new(|info| {
         PANICS.fetch_add(1, Ordering::SeqCst);
+        *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()) = info.to_string();
     }));
     let files = seeds(exts);
     assert!(!files.is_empty(), "{name}: no seed files");
@@ -167,7 +169,11 @@ fn fuzz(name: &str, exts: &[&str], read: impl Fn(&Path, &[u8])) -> Vec<String> {
             let t = Instant::now();
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read(f, &bytes)));
             if r.is_err() || PANICS.load(Ordering::SeqCst) != before {
-                failures.push(format!("{name}: {} round {round}: panicked", f.display()));
+                let why = LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                failures.push(format!(
+                    "{name}: {} round {round}: panicked: {why}",
+                    f.display()
+                ));
             }
             if t.elapsed() > Duration::from_secs(10) {
                 failures.push(format!(

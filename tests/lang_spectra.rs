@@ -189,7 +189,7 @@ fn bad_files_give_located_warnings() {
         ("odd", "300 1 900 1 950", &["5 values, an odd count: the last one (950) has no pair and is ignored (as pbrt-v3)"], None),
         ("text", "300 1\nabout 900 1", &["line 2: \"about\" is not a number: skipped (as pbrt-v3)"], None),
         ("repeated", "300 1 600 1 600 1 900 1", &["wavelength 600 nm is given twice"], None),
-        ("decreasing", "900 1 300 1", &[], None),
+        ("decreasing", "900 1 300 1", &["wavelengths are not in increasing order (300 nm after 900 nm): the pairs are sorted (as pbrt-v3)"], None),
         ("binary", "\u{0}\u{1}\u{2}", &["is not a number", "holds no (wavelength, value) pair"], Some([0.0; 3])),
     ];
     let flat = [1.2023306, 0.94621414, 0.90733975];

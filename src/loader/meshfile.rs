@@ -104,6 +104,19 @@ pub fn read_gltf(
     // The gltf crate's validation indexes accessors without a bounds check
     // (gltf-json 1.4.1 `primitive_validate_hook`), so those indices are checked
     // first; the rest runs under `catch_unwind` as a last guard.
+    // A GLB header's length below the header's own 12 bytes underflows
+    // the crate's length arithmetic.
+    if let Some(len) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|b| b.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+    {
+        if len < 12 {
+            return Err(format!(
+                "not a valid glTF file: its GLB header gives a length of {len} bytes, less than the 12-byte header"
+            ));
+        }
+    }
     let gltf = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| format!("not a valid glTF file: {e}"))?;
     validate(&gltf)?;
