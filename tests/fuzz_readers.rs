@@ -152,8 +152,10 @@ fn fuzz(name: &str, exts: &[&str], read: impl Fn(&Path, &[u8])) -> Vec<String> {
     let iterations = env_or("PBRS_FUZZ_ITERATIONS", ITERATIONS);
     let budget = Duration::from_secs_f64(env_or("PBRS_FUZZ_SECONDS", SECONDS_PER_READER));
     let start = Instant::now();
+    let verbose = std::env::var_os("PBRS_FUZZ_VERBOSE").is_some();
     let mut failures = Vec::new();
-    'rounds: for round in 0..iterations {
+    let from = env_or("PBRS_FUZZ_FROM", 0usize);
+    'rounds: for round in from..iterations {
         for (k, f) in files.iter().enumerate() {
             if start.elapsed() > budget {
                 break 'rounds;
@@ -165,6 +167,11 @@ fn fuzz(name: &str, exts: &[&str], read: impl Fn(&Path, &[u8])) -> Vec<String> {
             } else {
                 mutate(&seed, &mut rng)
             };
+            if verbose {
+                // The input about to be read, for a reader that aborts.
+                eprintln!("{name}: {} round {round}", f.display());
+                let _ = std::fs::write(std::env::temp_dir().join("pbrs-fuzz-last.bin"), &bytes);
+            }
             let before = PANICS.load(Ordering::SeqCst);
             let t = Instant::now();
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read(f, &bytes)));

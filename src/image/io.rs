@@ -400,18 +400,36 @@ pub fn read_exr(path: &Path) -> Result<Image, String> {
             ));
         }
     }
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |res, _| Image::new(res.width() as u32, res.height() as u32),
-        |img: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            let i = 3 * (pos.y() * img.width as usize + pos.x());
-            img.data[i] = r;
-            img.data[i + 1] = g;
-            img.data[i + 2] = b;
-        },
-    )
-    .map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok(img.layer_data.channel_data.pixels)
+    // Decoded on this thread (the exr crate's parallel decoder aborts the
+    // process when a worker panics on corrupt data; here a panic is this
+    // file's error).
+    let read = || {
+        use exr::prelude::traits::*;
+        exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |res, _| Image::new(res.width() as u32, res.height() as u32),
+                |img: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    let i = 3 * (pos.y() * img.width as usize + pos.x());
+                    img.data[i] = r;
+                    img.data[i + 1] = g;
+                    img.data[i + 2] = b;
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .non_parallel()
+            .from_file(path)
+    };
+    match std::panic::catch_unwind(read) {
+        Ok(Ok(img)) => Ok(img.layer_data.channel_data.pixels),
+        Ok(Err(e)) => Err(format!("{}: {e}", path.display())),
+        Err(_) => Err(format!(
+            "{}: the EXR decoder failed on this file (corrupt data)",
+            path.display()
+        )),
+    }
 }
 
 /// Reads an 8-bit PNG back to linear RGB (inverse sRGB curve), for tests.

@@ -447,6 +447,7 @@ fn decode_exr(bytes: &[u8]) -> Result<RgbImage, String> {
         .all_channels()
         .first_valid_layer()
         .all_attributes()
+        .non_parallel()
         .from_buffered(Cursor::new(bytes))
         .map_err(|e| e.to_string())?;
     let layer = image.layer_data;

@@ -286,12 +286,20 @@ fn check_accessors(prim: &gltf::Primitive, mesh: usize, buffers: &[Vec<u8>]) -> 
             ));
         }
         let size = a.size();
-        let stride = view.stride().unwrap_or(size).max(size);
-        let need = (a.count() as u64)
-            .checked_sub(1)
-            .map_or(Some(0), |n| n.checked_mul(stride as u64))
-            .and_then(|b| b.checked_add((a.offset() + size) as u64));
-        if a.count() > 0 && need.is_none_or(|n| n > view.length() as u64) {
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return bad(format!(
+                "has a buffer view stride of {stride} bytes, less than its {size}-byte elements"
+            ));
+        }
+        if a.count() == 0 {
+            return bad("has no elements".into());
+        }
+        let need = (a.count() as u64 - 1)
+            .checked_mul(stride as u64)
+            .and_then(|b| b.checked_add(a.offset() as u64))
+            .and_then(|b| b.checked_add(size as u64));
+        if need.is_none_or(|n| n > view.length() as u64) {
             return bad(format!(
                 "claims {} elements, more than its buffer view's {} bytes hold",
                 a.count(),

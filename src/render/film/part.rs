@@ -373,6 +373,7 @@ pub fn read_part(path: &Path) -> Result<Part, String> {
         .all_channels()
         .first_valid_layer()
         .all_attributes()
+        .non_parallel()
         .from_file(path)
         .map_err(|e| {
             fail(format!(
