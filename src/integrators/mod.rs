@@ -1,8 +1,9 @@
 //! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
 //! power-heuristic MIS, Russian roulette), `volpath` (the same with
 //! participating media), `directlighting` (strategy all or one, specular
-//! lobes followed recursively), `whitted`, `ambientocclusion` and `sppm`
-//! (stochastic progressive photon mapping).
+//! lobes followed recursively), `whitted`, `ambientocclusion`, `sppm`
+//! (stochastic progressive photon mapping) and `bdpt` (bidirectional path
+//! tracing, whose light tracing lands on the film as [`Splat`]s).
 //!
 //! One file per integrator: [`path`] (with the per-vertex step `path` and
 //! `volpath` share, over the medium the path is in), [`volpath`] (the
@@ -27,7 +28,7 @@
 //! which only delegate (a `match`, no dynamic dispatch). A new kind is its
 //! file, its row of [`INTEGRATORS`] and its line of `integrators!`.
 
-use crate::geometry::{Ray, RayDiff};
+use crate::geometry::{Bounds2i, Ray, RayDiff};
 use crate::lights::LightSampler;
 use crate::samplers::Sampler;
 use crate::scene::kind::{Kind, Report, Support};
@@ -65,6 +66,17 @@ impl RayCounts {
     }
 }
 
+/// A contribution that lands on the film at a position of its own, not
+/// filtered (pbrt-v3's `Film::AddSplat`: bdpt's light tracing). `layer` 0
+/// is the image; layer k > 0 is extra image k − 1 (bdpt's images per
+/// strategy).
+#[derive(Clone, Copy, Debug)]
+pub struct Splat {
+    pub p_film: Vec2,
+    pub l: Vec3,
+    pub layer: u32,
+}
+
 /// Per-tile scratch space, so the per-sample path never allocates.
 #[derive(Default)]
 pub struct Scratch {
@@ -72,11 +84,21 @@ pub struct Scratch {
     u_scatter: Vec<Vec2>,
     work: Vec<Work>,
     counts: RayCounts,
+    /// The tile's splats, in sample order.
+    splats: Vec<Splat>,
+    /// bdpt's subpath vertices, reused from sample to sample.
+    bdpt: bdpt::Subpaths,
 }
 
 impl Scratch {
     pub fn counts(&self) -> RayCounts {
         self.counts
+    }
+
+    /// The splats of the samples rendered with this scratch space, in
+    /// sample order (leaving none).
+    pub fn take_splats(&mut self) -> Vec<Splat> {
+        std::mem::take(&mut self.splats)
     }
 }
 
@@ -99,7 +121,7 @@ pub static INTEGRATORS: &[IntegratorKind] = &[
     whitted::KIND,
     ambientocclusion::KIND,
     sppm::KIND,
-    unsupported("bdpt", "bidirectional path tracing is not implemented"),
+    bdpt::KIND,
     unsupported("mlt", "Metropolis light transport is not implemented"),
 ];
 
@@ -154,6 +176,22 @@ pub trait Integrate {
     /// Requests the sampler arrays the integrator uses (pbrt-v3's
     /// Preprocess).
     fn prepare_sampler(&mut self, _scene: &RenderScene, _sampler: &mut Sampler) {}
+
+    /// Takes the film's sample bounds, or says why the integrator cannot
+    /// render this scene on it (bdpt's camera importance).
+    fn prepare_film(
+        &mut self,
+        _scene: &RenderScene,
+        _sample_bounds: Bounds2i,
+    ) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// The extra images the integrator splats to (each a [`Splat`] layer
+    /// k > 0) and their file names.
+    fn splat_images(&self) -> Vec<(u32, String)> {
+        Vec::new()
+    }
 
     /// What the integrator built beyond the light distribution.
     fn notes(&self) -> Vec<String> {
@@ -280,6 +318,20 @@ macro_rules! integrators {
                 }
             }
 
+            /// See [`Integrate::prepare_film`].
+            pub fn prepare_film(&mut self, scene: &RenderScene, sample_bounds: Bounds2i) -> Result<(), String> {
+                match self {
+                    $(Integrator::$variant(i) => i.prepare_film(scene, sample_bounds),)*
+                }
+            }
+
+            /// See [`Integrate::splat_images`].
+            pub fn splat_images(&self) -> Vec<(u32, String)> {
+                match self {
+                    $(Integrator::$variant(i) => i.splat_images(),)*
+                }
+            }
+
             /// See [`Integrate::notes`].
             pub fn notes(&self) -> Vec<String> {
                 match self {
@@ -335,6 +387,7 @@ integrators! {
     Whitted(WhittedSettings) => whitted::Whitted,
     AmbientOcclusion(AmbientOcclusionSettings) => ambientocclusion::AmbientOcclusion,
     Sppm(SppmSettings) => sppm::Sppm,
+    Bdpt(BdptSettings) => bdpt::Bdpt,
 }
 
 /// Without an `Integrator` statement: `path` with pbrt-v3's defaults.

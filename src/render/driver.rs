@@ -98,6 +98,7 @@ impl Renderer {
         let scene = RenderScene::new(desc);
         let mut integrator = Integrator::new(&desc.integrator, &scene, opts.scalar);
         let film = Film::new(&desc.film, &desc.filter);
+        integrator.prepare_film(&scene, film.sample_bounds())?;
         let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
         integrator.prepare_sampler(&scene, &mut sampler);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -165,6 +166,7 @@ impl Renderer {
             return self.render_sppm(on_chunk);
         }
         let t1 = Instant::now();
+        self.film.add_splat_samples(samples.len() as u64);
         let mut tiles = self.film.tiles(16);
         if let Some(r) = region {
             tiles.retain(|t| {
@@ -307,6 +309,19 @@ impl Renderer {
         self.stats.render_time += t1.elapsed();
     }
 
+    /// Writes the integrator's extra splat images (bdpt's strategy
+    /// images) next to the output image; returns the paths written.
+    pub fn write_splat_images(&self) -> Result<Vec<std::path::PathBuf>, String> {
+        let dir = self.output.parent().unwrap_or(std::path::Path::new(""));
+        let mut written = Vec::new();
+        for (layer, name) in self.integrator.splat_images() {
+            let path = dir.join(name);
+            crate::image::io::write_image(&path, &self.film.layer_image(layer))?;
+            written.push(path);
+        }
+        Ok(written)
+    }
+
     /// The sampler's samples per pixel.
     pub fn samples_per_pixel(&self) -> u32 {
         self.sampler.samples_per_pixel()
@@ -383,7 +398,20 @@ pub fn render_observed(
     let mut r = Renderer::new(desc, opts)?;
     let spp = r.sampler.samples_per_pixel();
     r.render_samples_observed(0..spp, on_chunk);
-    Ok((r.image(), r.stats()))
+    let mut stats = r.stats();
+    match r.write_splat_images() {
+        Ok(paths) if !paths.is_empty() => stats.notes.push(format!(
+            "{} strategy images written next to the output image ({} … {})",
+            paths.len(),
+            paths[0].display(),
+            paths[paths.len() - 1].display()
+        )),
+        Ok(_) => {}
+        Err(e) => stats
+            .notes
+            .push(format!("the strategy images were not written: {e}")),
+    }
+    Ok((r.image(), stats))
 }
 
 /// Renders part `kind` of the frame `desc` describes (a tile or a range of
@@ -404,6 +432,11 @@ pub fn render_part(
     let spp = r.samples_per_pixel();
     let header = PartHeader::new(desc, r.film(), opts.seed, kind);
     match kind {
+        PartKind::Tile { .. } if matches!(r.integrator, Integrator::Bdpt(_)) => {
+            return Err(format!(
+                "{kind}: bdpt's light-tracing splats land anywhere in the image, so one tile needs every pixel's samples; split the frame by samples instead (--spp-range)"
+            ));
+        }
         PartKind::Tile { index, count } => {
             part::check_tile(r.film(), index, count)?;
             let rect = part::tile_rect(r.film().pixel_bounds(), index, count);
@@ -463,6 +496,7 @@ fn render_tile(
         }
     }
     c.rays = scratch.counts();
+    tile.set_splats(scratch.take_splats());
     (tile, c)
 }
 
@@ -621,6 +655,7 @@ fn render_tile_batched(
         }
     }
     c.rays = scratch.counts();
+    tile.set_splats(scratch.take_splats());
     (tile, c)
 }
 
@@ -656,9 +691,14 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
     let h = ((f.yresolution as f64 * y1 as f64).ceil() - (f.yresolution as f64 * y0 as f64).ceil())
         .max(0.0) as u64;
     // sppm keeps each pixel's state and visible point besides the film.
+    // bdpt's splats: one f64 RGB sum per pixel, and one per strategy
+    // image when they are written.
     let per_pixel = match desc.integrator {
         crate::integrators::IntegratorSettings::Sppm(_) => {
             BYTES_PER_PIXEL + crate::integrators::SPPM_PIXEL_BYTES
+        }
+        crate::integrators::IntegratorSettings::Bdpt(b) => {
+            BYTES_PER_PIXEL + 24 * (1 + b.strategy_images().len() as u64)
         }
         _ => BYTES_PER_PIXEL,
     };
