@@ -163,7 +163,7 @@ fn light_vertex<'a>(
             (ls, p, Vec3::ZERO)
         }
     };
-    if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+    if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return None;
     }
     let mut v = Vertex::at(Kind::Light, p, n, ls.li / (ls.pdf * pmf), pt.time, None);
