@@ -51,6 +51,11 @@ const CASES: &[Case] = &[
             "\"integer iterations\" 4 \"integer photonsperiteration\" 2000 \"float radius\" 0.2",
         summary: "sppm, iterations 4, photons per iteration 2000, maxdepth 5, radius 0.2",
     },
+    Case {
+        kind: "bdpt",
+        params: "\"integer maxdepth\" 4",
+        summary: "bdpt, maxdepth 4, light samples power",
+    },
 ];
 
 /// A small scene lit by a point light and an area light: a matte floor, a
