@@ -56,6 +56,11 @@ const CASES: &[Case] = &[
         params: "\"integer maxdepth\" 4",
         summary: "bdpt, maxdepth 4, light samples power",
     },
+    Case {
+        kind: "mlt",
+        params: "\"integer bootstrapsamples\" 1000 \"integer chains\" 10 \"integer mutationsperpixel\" 4",
+        summary: "mlt, maxdepth 5, bootstrap samples 1000, chains 10, mutations per pixel 4, large step probability 0.3, sigma 0.01",
+    },
 ];
 
 /// A small scene lit by a point light and an area light: a matte floor, a

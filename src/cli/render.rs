@@ -49,10 +49,18 @@ pub fn scenes_label(args: &Args) -> String {
 /// resolution by 4 (at least 1) before the crop window applies; every
 /// sampler but "random" takes 1 sample per pixel (stratified: 1 × 1); the
 /// diffuse area and infinite lights take a quarter of their "nsamples" (at
-/// least 1); sppm takes a sixteenth of its iterations (at least 1).
+/// least 1); sppm takes a sixteenth of its iterations, mlt of its
+/// mutations per pixel and bootstrap samples (at least 1).
 pub fn apply_quick(desc: &mut SceneDescription) {
-    if let crate::integrators::IntegratorSettings::Sppm(s) = &mut desc.integrator {
-        s.iterations = (s.iterations / 16).max(1);
+    match &mut desc.integrator {
+        crate::integrators::IntegratorSettings::Sppm(s) => {
+            s.iterations = (s.iterations / 16).max(1);
+        }
+        crate::integrators::IntegratorSettings::Mlt(m) => {
+            m.mutations_per_pixel = (m.mutations_per_pixel / 16).max(1);
+            m.bootstrap_samples = (m.bootstrap_samples / 16).max(1);
+        }
+        _ => {}
     }
     desc.film.xresolution = (desc.film.xresolution / 4).max(1);
     desc.film.yresolution = (desc.film.yresolution / 4).max(1);

@@ -32,7 +32,7 @@
 //! Subsurface scattering is not sampled (as pbrt-v3's bdpt, which uses
 //! only the BSDF of such a material: its dielectric boundary).
 
-mod connect;
+pub(super) mod connect;
 pub(crate) mod vertex;
 
 use super::common::light_sampler;
@@ -181,14 +181,14 @@ fn buffer_index(s: usize, t: usize) -> usize {
 /// grown to the longest subpaths).
 #[derive(Default)]
 pub struct Subpaths {
-    camera: Vec<Vertex<'static>>,
-    light: Vec<Vertex<'static>>,
+    pub(super) camera: Vec<Vertex<'static>>,
+    pub(super) light: Vec<Vertex<'static>>,
 }
 
 /// An empty vector's storage for vertices of another lifetime (the same
 /// type but for the lifetime of the materials the BSDFs refer to: the
 /// storage is reused in place, nothing is allocated).
-fn recycle<'x, 'y>(mut v: Vec<Vertex<'x>>) -> Vec<Vertex<'y>> {
+pub(super) fn recycle<'x, 'y>(mut v: Vec<Vertex<'x>>) -> Vec<Vertex<'y>> {
     v.clear();
     v.into_iter().map(|_| unreachable!()).collect()
 }
@@ -300,7 +300,14 @@ impl Integrate for Bdpt {
         };
         let mut cam = recycle(std::mem::take(&mut scratch.bdpt.camera));
         let mut light = recycle(std::mem::take(&mut scratch.bdpt.light));
-        let l = self.sample(&c, (ray, time, diff), &mut cam, &mut light, sampler, scratch);
+        let l = self.sample(
+            &c,
+            (ray, time, diff),
+            &mut cam,
+            &mut light,
+            sampler,
+            scratch,
+        );
         scratch.bdpt.camera = recycle(cam);
         scratch.bdpt.light = recycle(light);
         l
@@ -320,20 +327,8 @@ impl Bdpt {
         scratch: &mut Scratch,
     ) -> Vec3 {
         let max_depth = self.settings.max_depth;
-        // The camera subpath (pbrt-v3's GenerateCameraSubpath).
-        let pdf_dir = c.camera.pdf_we(ray.o, ray.d, time).1;
-        cam.push(Vertex::at(Kind::Camera, ray.o, Vec3::ZERO, Vec3::ONE, time, c.camera_medium));
-        let walk = Walk {
-            ray,
-            diff,
-            beta: Vec3::ONE,
-            pdf: pdf_dir,
-            medium: c.camera_medium,
-            time,
-            mode: Mode::Radiance,
-        };
-        let n_camera = 1 + random_walk(c, walk, max_depth + 1, cam, sampler, scratch) as usize;
-        let n_light = self.light_subpath(c, time, light, sampler, scratch);
+        let n_camera = camera_subpath(c, (ray, time, diff), max_depth + 1, cam, sampler, scratch);
+        let n_light = light_subpath(c, time, max_depth, light, sampler, scratch);
         let p_film = if self.settings.visualizes() {
             c.camera.we(ray.o, ray.d, time).1
         } else {
@@ -375,57 +370,89 @@ impl Bdpt {
         }
         l
     }
+}
 
-    /// The light subpath (pbrt-v3's GenerateLightSubpath): its number of
-    /// vertices.
-    fn light_subpath<'a>(
-        &self,
-        c: &Ctx<'a>,
-        time: f32,
-        path: &mut Vec<Vertex<'a>>,
-        sampler: &mut Sampler,
-        scratch: &mut Scratch,
-    ) -> usize {
-        let scene = c.scene;
-        let u = sampler.get_1d();
-        let chosen = c
-            .lights
-            .sample(c.p_camera, Vec3::ZERO, u, &scene.lights, &scene.aggregate);
-        let (u1, u2) = (sampler.get_2d(), sampler.get_2d());
-        let Some((i, pmf)) = chosen else {
-            return 0;
-        };
-        let Some(e) = scene.lights[i as usize].sample_le(u1, u2, &scene.aggregate) else {
-            return 0;
-        };
-        if e.pdf_pos == 0.0 || e.pdf_dir == 0.0 || e.le == Vec3::ZERO {
-            return 0;
-        }
-        let mut v = Vertex::at(Kind::Light, e.ray.o, e.n, e.le, time, c.camera_medium);
-        v.light = Some(i);
-        v.pdf_fwd = e.pdf_pos * pmf;
-        path.push(v);
-        let beta = e.le * e.n.dot(e.ray.d).abs() / (pmf * e.pdf_pos * e.pdf_dir);
-        let walk = Walk {
-            ray: e.ray,
-            diff: None,
-            beta,
-            pdf: e.pdf_dir,
-            medium: c.camera_medium,
-            time,
-            mode: Mode::Importance,
-        };
-        let n = random_walk(c, walk, self.settings.max_depth, path, sampler, scratch) as usize;
-        if path[0].is_infinite_light(c) {
-            if n > 0 {
-                let v1 = &mut path[1];
-                v1.pdf_fwd = e.pdf_pos;
-                if v1.on_surface() {
-                    v1.pdf_fwd *= e.ray.d.dot(v1.n).abs();
-                }
-            }
-            path[0].pdf_fwd = c.infinite_light_density(e.ray.d);
-        }
-        n + 1
+/// The camera subpath from the camera ray (pbrt-v3's GenerateCameraSubpath
+/// after its ray): the camera vertex and up to `bounces` more; returns its
+/// number of vertices.
+pub(super) fn camera_subpath<'a>(
+    c: &Ctx<'a>,
+    (ray, time, diff): (Ray, f32, Option<RayDiff>),
+    bounces: u32,
+    cam: &mut Vec<Vertex<'a>>,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> usize {
+    let pdf_dir = c.camera.pdf_we(ray.o, ray.d, time).1;
+    cam.push(Vertex::at(
+        Kind::Camera,
+        ray.o,
+        Vec3::ZERO,
+        Vec3::ONE,
+        time,
+        c.camera_medium,
+    ));
+    let walk = Walk {
+        ray,
+        diff,
+        beta: Vec3::ONE,
+        pdf: pdf_dir,
+        medium: c.camera_medium,
+        time,
+        mode: Mode::Radiance,
+    };
+    1 + random_walk(c, walk, bounces, cam, sampler, scratch) as usize
+}
+
+/// The light subpath (pbrt-v3's GenerateLightSubpath): the light vertex
+/// and up to `bounces` more; returns its number of vertices.
+pub(super) fn light_subpath<'a>(
+    c: &Ctx<'a>,
+    time: f32,
+    bounces: u32,
+    path: &mut Vec<Vertex<'a>>,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> usize {
+    let scene = c.scene;
+    let u = sampler.get_1d();
+    let chosen = c
+        .lights
+        .sample(c.p_camera, Vec3::ZERO, u, &scene.lights, &scene.aggregate);
+    let (u1, u2) = (sampler.get_2d(), sampler.get_2d());
+    let Some((i, pmf)) = chosen else {
+        return 0;
+    };
+    let Some(e) = scene.lights[i as usize].sample_le(u1, u2, &scene.aggregate) else {
+        return 0;
+    };
+    if e.pdf_pos == 0.0 || e.pdf_dir == 0.0 || e.le == Vec3::ZERO {
+        return 0;
     }
+    let mut v = Vertex::at(Kind::Light, e.ray.o, e.n, e.le, time, c.camera_medium);
+    v.light = Some(i);
+    v.pdf_fwd = e.pdf_pos * pmf;
+    path.push(v);
+    let beta = e.le * e.n.dot(e.ray.d).abs() / (pmf * e.pdf_pos * e.pdf_dir);
+    let walk = Walk {
+        ray: e.ray,
+        diff: None,
+        beta,
+        pdf: e.pdf_dir,
+        medium: c.camera_medium,
+        time,
+        mode: Mode::Importance,
+    };
+    let n = random_walk(c, walk, bounces, path, sampler, scratch) as usize;
+    if path[0].is_infinite_light(c) {
+        if n > 0 {
+            let v1 = &mut path[1];
+            v1.pdf_fwd = e.pdf_pos;
+            if v1.on_surface() {
+                v1.pdf_fwd *= e.ray.d.dot(v1.n).abs();
+            }
+        }
+        path[0].pdf_fwd = c.infinite_light_density(e.ray.d);
+    }
+    n + 1
 }

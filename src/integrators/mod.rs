@@ -2,15 +2,17 @@
 //! power-heuristic MIS, Russian roulette), `volpath` (the same with
 //! participating media), `directlighting` (strategy all or one, specular
 //! lobes followed recursively), `whitted`, `ambientocclusion`, `sppm`
-//! (stochastic progressive photon mapping) and `bdpt` (bidirectional path
-//! tracing, whose light tracing lands on the film as [`Splat`]s).
+//! (stochastic progressive photon mapping), `bdpt` (bidirectional path
+//! tracing, whose light tracing lands on the film as [`Splat`]s) and `mlt`
+//! (Metropolis light transport over bdpt's paths, all splats).
 //!
 //! One file per integrator: [`path`] (with the per-vertex step `path` and
 //! `volpath` share, over the medium the path is in), [`volpath`] (the
 //! medium tracking and transmittance of that step), [`directlighting`],
-//! [`whitted`], [`ambientocclusion`] and [`sppm`] (photon mapping, which
+//! [`whitted`], [`ambientocclusion`], [`sppm`] (photon mapping, which
 //! has its own render loop, [`sppm::Sppm::render`], that the driver calls
-//! instead of the tile loop); the recursive specular tree that directlighting and
+//! instead of the tile loop), [`bdpt`] and [`mlt`] (its own loop too,
+//! [`mlt::Mlt::render`]); the recursive specular tree that directlighting and
 //! whitted share ([`specular`]); the batch of samples a thread renders
 //! together ([`batch`]: `path` and `volpath` one vertex of every lane at a
 //! time); directlighting's four-lane estimate ([`direct_lanes`]); and what
@@ -31,7 +33,7 @@
 use crate::geometry::{Bounds2i, Ray, RayDiff};
 use crate::lights::LightSampler;
 use crate::samplers::Sampler;
-use crate::scene::kind::{Kind, Report, Support};
+use crate::scene::kind::{Kind, Report};
 use crate::scene::{ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
 
@@ -43,6 +45,7 @@ mod specular;
 mod subsurface;
 
 pub use batch::Batch;
+pub use mlt::{MltDone, MltRun};
 pub use render_scene::{RenderScene, SurfaceMedia};
 use specular::Work;
 pub use sppm::{SppmRun, PIXEL_BYTES as SPPM_PIXEL_BYTES};
@@ -112,8 +115,7 @@ pub type IntegratorBuild = fn(&ParamValues, &mut dyn Report) -> IntegratorSettin
 /// One integrator kind: its pbrt-v3 name, its parameters, its builder.
 pub type IntegratorKind = Kind<IntegratorBuild>;
 
-/// Every integrator pbrt-v3 knows: those pbrs renders, then those it
-/// substitutes by `path` (with the statement's `maxdepth`, and a warning).
+/// Every integrator pbrt-v3 knows.
 pub static INTEGRATORS: &[IntegratorKind] = &[
     path::KIND,
     volpath::KIND,
@@ -122,7 +124,7 @@ pub static INTEGRATORS: &[IntegratorKind] = &[
     ambientocclusion::KIND,
     sppm::KIND,
     bdpt::KIND,
-    unsupported("mlt", "Metropolis light transport is not implemented"),
+    mlt::KIND,
 ];
 
 /// `maxdepth`, which every integrator reads.
@@ -133,27 +135,6 @@ const PIXEL_BOUNDS: ParamSpec = ParamSpec::unsupported(
     "pixelbounds",
     "\"pixelbounds\" is not supported by pbrs: the whole film is rendered (use --cropwindow)",
 );
-
-/// The parameters of the kinds pbrs substitutes by `path`.
-const UNSUPPORTED_PARAMS: &[ParamSpec] = &[MAX_DEPTH, PIXEL_BOUNDS];
-
-/// A kind pbrs does not render: `path` with the statement's `maxdepth`
-/// (the loader says so).
-const fn unsupported(name: &'static str, why: &'static str) -> IntegratorKind {
-    IntegratorKind {
-        name,
-        aliases: &[],
-        support: Support::Unsupported(why),
-        params: UNSUPPORTED_PARAMS,
-        doc: "substituted by `path` with the same `maxdepth`, with a warning",
-        build: |p, r| {
-            IntegratorSettings::Path(PathSettings {
-                max_depth: max_depth(p, r),
-                ..PathSettings::default()
-            })
-        },
-    }
-}
 
 /// pbrt-v3's `maxdepth`, checked: a negative one is an error (and 5 is used).
 fn max_depth(p: &ParamValues, r: &mut dyn Report) -> u32 {
@@ -388,6 +369,7 @@ integrators! {
     AmbientOcclusion(AmbientOcclusionSettings) => ambientocclusion::AmbientOcclusion,
     Sppm(SppmSettings) => sppm::Sppm,
     Bdpt(BdptSettings) => bdpt::Bdpt,
+    Mlt(MltSettings) => mlt::Mlt,
 }
 
 /// Without an `Integrator` statement: `path` with pbrt-v3's defaults.

@@ -742,16 +742,20 @@ impl<'s, 'c> Builder<'s, 'c> {
         let filter = options::filter(self.ctx, ent(self.filter));
         let sampler = options::sampler(self.ctx, ent(self.sampler));
         let integrator = options::integrator(self.ctx, ent(self.integrator));
-        if let (crate::integrators::IntegratorSettings::Bdpt(_), Some((name, _))) =
-            (&integrator, ent(self.integrator))
+        if let (
+            crate::integrators::IntegratorSettings::Bdpt(_)
+            | crate::integrators::IntegratorSettings::Mlt(_),
+            Some((name, _)),
+        ) = (&integrator, ent(self.integrator))
         {
-            // pbrt-v3's bdpt asks the camera for its importance (We), which
-            // only the perspective camera has.
+            // pbrt-v3's bdpt and mlt ask the camera for its importance
+            // (We), which only the perspective camera has.
             if !matches!(
                 camera.projection,
                 crate::cameras::Projection::Perspective(_)
             ) {
-                self.ctx.error(name.loc, format!("the \"bdpt\" integrator needs the camera's importance (We), which only the \"perspective\" camera has (as in pbrt-v3): the \"{}\" camera cannot be used with bdpt", camera.projection.kind_name()), "needs a perspective camera", None);
+                let kind = integrator.name();
+                self.ctx.error(name.loc, format!("the \"{kind}\" integrator needs the camera's importance (We), which only the \"perspective\" camera has (as in pbrt-v3): the \"{}\" camera cannot be used with {kind}", camera.projection.kind_name()), "needs a perspective camera", None);
             }
         }
         if let Some(loc) = self.first_medium_interface {

@@ -162,8 +162,10 @@ impl Renderer {
         region: Option<Bounds2i>,
         on_chunk: &mut dyn FnMut(&ChunkDone),
     ) {
-        if let Integrator::Sppm(_) = self.integrator {
-            return self.render_sppm(on_chunk);
+        match self.integrator {
+            Integrator::Sppm(_) => return self.render_sppm(on_chunk),
+            Integrator::Mlt(_) => return self.render_mlt(on_chunk),
+            _ => {}
         }
         let t1 = Instant::now();
         self.film.add_splat_samples(samples.len() as u64);
@@ -309,6 +311,41 @@ impl Renderer {
         self.stats.render_time += t1.elapsed();
     }
 
+    /// `mlt`'s own loop: bootstrap paths, then the Markov chains in groups
+    /// whose splats are added to the film in chain order (`on_chunk` is
+    /// called with the groups). The range of samples and the region of the
+    /// other integrators do not apply.
+    fn render_mlt(&mut self, on_chunk: &mut dyn FnMut(&ChunkDone)) {
+        let Integrator::Mlt(mlt) = &self.integrator else {
+            return;
+        };
+        let t1 = Instant::now();
+        let run = crate::integrators::MltRun {
+            scene: &self.scene,
+            seed: self.seed,
+            pool: &self.pool,
+        };
+        let whole = [self.film.pixel_bounds()];
+        let done = mlt.render(&run, &mut self.film, &mut |k, total, film| {
+            on_chunk(&ChunkDone {
+                done: k,
+                total,
+                tiles: &whole,
+                film,
+            })
+        });
+        self.scene.notes.push(format!(
+            "mlt: b = {:.6} from {} bootstrap paths; {} mutations, {:.1}% accepted",
+            done.b,
+            done.bootstrap_paths,
+            done.mutations,
+            100.0 * done.accepted as f64 / done.mutations.max(1) as f64
+        ));
+        self.stats.rays.add(&done.rays);
+        self.stats.samples += done.mutations;
+        self.stats.render_time += t1.elapsed();
+    }
+
     /// Writes the integrator's extra splat images (bdpt's strategy
     /// images) next to the output image; returns the paths written.
     pub fn write_splat_images(&self) -> Result<Vec<std::path::PathBuf>, String> {
@@ -427,6 +464,11 @@ pub fn render_part(
     if let Integrator::Sppm(_) = r.integrator {
         return Err(format!(
             "{kind}: sppm's iterations depend on each other (each shrinks the radii the next uses), so a frame cannot be split into parts; render it whole"
+        ));
+    }
+    if let Integrator::Mlt(_) = r.integrator {
+        return Err(format!(
+            "{kind}: mlt's Markov chains splat anywhere in the image and its normalisation comes from the whole frame's bootstrap paths, so a frame cannot be split into tiles or sample ranges; render it whole"
         ));
     }
     let spp = r.samples_per_pixel();
@@ -700,6 +742,7 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
         crate::integrators::IntegratorSettings::Bdpt(b) => {
             BYTES_PER_PIXEL + 24 * (1 + b.strategy_images().len() as u64)
         }
+        crate::integrators::IntegratorSettings::Mlt(_) => BYTES_PER_PIXEL + 24,
         _ => BYTES_PER_PIXEL,
     };
     let need = w * h * per_pixel;

@@ -81,7 +81,14 @@ pub(crate) fn connect<'a>(
             if let Some(is) = c.camera.sample_wi(qs.p, u, qs.time) {
                 p_raster = Some(is.p_raster);
                 if is.pdf > 0.0 && is.we != Vec3::ZERO {
-                    let v = Vertex::at(Kind::Camera, is.p_lens, is.n, is.we / is.pdf, qs.time, c.camera_medium);
+                    let v = Vertex::at(
+                        Kind::Camera,
+                        is.p_lens,
+                        is.n,
+                        is.we / is.pdf,
+                        qs.time,
+                        c.camera_medium,
+                    );
                     l = qs.beta * qs.f(&v, Mode::Importance) * v.beta;
                     if qs.on_surface() {
                         l *= is.wi.dot(qs.ns).abs();
@@ -97,7 +104,13 @@ pub(crate) fn connect<'a>(
         let pt = &camera[t - 1];
         if pt.is_connectible(c) {
             let u = sampler.get_1d();
-            let chosen = c.lights.sample(c.p_camera, Vec3::ZERO, u, &c.scene.lights, &c.scene.aggregate);
+            let chosen = c.lights.sample(
+                c.p_camera,
+                Vec3::ZERO,
+                u,
+                &c.scene.lights,
+                &c.scene.aggregate,
+            );
             let u2 = sampler.get_2d();
             if let Some((i, pmf)) = chosen {
                 if let Some((v, shadow, wi)) = light_vertex(c, pt, i, pmf, u2) {
@@ -190,7 +203,11 @@ fn mis_weight<'a>(
     // The sampled endpoint replaces the subpath's.
     let mut swapped = None;
     if let Some(v) = sampled {
-        let slot = if s == 1 { &mut light[0] } else { &mut camera[0] };
+        let slot = if s == 1 {
+            &mut light[0]
+        } else {
+            &mut camera[0]
+        };
         swapped = Some(std::mem::replace(slot, v));
     }
     // The new reverse densities, computed before any is set.
@@ -210,14 +227,16 @@ fn mis_weight<'a>(
     let saved_pt = (camera[pt].pdf_rev, camera[pt].delta);
     camera[pt].pdf_rev = pt_rev;
     camera[pt].delta = false;
-    let saved_pt_m = pt_m.map(|m| std::mem::replace(&mut camera[m].pdf_rev, pt_m_rev.unwrap_or(0.0)));
+    let saved_pt_m =
+        pt_m.map(|m| std::mem::replace(&mut camera[m].pdf_rev, pt_m_rev.unwrap_or(0.0)));
     let saved_qs = qs.map(|q| {
         let old = (light[q].pdf_rev, light[q].delta);
         light[q].pdf_rev = qs_rev.unwrap_or(0.0);
         light[q].delta = false;
         old
     });
-    let saved_qs_m = qs_m.map(|m| std::mem::replace(&mut light[m].pdf_rev, qs_m_rev.unwrap_or(0.0)));
+    let saved_qs_m =
+        qs_m.map(|m| std::mem::replace(&mut light[m].pdf_rev, qs_m_rev.unwrap_or(0.0)));
 
     let remap0 = |f: f32| if f != 0.0 { f } else { 1.0 };
     let mut sum_ri = 0.0f32;

@@ -419,13 +419,25 @@ pub(crate) fn random_walk<'a>(
                 continue;
             }
             let mut v = Vertex::at(Kind::Surface, s.point.p, s.point.n, beta, time, medium);
-            shade(scene, &h, &mut s, material, true, diff.as_ref(), &mut v.bsdf);
+            shade(
+                scene,
+                &h,
+                &mut s,
+                material,
+                true,
+                diff.as_ref(),
+                &mut v.bsdf,
+            );
             diff = None;
             v.p_error = s.point.p_error;
             v.ns = s.point.ns;
             v.wo = -ray.d.normalize();
             v.light = s.light;
-            v.media = scene.surface_media.get(s.material as usize).copied().flatten();
+            v.media = scene
+                .surface_media
+                .get(s.material as usize)
+                .copied()
+                .flatten();
             v.pdf_fwd = path[prev].convert_density(pdf_fwd, &v, c);
             path.push(v);
             bounces += 1;

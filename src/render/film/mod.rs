@@ -67,6 +67,9 @@ pub struct Film {
     /// Samples per pixel rendered so far: splats are scaled by its inverse
     /// (pbrt-v3's `splatScale` 1/spp).
     splat_spp: u64,
+    /// The splats' scale when an integrator sets it (`mlt`: b over the
+    /// mutations per pixel) instead of 1/spp.
+    splat_scale_set: Option<f64>,
 }
 
 impl Film {
@@ -113,6 +116,7 @@ impl Film {
             splats: Vec::new(),
             layers: Vec::new(),
             splat_spp: 0,
+            splat_scale_set: None,
         }
     }
 
@@ -295,11 +299,19 @@ impl Film {
         self.splats.clear();
         self.layers.clear();
         self.splat_spp = 0;
+        self.splat_scale_set = None;
+    }
+
+    /// Sets the scale of the splats (pbrt-v3's `WriteImage(splatScale)`),
+    /// in place of 1/spp.
+    pub fn set_splat_scale(&mut self, scale: f64) {
+        self.splat_scale_set = Some(scale);
     }
 
     /// The splat scale: 1/spp (pbrt-v3's `splatScale`).
     fn splat_scale(&self) -> f64 {
-        1.0 / self.splat_spp.max(1) as f64
+        self.splat_scale_set
+            .unwrap_or(1.0 / self.splat_spp.max(1) as f64)
     }
 
     /// The image over the pixel bounds: `max(0, Σ wL / Σ w) × scale` per
