@@ -231,8 +231,10 @@ pub struct MltDone {
 /// are added to the film in order (about 12 MiB of splats at most).
 const GROUP_MUTATIONS: u64 = 1 << 18;
 
-/// Bootstrap paths per unit of parallel work.
+/// Bootstrap samples (each `maxdepth` + 1 paths) per unit of parallel
+/// work, and the most rounds of them between progress reports.
 const BOOTSTRAP_CHUNK: usize = 1024;
+const BOOTSTRAP_ROUNDS: usize = 16;
 
 /// The sequence number of PCG32 stream `index` under `seed` (seed 0:
 /// pbrt-v3's, the index itself).
@@ -278,7 +280,8 @@ impl Mlt {
 
     /// Renders every chain, adding their splats to `film` (whose splat
     /// scale it sets to b / `mutationsperpixel`); `progress(done, total,
-    /// film)` is called after each group of chains is added.
+    /// film)` is called after each round of bootstrap paths and each group
+    /// of chains added.
     pub fn render(
         &self,
         run: &MltRun,
@@ -327,45 +330,59 @@ impl Mlt {
             ))
         };
 
-        // The bootstrap paths: b and the chains' starting points.
-        let mut weights = vec![0.0f32; s.bootstrap_samples as usize * depths];
-        let rays = run.pool.install(|| {
-            weights
-                .par_chunks_mut(BOOTSTRAP_CHUNK * depths)
-                .enumerate()
-                .map(|(k, chunk)| {
-                    let mut scratch = Scratch::default();
-                    for (j, w) in chunk.iter_mut().enumerate() {
-                        let index = k * BOOTSTRAP_CHUNK * depths + j;
-                        let mut sampler = sampler_for(index);
-                        let depth = (index % depths) as u32;
-                        *w = luminance(paths.path(&mut sampler, depth, &mut scratch).0);
-                    }
-                    scratch.counts()
-                })
-                .reduce(RayCounts::default, |mut a, b| {
-                    a.add(&b);
-                    a
-                })
-        });
-        done.rays.add(&rays);
-        done.bootstrap_paths = weights.len() as u64;
-        let bootstrap = Distribution1D::new(&weights);
-        let b = bootstrap.func_int() * depths as f32;
-        done.b = b as f64;
-        film.set_splat_scale(b as f64 / mpp as f64);
-        if b.is_nan() || b <= 0.0 {
-            progress(1, 1, film);
-            return done;
-        }
-
-        // The chains, in groups of consecutive chains.
+        // The chains, in groups of consecutive chains (fixed by the
+        // settings and the film alone).
         let total = mpp as u64 * bounds.area().max(0) as u64;
         let n_chains = s.chains as u64;
         let chain_start = |i: u64| ((i as u128 * total as u128) / n_chains as u128) as u64;
         let per_group = ((GROUP_MUTATIONS as u128 * n_chains as u128) / total.max(1) as u128)
             .clamp(1, n_chains as u128) as u64;
         let groups = n_chains.div_ceil(per_group) as usize;
+
+        // The bootstrap paths (b and the chains' starting points), in
+        // rounds between which progress is reported.
+        let mut weights = vec![0.0f32; s.bootstrap_samples as usize * depths];
+        let chunk_len = BOOTSTRAP_CHUNK * depths;
+        let n_chunks = weights.len().div_ceil(chunk_len);
+        let rounds = n_chunks.min(BOOTSTRAP_ROUNDS);
+        let steps = rounds + groups;
+        let chunks_per_round = n_chunks.div_ceil(rounds);
+        for (round, part) in weights
+            .chunks_mut(chunks_per_round * chunk_len)
+            .enumerate()
+        {
+            let first = round * chunks_per_round * chunk_len;
+            let rays = run.pool.install(|| {
+                part.par_chunks_mut(chunk_len)
+                    .enumerate()
+                    .map(|(k, chunk)| {
+                        let mut scratch = Scratch::default();
+                        for (j, w) in chunk.iter_mut().enumerate() {
+                            let index = first + k * chunk_len + j;
+                            let mut sampler = sampler_for(index);
+                            let depth = (index % depths) as u32;
+                            *w = luminance(paths.path(&mut sampler, depth, &mut scratch).0);
+                        }
+                        scratch.counts()
+                    })
+                    .reduce(RayCounts::default, |mut a, b| {
+                        a.add(&b);
+                        a
+                    })
+            });
+            done.rays.add(&rays);
+            progress(round + 1, steps, film);
+        }
+        done.bootstrap_paths = weights.len() as u64;
+        let bootstrap = Distribution1D::new(&weights);
+        let b = bootstrap.func_int() * depths as f32;
+        done.b = b as f64;
+        film.set_splat_scale(b as f64 / mpp as f64);
+        if b.is_nan() || b <= 0.0 {
+            progress(steps, steps, film);
+            return done;
+        }
+
         let next = AtomicUsize::new(0);
         let (tx, rx) = mpsc::channel::<(usize, Group)>();
         let chain = |i: u64, group: &mut Group, scratch: &mut Scratch| {
@@ -438,7 +455,7 @@ impl Mlt {
                     done.mutations += group.mutations;
                     done.accepted += group.accepted;
                     merged += 1;
-                    progress(merged, groups, film);
+                    progress(rounds + merged, steps, film);
                 }
             }
         });
