@@ -443,11 +443,15 @@ fn render_one(
             format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0))
         });
         eprintln!(
-            "{}: {}x{} px, {} spp, {} threads; build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
+            "{}: {}x{} px, {}, {} threads; build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
             out.display(),
             image.width,
             image.height,
-            desc.sampler.pixel_samples,
+            match &desc.integrator {
+                crate::integrators::IntegratorSettings::Mlt(m) =>
+                    format!("{} mutations per pixel", m.mutations_per_pixel),
+                _ => format!("{} spp", desc.sampler.pixel_samples),
+            },
             stats.threads,
             stats.build_time.as_secs_f64(),
             stats.render_time.as_secs_f64(),

@@ -377,18 +377,23 @@ impl Renderer {
     pub fn stats(&self) -> RenderStats {
         let mut stats = self.stats.clone();
         stats.notes = self.scene.notes.clone();
-        stats.notes.push(if self.batch > 1 {
-            format!(
-                "batched: {} samples in flight per thread ({:.1} KiB of lane state per thread)",
-                self.batch,
-                self.integrator
-                    .batch(self.batch, &self.sampler)
-                    .state_bytes() as f64
-                    / 1024.0
-            )
-        } else {
-            "one sample at a time per thread (scalar loop)".to_string()
-        });
+        stats.notes.push(
+            if let Integrator::Sppm(_) | Integrator::Mlt(_) = self.integrator {
+                "the integrator's own render loop over the whole film (not tiles of samples)"
+                    .to_string()
+            } else if self.batch > 1 {
+                format!(
+                    "batched: {} samples in flight per thread ({:.1} KiB of lane state per thread)",
+                    self.batch,
+                    self.integrator
+                        .batch(self.batch, &self.sampler)
+                        .state_bytes() as f64
+                        / 1024.0
+                )
+            } else {
+                "one sample at a time per thread (scalar loop)".to_string()
+            },
+        );
         stats.notes.extend(self.integrator.notes());
         if let Some(ls) = self.integrator.light_sampler() {
             stats.notes.push(format!(
