@@ -51,6 +51,16 @@ const CASES: &[Case] = &[
             "\"integer iterations\" 4 \"integer photonsperiteration\" 2000 \"float radius\" 0.2",
         summary: "sppm, iterations 4, photons per iteration 2000, maxdepth 5, radius 0.2",
     },
+    Case {
+        kind: "bdpt",
+        params: "\"integer maxdepth\" 4",
+        summary: "bdpt, maxdepth 4, light samples power",
+    },
+    Case {
+        kind: "mlt",
+        params: "\"integer bootstrapsamples\" 1000 \"integer chains\" 10 \"integer mutationsperpixel\" 4",
+        summary: "mlt, maxdepth 5, bootstrap samples 1000, chains 10, mutations per pixel 4, large step probability 0.3, sigma 0.01",
+    },
 ];
 
 /// A small scene lit by a point light and an area light: a matte floor, a

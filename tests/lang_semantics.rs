@@ -168,9 +168,20 @@ fn integrators() {
     let b = i("\"bdpt\" \"integer maxdepth\" 7");
     assert!(matches!(
         b.scene.integrator,
-        IntegratorSettings::Path(pbrs::scene::PathSettings { max_depth: 7, .. })
+        IntegratorSettings::Bdpt(pbrs::integrators::BdptSettings { max_depth: 7, .. })
     ));
-    assert!(warnings(&b).contains("substituted by \"path\""));
+    assert_eq!(warnings(&b), "");
+    let m = i("\"mlt\" \"integer maxdepth\" 7 \"integer chains\" 12 \"float sigma\" 0.05");
+    assert_eq!(
+        m.scene.integrator,
+        IntegratorSettings::Mlt(pbrs::integrators::MltSettings {
+            max_depth: 7,
+            chains: 12,
+            sigma: 0.05,
+            ..Default::default()
+        })
+    );
+    assert_eq!(warnings(&m), "");
 }
 
 #[test]

@@ -316,7 +316,7 @@ fn erf(x: f32) -> f32 {
 /// erf⁻¹ (Giles' single-precision approximation, as pbrt-v3).
 #[allow(clippy::excessive_precision)]
 #[inline]
-fn erf_inv(x: f32) -> f32 {
+pub(crate) fn erf_inv(x: f32) -> f32 {
     const CENTRAL: [f32; 9] = [
         2.81022636e-08,
         3.43273939e-07,

@@ -16,7 +16,7 @@ mod fresnel;
 mod fresnel_blend;
 pub mod hair;
 mod lambertian;
-mod microfacet;
+pub(crate) mod microfacet;
 mod microfacet_lobes;
 mod oren_nayar;
 mod specular;

@@ -27,11 +27,13 @@
 //! weight still counts, as pbrt-v3).
 
 mod environment;
+mod importance;
 mod orthographic;
 mod perspective;
 pub mod realistic;
 
 pub use environment::EnvironmentCamera;
+pub use importance::{CameraImportance, ImportanceSample};
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
 pub use realistic::RealisticCamera;
@@ -270,6 +272,18 @@ projections! {
     Orthographic(OrthographicCamera),
     Environment(EnvironmentCamera),
     Realistic(RealisticCamera),
+}
+
+impl Projection {
+    /// pbrt-v3's name of its kind.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Projection::Perspective(_) => perspective::KIND.name,
+            Projection::Orthographic(_) => orthographic::KIND.name,
+            Projection::Environment(_) => environment::KIND.name,
+            Projection::Realistic(_) => realistic::KIND.name,
+        }
+    }
 }
 
 impl Default for Projection {

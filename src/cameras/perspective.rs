@@ -149,6 +149,26 @@ impl PerspectiveCamera {
         self.focal_distance
     }
 
+    /// Camera-to-world as prepared (the identity for a moving camera).
+    pub fn camera_to_world(&self) -> Affine3A {
+        self.camera_to_world
+    }
+
+    /// The screen window [xmin, xmax, ymin, ymax].
+    pub fn screen(&self) -> [f32; 4] {
+        self.screen
+    }
+
+    /// The full film resolution the mapping was prepared for.
+    pub fn resolution(&self) -> Vec2 {
+        self.resolution
+    }
+
+    /// tan(fov/2).
+    pub fn tan_half_fov(&self) -> f32 {
+        self.tan_half_fov
+    }
+
     #[inline(always)]
     pub fn ray(&self, cs: &CameraSample) -> (Ray, f32) {
         (self.generate_ray(cs), 1.0)

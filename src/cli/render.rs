@@ -51,10 +51,18 @@ pub fn scenes_label(args: &Args) -> String {
 /// resolution by 4 (at least 1) before the crop window applies; every
 /// sampler but "random" takes 1 sample per pixel (stratified: 1 × 1); the
 /// diffuse area and infinite lights take a quarter of their "nsamples" (at
-/// least 1); sppm takes a sixteenth of its iterations (at least 1).
+/// least 1); sppm takes a sixteenth of its iterations, mlt of its
+/// mutations per pixel and bootstrap samples (at least 1).
 pub fn apply_quick(desc: &mut SceneDescription) {
-    if let crate::integrators::IntegratorSettings::Sppm(s) = &mut desc.integrator {
-        s.iterations = (s.iterations / 16).max(1);
+    match &mut desc.integrator {
+        crate::integrators::IntegratorSettings::Sppm(s) => {
+            s.iterations = (s.iterations / 16).max(1);
+        }
+        crate::integrators::IntegratorSettings::Mlt(m) => {
+            m.mutations_per_pixel = (m.mutations_per_pixel / 16).max(1);
+            m.bootstrap_samples = (m.bootstrap_samples / 16).max(1);
+        }
+        _ => {}
     }
     desc.film.xresolution = (desc.film.xresolution / 4).max(1);
     desc.film.yresolution = (desc.film.yresolution / 4).max(1);
@@ -465,11 +473,15 @@ fn render_one(
             format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0))
         });
         eprintln!(
-            "{}: {}x{} px, {} spp, {} threads; build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
+            "{}: {}x{} px, {}, {} threads; build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
             out.display(),
             image.width,
             image.height,
-            desc.sampler.pixel_samples,
+            match &desc.integrator {
+                crate::integrators::IntegratorSettings::Mlt(m) =>
+                    format!("{} mutations per pixel", m.mutations_per_pixel),
+                _ => format!("{} spp", desc.sampler.pixel_samples),
+            },
             stats.threads,
             stats.build_time.as_secs_f64(),
             stats.render_time.as_secs_f64(),

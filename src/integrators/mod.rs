@@ -1,15 +1,18 @@
 //! Integrators, as pbrt-v3 defines them: `path` (next-event estimation with
 //! power-heuristic MIS, Russian roulette), `volpath` (the same with
 //! participating media), `directlighting` (strategy all or one, specular
-//! lobes followed recursively), `whitted`, `ambientocclusion` and `sppm`
-//! (stochastic progressive photon mapping).
+//! lobes followed recursively), `whitted`, `ambientocclusion`, `sppm`
+//! (stochastic progressive photon mapping), `bdpt` (bidirectional path
+//! tracing, whose light tracing lands on the film as [`Splat`]s) and `mlt`
+//! (Metropolis light transport over bdpt's paths, all splats).
 //!
 //! One file per integrator: [`path`] (with the per-vertex step `path` and
 //! `volpath` share, over the medium the path is in), [`volpath`] (the
 //! medium tracking and transmittance of that step), [`directlighting`],
-//! [`whitted`], [`ambientocclusion`] and [`sppm`] (photon mapping, which
+//! [`whitted`], [`ambientocclusion`], [`sppm`] (photon mapping, which
 //! has its own render loop, [`sppm::Sppm::render`], that the driver calls
-//! instead of the tile loop); the recursive specular tree that directlighting and
+//! instead of the tile loop), [`bdpt`] and [`mlt`] (its own loop too,
+//! [`mlt::Mlt::render`]); the recursive specular tree that directlighting and
 //! whitted share ([`specular`]); the batch of samples a thread renders
 //! together ([`batch`]: `path` and `volpath` one vertex of every lane at a
 //! time); directlighting's four-lane estimate ([`direct_lanes`]); and what
@@ -27,10 +30,10 @@
 //! which only delegate (a `match`, no dynamic dispatch). A new kind is its
 //! file, its row of [`INTEGRATORS`] and its line of `integrators!`.
 
-use crate::geometry::{Ray, RayDiff};
+use crate::geometry::{Bounds2i, Ray, RayDiff};
 use crate::lights::LightSampler;
 use crate::samplers::Sampler;
-use crate::scene::kind::{Kind, Report, Support};
+use crate::scene::kind::{Kind, Report};
 use crate::scene::{ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
 
@@ -42,6 +45,7 @@ mod specular;
 mod subsurface;
 
 pub use batch::Batch;
+pub use mlt::{MltDone, MltRun};
 pub use render_scene::{RenderScene, SurfaceMedia};
 use specular::Work;
 pub use sppm::{SppmRun, PIXEL_BYTES as SPPM_PIXEL_BYTES};
@@ -65,6 +69,17 @@ impl RayCounts {
     }
 }
 
+/// A contribution that lands on the film at a position of its own, not
+/// filtered (pbrt-v3's `Film::AddSplat`: bdpt's light tracing). `layer` 0
+/// is the image; layer k > 0 is extra image k − 1 (bdpt's images per
+/// strategy).
+#[derive(Clone, Copy, Debug)]
+pub struct Splat {
+    pub p_film: Vec2,
+    pub l: Vec3,
+    pub layer: u32,
+}
+
 /// Per-tile scratch space, so the per-sample path never allocates.
 #[derive(Default)]
 pub struct Scratch {
@@ -72,11 +87,21 @@ pub struct Scratch {
     u_scatter: Vec<Vec2>,
     work: Vec<Work>,
     counts: RayCounts,
+    /// The tile's splats, in sample order.
+    splats: Vec<Splat>,
+    /// bdpt's subpath vertices, reused from sample to sample.
+    bdpt: bdpt::Subpaths,
 }
 
 impl Scratch {
     pub fn counts(&self) -> RayCounts {
         self.counts
+    }
+
+    /// The splats of the samples rendered with this scratch space, in
+    /// sample order (leaving none).
+    pub fn take_splats(&mut self) -> Vec<Splat> {
+        std::mem::take(&mut self.splats)
     }
 }
 
@@ -90,8 +115,7 @@ pub type IntegratorBuild = fn(&ParamValues, &mut dyn Report) -> IntegratorSettin
 /// One integrator kind: its pbrt-v3 name, its parameters, its builder.
 pub type IntegratorKind = Kind<IntegratorBuild>;
 
-/// Every integrator pbrt-v3 knows: those pbrs renders, then those it
-/// substitutes by `path` (with the statement's `maxdepth`, and a warning).
+/// Every integrator pbrt-v3 knows.
 pub static INTEGRATORS: &[IntegratorKind] = &[
     path::KIND,
     volpath::KIND,
@@ -99,8 +123,8 @@ pub static INTEGRATORS: &[IntegratorKind] = &[
     whitted::KIND,
     ambientocclusion::KIND,
     sppm::KIND,
-    unsupported("bdpt", "bidirectional path tracing is not implemented"),
-    unsupported("mlt", "Metropolis light transport is not implemented"),
+    bdpt::KIND,
+    mlt::KIND,
 ];
 
 /// `maxdepth`, which every integrator reads.
@@ -111,27 +135,6 @@ const PIXEL_BOUNDS: ParamSpec = ParamSpec::unsupported(
     "pixelbounds",
     "\"pixelbounds\" is not supported by pbrs: the whole film is rendered (use --cropwindow)",
 );
-
-/// The parameters of the kinds pbrs substitutes by `path`.
-const UNSUPPORTED_PARAMS: &[ParamSpec] = &[MAX_DEPTH, PIXEL_BOUNDS];
-
-/// A kind pbrs does not render: `path` with the statement's `maxdepth`
-/// (the loader says so).
-const fn unsupported(name: &'static str, why: &'static str) -> IntegratorKind {
-    IntegratorKind {
-        name,
-        aliases: &[],
-        support: Support::Unsupported(why),
-        params: UNSUPPORTED_PARAMS,
-        doc: "substituted by `path` with the same `maxdepth`, with a warning",
-        build: |p, r| {
-            IntegratorSettings::Path(PathSettings {
-                max_depth: max_depth(p, r),
-                ..PathSettings::default()
-            })
-        },
-    }
-}
 
 /// The deepest `maxdepth` pbrs follows: 100 times the depth at which
 /// pbrt-v3's Halton and Sobol samplers run out of dimensions (1000) and
@@ -169,6 +172,22 @@ pub trait Integrate {
     /// Requests the sampler arrays the integrator uses (pbrt-v3's
     /// Preprocess).
     fn prepare_sampler(&mut self, _scene: &RenderScene, _sampler: &mut Sampler) {}
+
+    /// Takes the film's sample bounds, or says why the integrator cannot
+    /// render this scene on it (bdpt's camera importance).
+    fn prepare_film(
+        &mut self,
+        _scene: &RenderScene,
+        _sample_bounds: Bounds2i,
+    ) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// The extra images the integrator splats to (each a [`Splat`] layer
+    /// k > 0) and their file names.
+    fn splat_images(&self) -> Vec<(u32, String)> {
+        Vec::new()
+    }
 
     /// What the integrator built beyond the light distribution.
     fn notes(&self) -> Vec<String> {
@@ -295,6 +314,20 @@ macro_rules! integrators {
                 }
             }
 
+            /// See [`Integrate::prepare_film`].
+            pub fn prepare_film(&mut self, scene: &RenderScene, sample_bounds: Bounds2i) -> Result<(), String> {
+                match self {
+                    $(Integrator::$variant(i) => i.prepare_film(scene, sample_bounds),)*
+                }
+            }
+
+            /// See [`Integrate::splat_images`].
+            pub fn splat_images(&self) -> Vec<(u32, String)> {
+                match self {
+                    $(Integrator::$variant(i) => i.splat_images(),)*
+                }
+            }
+
             /// See [`Integrate::notes`].
             pub fn notes(&self) -> Vec<String> {
                 match self {
@@ -350,6 +383,8 @@ integrators! {
     Whitted(WhittedSettings) => whitted::Whitted,
     AmbientOcclusion(AmbientOcclusionSettings) => ambientocclusion::AmbientOcclusion,
     Sppm(SppmSettings) => sppm::Sppm,
+    Bdpt(BdptSettings) => bdpt::Bdpt,
+    Mlt(MltSettings) => mlt::Mlt,
 }
 
 /// Without an `Integrator` statement: `path` with pbrt-v3's defaults.

@@ -101,7 +101,7 @@ impl PathSettings {
 
 /// `lightsamplestrategy`: an unknown one is a warning, and `spatial` is
 /// used (as pbrt-v3).
-fn light_sample_strategy(p: &ParamValues, r: &mut dyn Report) -> LightSampleStrategy {
+pub(super) fn light_sample_strategy(p: &ParamValues, r: &mut dyn Report) -> LightSampleStrategy {
     match p.string("lightsamplestrategy") {
         "spatial" => LightSampleStrategy::Spatial,
         "uniform" => LightSampleStrategy::Uniform,

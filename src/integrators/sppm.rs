@@ -638,7 +638,7 @@ impl Sppm {
 /// whose BSDF carries radiance's (η_i/η_t)², into importance's (pbrt-v3's
 /// `TransportMode::Importance`): (η_t/η_i)², by the side `wo` is on.
 #[inline]
-fn importance(bsdf: &Bsdf, bs: &crate::materials::BsdfSample, wo: Vec3) -> f32 {
+pub(super) fn importance(bsdf: &Bsdf, bs: &crate::materials::BsdfSample, wo: Vec3) -> f32 {
     if !bs.is_transmission() || bs.flags.intersects(BxdfFlags::DIFFUSE) || bsdf.eta == 1.0 {
         return 1.0;
     }

@@ -94,6 +94,51 @@ pub struct DiffuseLight {
 }
 
 impl DiffuseLight {
+    /// `sample_li` with the sampled point of the light and its normal
+    /// (what a bidirectional method's light vertex needs).
+    #[inline(always)]
+    pub fn sample_li_at(
+        &self,
+        r: &SurfacePoint,
+        u: Vec2,
+        geom: &Aggregate,
+    ) -> Option<(LightSample, Vec3, Vec3)> {
+        let (l, two_sided, area, cache) = (self.l, self.two_sided, self.area, self.tri);
+        let s = match self.shape {
+            AreaShape::Triangle { .. } if cache.n != Vec3::ZERO => {
+                return cache.sample_li(r, u, l, two_sided, area);
+            }
+            AreaShape::Triangle { mesh, tri } => {
+                let s = geom.meshes[mesh as usize].sample_area(tri, u);
+                crate::shapes::to_solid_angle(r.p, s)?
+            }
+            AreaShape::Analytic(i) => {
+                geom.quadrics[i as usize].sample_from(r.p, r.p_error, r.n, u)?
+            }
+        };
+        let d = s.point.p - r.p;
+        if d.length_squared() == 0.0 || s.pdf.is_nan() || s.pdf <= 0.0 {
+            return None;
+        }
+        let wi = d.normalize();
+        let li = if two_sided || s.point.n.dot(-wi) > 0.0 {
+            l
+        } else {
+            Vec3::ZERO
+        };
+        let shadow = spawn_ray_to(r.p, r.p_error, r.n, s.point.p, s.point.p_error, s.point.n);
+        Some((
+            LightSample {
+                li,
+                wi,
+                pdf: s.pdf,
+                shadow,
+            },
+            s.point.p,
+            s.point.n,
+        ))
+    }
+
     /// The light of `shape` (already in `geom`) emitting as `e` says.
     pub fn new(e: DiffuseEmission, shape: AreaShape, geom: &Aggregate) -> DiffuseLight {
         let (area, tri) = match shape {
@@ -164,36 +209,7 @@ impl LightModel for DiffuseLight {
 
     #[inline]
     fn sample_li(&self, r: &SurfacePoint, u: Vec2, geom: &Aggregate) -> Option<LightSample> {
-        let (l, two_sided, area, cache) = (self.l, self.two_sided, self.area, self.tri);
-        let s = match self.shape {
-            AreaShape::Triangle { .. } if cache.n != Vec3::ZERO => {
-                return cache.sample_li(r, u, l, two_sided, area);
-            }
-            AreaShape::Triangle { mesh, tri } => {
-                let s = geom.meshes[mesh as usize].sample_area(tri, u);
-                crate::shapes::to_solid_angle(r.p, s)?
-            }
-            AreaShape::Analytic(i) => {
-                geom.quadrics[i as usize].sample_from(r.p, r.p_error, r.n, u)?
-            }
-        };
-        let d = s.point.p - r.p;
-        if d.length_squared() == 0.0 || s.pdf.is_nan() || s.pdf <= 0.0 {
-            return None;
-        }
-        let wi = d.normalize();
-        let li = if two_sided || s.point.n.dot(-wi) > 0.0 {
-            l
-        } else {
-            Vec3::ZERO
-        };
-        let shadow = spawn_ray_to(r.p, r.p_error, r.n, s.point.p, s.point.p_error, s.point.n);
-        Some(LightSample {
-            li,
-            wi,
-            pdf: s.pdf,
-            shadow,
-        })
+        self.sample_li_at(r, u, geom).map(|(ls, _, _)| ls)
     }
 
     /// pbrt-v3's `Pdf_Li`: the ray is tested against the light's own shape
@@ -211,6 +227,18 @@ impl LightModel for DiffuseLight {
                 geom.quadrics[i as usize].pdf_from(r.p, r.p_error, r.n, ray.d)
             }
         }
+    }
+
+    /// pbrt-v3's: uniform by area on the shape, cosine-weighted about the
+    /// normal (on both sides for a two-sided light).
+    fn pdf_le(&self, d: Vec3, n: Vec3) -> (f32, f32) {
+        let cos = n.dot(d);
+        let pdf_dir = if self.two_sided {
+            0.5 * cosine_hemisphere_pdf(cos.abs())
+        } else {
+            cosine_hemisphere_pdf(cos).max(0.0)
+        };
+        (1.0 / self.area, pdf_dir)
     }
 
     /// pbrt-v3's: a point uniform by area on the shape (`u1`), a direction
@@ -349,7 +377,7 @@ impl TriangleCache {
         l: Vec3,
         two_sided: bool,
         area: f32,
-    ) -> Option<LightSample> {
+    ) -> Option<(LightSample, Vec3, Vec3)> {
         let (_, p, p_error) = sample_triangle_point(self.p, u);
         let d = p - r.p;
         let dist2 = d.length_squared();
@@ -367,12 +395,16 @@ impl TriangleCache {
         } else {
             Vec3::ZERO
         };
-        Some(LightSample {
-            li,
-            wi,
-            pdf,
-            shadow: spawn_ray_to(r.p, r.p_error, r.n, p, p_error, self.n),
-        })
+        Some((
+            LightSample {
+                li,
+                wi,
+                pdf,
+                shadow: spawn_ray_to(r.p, r.p_error, r.n, p, p_error, self.n),
+            },
+            p,
+            self.n,
+        ))
     }
 
     /// Solid-angle density 2t²/|(e1×e2)·d| of area-sampling this triangle

@@ -101,6 +101,13 @@ impl LightModel for DistantLight {
         })
     }
 
+    /// pbrt-v3's: uniform on the disk of the scene's bounding sphere, one
+    /// direction (density 0 for any other).
+    fn pdf_le(&self, _d: Vec3, _n: Vec3) -> (f32, f32) {
+        let r = self.scene_radius;
+        (1.0 / (std::f32::consts::PI * r * r), 0.0)
+    }
+
     /// pbrt-v3's: a ray along the light's direction from a point uniform
     /// on the disk of the scene's bounding sphere facing the light.
     fn sample_le(&self, u1: Vec2, _u2: Vec2, geom: &Aggregate) -> Option<EmittedRay> {

@@ -184,6 +184,13 @@ impl LightModel for InfiniteLight {
         self.map.pdf(ray.d)
     }
 
+    /// pbrt-v3's: the map's density of the direction the ray comes from,
+    /// uniform on the disk of the scene's bounding sphere.
+    fn pdf_le(&self, d: Vec3, _n: Vec3) -> (f32, f32) {
+        let r = self.scene_radius;
+        (1.0 / (std::f32::consts::PI * r * r), self.map.pdf(-d))
+    }
+
     /// pbrt-v3's: a direction as `sample_li` samples it (`u1`), the ray
     /// coming from it through a point uniform on the disk of the scene's
     /// bounding sphere facing it (`u2`).

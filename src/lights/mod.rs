@@ -157,6 +157,12 @@ pub trait LightModel {
     /// a density is 0. Every light kind has its own.
     fn sample_le(&self, u1: Vec2, u2: Vec2, geom: &Aggregate) -> Option<EmittedRay>;
 
+    /// Densities of `sample_le` producing a ray leaving the light in
+    /// direction `d` from a point with normal `n` (pbrt-v3's `Pdf_Le`):
+    /// (by area of the origin, by solid angle of the direction). Every
+    /// light kind has its own.
+    fn pdf_le(&self, d: Vec3, n: Vec3) -> (f32, f32);
+
     /// Solid-angle density of `sample_li` producing direction `wi` from `r`
     /// (pbrt-v3's `Pdf_Li`); 0 when `wi` cannot come from this light.
     #[inline]
@@ -310,6 +316,11 @@ macro_rules! lights {
             #[inline]
             pub fn sample_le(&self, u1: Vec2, u2: Vec2, geom: &Aggregate) -> Option<EmittedRay> {
                 match self { $(Light::$variant(l) => l.sample_le(u1, u2, geom),)* }
+            }
+            /// See [`LightModel::pdf_le`].
+            #[inline]
+            pub fn pdf_le(&self, d: Vec3, n: Vec3) -> (f32, f32) {
+                match self { $(Light::$variant(l) => l.pdf_le(d, n),)* }
             }
             #[inline]
             pub fn pdf_li(&self, r: &SurfacePoint, wi: Vec3, geom: &Aggregate) -> f32 {

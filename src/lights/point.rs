@@ -77,6 +77,11 @@ impl LightModel for PointLight {
         sample_at_point(self.p, r, |_| self.intensity)
     }
 
+    /// pbrt-v3's: no density by area (a point), uniform over the sphere.
+    fn pdf_le(&self, _d: Vec3, _n: Vec3) -> (f32, f32) {
+        (0.0, uniform_sphere_pdf())
+    }
+
     /// pbrt-v3's: a direction uniform over the sphere.
     fn sample_le(&self, u1: Vec2, _u2: Vec2, _geom: &Aggregate) -> Option<EmittedRay> {
         let d = uniform_sample_sphere(u1);

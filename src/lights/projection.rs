@@ -155,6 +155,20 @@ impl LightModel for ProjectionLight {
         sample_at_point(self.p, r, |w| self.intensity * self.projection(w))
     }
 
+    /// pbrt-v3's: no density by area (a point), uniform over the cone
+    /// around the frustum.
+    fn pdf_le(&self, d: Vec3, _n: Vec3) -> (f32, f32) {
+        let inside = d.dot(self.axis) >= self.cos_total_width;
+        (
+            0.0,
+            if inside {
+                uniform_cone_pdf(self.cos_total_width)
+            } else {
+                0.0
+            },
+        )
+    }
+
     /// A direction uniform over the cone around the frustum (directions
     /// outside the frustum carry no intensity). pbrt-v3 samples the cone of
     /// `cos_total_width`, whose tangent is tan(fov/2)·√(1 + 1/aspect²):

@@ -152,6 +152,19 @@ impl LightModel for SpotLight {
         })
     }
 
+    /// pbrt-v3's: no density by area (a point), uniform over the cone.
+    fn pdf_le(&self, d: Vec3, _n: Vec3) -> (f32, f32) {
+        let inside = d.dot(self.frame.n) >= self.cos_total;
+        (
+            0.0,
+            if inside {
+                uniform_cone_pdf(self.cos_total)
+            } else {
+                0.0
+            },
+        )
+    }
+
     /// pbrt-v3's: a direction uniform over the cone of `coneangle`.
     fn sample_le(&self, u1: Vec2, _u2: Vec2, _geom: &Aggregate) -> Option<EmittedRay> {
         let local = uniform_sample_cone(u1, self.cos_total);

@@ -774,6 +774,22 @@ impl<'s, 'c> Builder<'s, 'c> {
                 }
             }
         }
+        if let (
+            crate::integrators::IntegratorSettings::Bdpt(_)
+            | crate::integrators::IntegratorSettings::Mlt(_),
+            Some((name, _)),
+        ) = (&integrator, ent(self.integrator))
+        {
+            // pbrt-v3's bdpt and mlt ask the camera for its importance
+            // (We), which only the perspective camera has.
+            if !matches!(
+                camera.projection,
+                crate::cameras::Projection::Perspective(_)
+            ) {
+                let kind = integrator.name();
+                self.ctx.error(name.loc, format!("the \"{kind}\" integrator needs the camera's importance (We), which only the \"perspective\" camera has (as in pbrt-v3): the \"{}\" camera cannot be used with {kind}", camera.projection.kind_name()), "needs a perspective camera", None);
+            }
+        }
         if let Some(loc) = self.first_medium_interface {
             // pbrt-v3's warning for integrators without volume scattering.
             let name = (!integrator.renders_media()).then(|| integrator.name());

@@ -98,6 +98,7 @@ impl Renderer {
         let scene = RenderScene::new(desc);
         let mut integrator = Integrator::new(&desc.integrator, &scene, opts.scalar);
         let film = Film::new(&desc.film, &desc.filter);
+        integrator.prepare_film(&scene, film.sample_bounds())?;
         let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
         integrator.prepare_sampler(&scene, &mut sampler);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -161,10 +162,13 @@ impl Renderer {
         region: Option<Bounds2i>,
         on_chunk: &mut dyn FnMut(&ChunkDone),
     ) {
-        if let Integrator::Sppm(_) = self.integrator {
-            return self.render_sppm(on_chunk);
+        match self.integrator {
+            Integrator::Sppm(_) => return self.render_sppm(on_chunk),
+            Integrator::Mlt(_) => return self.render_mlt(on_chunk),
+            _ => {}
         }
         let t1 = Instant::now();
+        self.film.add_splat_samples(samples.len() as u64);
         let mut tiles = self.film.tiles(16);
         if let Some(r) = region {
             tiles.retain(|t| {
@@ -307,6 +311,54 @@ impl Renderer {
         self.stats.render_time += t1.elapsed();
     }
 
+    /// `mlt`'s own loop: bootstrap paths, then the Markov chains in groups
+    /// whose splats are added to the film in chain order (`on_chunk` is
+    /// called with the groups). The range of samples and the region of the
+    /// other integrators do not apply.
+    fn render_mlt(&mut self, on_chunk: &mut dyn FnMut(&ChunkDone)) {
+        let Integrator::Mlt(mlt) = &self.integrator else {
+            return;
+        };
+        let t1 = Instant::now();
+        let run = crate::integrators::MltRun {
+            scene: &self.scene,
+            seed: self.seed,
+            pool: &self.pool,
+        };
+        let whole = [self.film.pixel_bounds()];
+        let done = mlt.render(&run, &mut self.film, &mut |k, total, film| {
+            on_chunk(&ChunkDone {
+                done: k,
+                total,
+                tiles: &whole,
+                film,
+            })
+        });
+        self.scene.notes.push(format!(
+            "mlt: b = {:.6} from {} bootstrap paths; {} mutations, {:.1}% accepted",
+            done.b,
+            done.bootstrap_paths,
+            done.mutations,
+            100.0 * done.accepted as f64 / done.mutations.max(1) as f64
+        ));
+        self.stats.rays.add(&done.rays);
+        self.stats.samples += done.mutations;
+        self.stats.render_time += t1.elapsed();
+    }
+
+    /// Writes the integrator's extra splat images (bdpt's strategy
+    /// images) next to the output image; returns the paths written.
+    pub fn write_splat_images(&self) -> Result<Vec<std::path::PathBuf>, String> {
+        let dir = self.output.parent().unwrap_or(std::path::Path::new(""));
+        let mut written = Vec::new();
+        for (layer, name) in self.integrator.splat_images() {
+            let path = dir.join(name);
+            crate::image::io::write_image(&path, &self.film.layer_image(layer))?;
+            written.push(path);
+        }
+        Ok(written)
+    }
+
     /// The sampler's samples per pixel.
     pub fn samples_per_pixel(&self) -> u32 {
         self.sampler.samples_per_pixel()
@@ -325,18 +377,23 @@ impl Renderer {
     pub fn stats(&self) -> RenderStats {
         let mut stats = self.stats.clone();
         stats.notes = self.scene.notes.clone();
-        stats.notes.push(if self.batch > 1 {
-            format!(
-                "batched: {} samples in flight per thread ({:.1} KiB of lane state per thread)",
-                self.batch,
-                self.integrator
-                    .batch(self.batch, &self.sampler)
-                    .state_bytes() as f64
-                    / 1024.0
-            )
-        } else {
-            "one sample at a time per thread (scalar loop)".to_string()
-        });
+        stats.notes.push(
+            if let Integrator::Sppm(_) | Integrator::Mlt(_) = self.integrator {
+                "the integrator's own render loop over the whole film (not tiles of samples)"
+                    .to_string()
+            } else if self.batch > 1 {
+                format!(
+                    "batched: {} samples in flight per thread ({:.1} KiB of lane state per thread)",
+                    self.batch,
+                    self.integrator
+                        .batch(self.batch, &self.sampler)
+                        .state_bytes() as f64
+                        / 1024.0
+                )
+            } else {
+                "one sample at a time per thread (scalar loop)".to_string()
+            },
+        );
         stats.notes.extend(self.integrator.notes());
         if let Some(ls) = self.integrator.light_sampler() {
             stats.notes.push(format!(
@@ -383,7 +440,20 @@ pub fn render_observed(
     let mut r = Renderer::new(desc, opts)?;
     let spp = r.sampler.samples_per_pixel();
     r.render_samples_observed(0..spp, on_chunk);
-    Ok((r.image(), r.stats()))
+    let mut stats = r.stats();
+    match r.write_splat_images() {
+        Ok(paths) if !paths.is_empty() => stats.notes.push(format!(
+            "{} strategy images written next to the output image ({} … {})",
+            paths.len(),
+            paths[0].display(),
+            paths[paths.len() - 1].display()
+        )),
+        Ok(_) => {}
+        Err(e) => stats
+            .notes
+            .push(format!("the strategy images were not written: {e}")),
+    }
+    Ok((r.image(), stats))
 }
 
 /// Renders part `kind` of the frame `desc` describes (a tile or a range of
@@ -401,9 +471,19 @@ pub fn render_part(
             "{kind}: sppm's iterations depend on each other (each shrinks the radii the next uses), so a frame cannot be split into parts; render it whole"
         ));
     }
+    if let Integrator::Mlt(_) = r.integrator {
+        return Err(format!(
+            "{kind}: mlt's Markov chains splat anywhere in the image and its normalisation comes from the whole frame's bootstrap paths, so a frame cannot be split into tiles or sample ranges; render it whole"
+        ));
+    }
     let spp = r.samples_per_pixel();
     let header = PartHeader::new(desc, r.film(), opts.seed, kind);
     match kind {
+        PartKind::Tile { .. } if matches!(r.integrator, Integrator::Bdpt(_)) => {
+            return Err(format!(
+                "{kind}: bdpt's light-tracing splats land anywhere in the image, so one tile needs every pixel's samples; split the frame by samples instead (--spp-range)"
+            ));
+        }
         PartKind::Tile { index, count } => {
             part::check_tile(r.film(), index, count)?;
             let rect = part::tile_rect(r.film().pixel_bounds(), index, count);
@@ -463,6 +543,7 @@ fn render_tile(
         }
     }
     c.rays = scratch.counts();
+    tile.set_splats(scratch.take_splats());
     (tile, c)
 }
 
@@ -621,6 +702,7 @@ fn render_tile_batched(
         }
     }
     c.rays = scratch.counts();
+    tile.set_splats(scratch.take_splats());
     (tile, c)
 }
 
@@ -656,10 +738,16 @@ fn check_film_memory(desc: &SceneDescription) -> Result<(), String> {
     let h = ((f.yresolution as f64 * y1 as f64).ceil() - (f.yresolution as f64 * y0 as f64).ceil())
         .max(0.0) as u64;
     // sppm keeps each pixel's state and visible point besides the film.
+    // bdpt's splats: one f64 RGB sum per pixel, and one per strategy
+    // image when they are written.
     let per_pixel = match desc.integrator {
         crate::integrators::IntegratorSettings::Sppm(_) => {
             BYTES_PER_PIXEL + crate::integrators::SPPM_PIXEL_BYTES
         }
+        crate::integrators::IntegratorSettings::Bdpt(b) => {
+            BYTES_PER_PIXEL + 24 * (1 + b.strategy_images().len() as u64)
+        }
+        crate::integrators::IntegratorSettings::Mlt(_) => BYTES_PER_PIXEL + 24,
         _ => BYTES_PER_PIXEL,
     };
     let need = w * h * per_pixel;

@@ -14,6 +14,7 @@
 pub mod halton;
 pub mod lowdiscrepancy;
 pub mod maxmindist;
+pub mod mlt;
 pub mod pixel;
 pub mod random;
 pub mod sobol;
@@ -22,6 +23,7 @@ pub mod stratified;
 pub mod zerotwosequence;
 
 pub use halton::HaltonSampler;
+pub use mlt::MltSampler;
 pub use pixel::PixelSampler;
 pub use random::RandomSampler;
 pub use sobol::SobolSampler;
@@ -91,6 +93,8 @@ pub enum Sampler {
     Sobol(SobolSampler),
     ZeroTwoSequence(PixelSampler),
     MaxMinDist(PixelSampler),
+    /// The `mlt` integrator's primary sample space (no `Sampler` kind).
+    Mlt(MltSampler),
 }
 
 macro_rules! dispatch {
@@ -102,6 +106,7 @@ macro_rules! dispatch {
             Sampler::Sobol($s) => $e,
             Sampler::ZeroTwoSequence($s) => $e,
             Sampler::MaxMinDist($s) => $e,
+            Sampler::Mlt($s) => $e,
         }
     };
 }

@@ -13,6 +13,7 @@ pub use crate::filters::Filter;
 
 use crate::geometry::Bounds2i;
 use crate::image::Image;
+use crate::integrators::Splat;
 use crate::scene::FilmDesc;
 use glam::{DVec3, IVec2, Vec2, Vec3};
 
@@ -56,6 +57,19 @@ pub struct Film {
     scale: f32,
     max_sample_luminance: f32,
     pixels: Vec<PixelSums>,
+    /// Σ splatted radiance per pixel (pbrt-v3's `splatXYZ`, in RGB and
+    /// f64); empty until a splat arrives, so images without splats are
+    /// what they were.
+    splats: Vec<[f64; 3]>,
+    /// The extra splat images (layer k > 0 of [`Splat`] is `layers[k − 1]`),
+    /// each empty until a splat arrives.
+    layers: Vec<Vec<[f64; 3]>>,
+    /// Samples per pixel rendered so far: splats are scaled by its inverse
+    /// (pbrt-v3's `splatScale` 1/spp).
+    splat_spp: u64,
+    /// The splats' scale when an integrator sets it (`mlt`: b over the
+    /// mutations per pixel) instead of 1/spp.
+    splat_scale_set: Option<f64>,
 }
 
 impl Film {
@@ -99,6 +113,10 @@ impl Film {
             scale: film.scale,
             max_sample_luminance,
             pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
+            splats: Vec::new(),
+            layers: Vec::new(),
+            splat_spp: 0,
+            splat_scale_set: None,
         }
     }
 
@@ -165,6 +183,9 @@ impl Film {
     /// Adds a tile's sums into the film (plain additions: merge tiles in a
     /// fixed order for bit-identical images).
     pub fn merge_tile(&mut self, tile: FilmTile) {
+        for sp in &tile.splats {
+            self.add_splat(sp);
+        }
         let fw = self.pixel_bounds.width() as usize;
         let tw = tile.pixel_bounds.width() as usize;
         if tw == 0 {
@@ -182,6 +203,76 @@ impl Film {
                 d.weight += s.weight;
             }
         }
+    }
+
+    /// Adds a splat to the pixel its position is in (pbrt-v3's
+    /// `Film::AddSplat`: NaN, negative and infinite values are dropped,
+    /// bright ones scaled down to `maxsampleluminance`), in f64.
+    pub fn add_splat(&mut self, sp: &Splat) {
+        let mut v = sp.l;
+        let y = luminance(v);
+        if v.is_nan() || y < 0.0 || y.is_infinite() {
+            return;
+        }
+        let pi = sp.p_film.floor().as_ivec2();
+        let b = self.pixel_bounds;
+        if !(pi.x >= b.min.x && pi.x < b.max.x && pi.y >= b.min.y && pi.y < b.max.y) {
+            return;
+        }
+        if y > self.max_sample_luminance {
+            v *= self.max_sample_luminance / y;
+        }
+        let n = self.pixels.len();
+        let buf = if sp.layer == 0 {
+            &mut self.splats
+        } else {
+            let k = sp.layer as usize - 1;
+            if self.layers.len() <= k {
+                self.layers.resize_with(k + 1, Vec::new);
+            }
+            &mut self.layers[k]
+        };
+        if buf.is_empty() {
+            buf.resize(n, [0.0; 3]);
+        }
+        let o = pi - b.min;
+        let d = &mut buf[(o.y * b.width() + o.x) as usize];
+        d[0] += v.x as f64;
+        d[1] += v.y as f64;
+        d[2] += v.z as f64;
+    }
+
+    /// Counts `n` more samples per pixel for the splats' scale.
+    pub fn add_splat_samples(&mut self, n: u64) {
+        self.splat_spp += n;
+    }
+
+    /// Samples per pixel the splats are divided by.
+    pub fn splat_samples(&self) -> u64 {
+        self.splat_spp
+    }
+
+    /// Σ splatted radiance per pixel (row order over the pixel bounds);
+    /// empty if nothing was splatted.
+    pub fn splat_sums(&self) -> &[[f64; 3]] {
+        &self.splats
+    }
+
+    /// Extra splat image `layer` (≥ 1) as pbrt-v3 writes bdpt's strategy
+    /// images: the splats over the spp, scale 1.
+    pub fn layer_image(&self, layer: u32) -> Image {
+        let w = self.pixel_bounds.width().max(0) as u32;
+        let h = self.pixel_bounds.height().max(0) as u32;
+        let mut img = Image::new(w, h);
+        let inv = 1.0 / self.splat_spp.max(1) as f64;
+        if let Some(buf) = self.layers.get(layer.saturating_sub(1) as usize) {
+            for (d, s) in img.data.chunks_exact_mut(3).zip(buf) {
+                for c in 0..3 {
+                    d[c] = (s[c] * inv) as f32;
+                }
+            }
+        }
+        img
     }
 
     /// Sums of a pixel inside the pixel bounds.
@@ -205,6 +296,22 @@ impl Film {
     /// Resets all sums to zero.
     pub fn clear(&mut self) {
         self.pixels.fill(PixelSums::default());
+        self.splats.clear();
+        self.layers.clear();
+        self.splat_spp = 0;
+        self.splat_scale_set = None;
+    }
+
+    /// Sets the scale of the splats (pbrt-v3's `WriteImage(splatScale)`),
+    /// in place of 1/spp.
+    pub fn set_splat_scale(&mut self, scale: f64) {
+        self.splat_scale_set = Some(scale);
+    }
+
+    /// The splat scale: 1/spp (pbrt-v3's `splatScale`).
+    fn splat_scale(&self) -> f64 {
+        self.splat_scale_set
+            .unwrap_or(1.0 / self.splat_spp.max(1) as f64)
     }
 
     /// The image over the pixel bounds: `max(0, Σ wL / Σ w) × scale` per
@@ -214,8 +321,15 @@ impl Film {
         let h = self.pixel_bounds.height() as u32;
         let mut data = Vec::with_capacity(self.pixels.len() * 3);
         let scale = self.scale as f64;
-        for p in &self.pixels {
-            data.extend(pixel_rgb(p, scale));
+        if self.splats.is_empty() {
+            for p in &self.pixels {
+                data.extend(pixel_rgb(p, scale));
+            }
+        } else {
+            let ss = self.splat_scale();
+            for (p, sp) in self.pixels.iter().zip(&self.splats) {
+                data.extend(pixel_rgb_splat(p, sp, ss, scale));
+            }
         }
         Image {
             width: w,
@@ -238,8 +352,12 @@ impl Film {
         for y in r.min.y..r.min.y + h {
             let row = ((y - self.pixel_bounds.min.y) * fw - self.pixel_bounds.min.x) as isize;
             for x in r.min.x..r.min.x + w {
-                let p = &self.pixels[(row + x as isize) as usize];
-                data.extend(pixel_rgb(p, scale));
+                let i = (row + x as isize) as usize;
+                let p = &self.pixels[i];
+                match self.splats.get(i) {
+                    Some(sp) => data.extend(pixel_rgb_splat(p, sp, self.splat_scale(), scale)),
+                    None => data.extend(pixel_rgb(p, scale)),
+                }
             }
         }
         (r, data)
@@ -255,6 +373,28 @@ pub(crate) fn pixel_rgb(p: &PixelSums, scale: f64) -> [f32; 3] {
     } else {
         [0.0; 3]
     }
+}
+
+/// One pixel's value with its splats (pbrt-v3's `WriteImage`):
+/// `(max(0, Σ wL / Σ w) + splat · splat_scale) × scale`.
+#[inline]
+pub(crate) fn pixel_rgb_splat(
+    p: &PixelSums,
+    splat: &[f64; 3],
+    splat_scale: f64,
+    scale: f64,
+) -> [f32; 3] {
+    let inv = if p.weight != 0.0 { 1.0 / p.weight } else { 0.0 };
+    let mut out = [0.0f32; 3];
+    for c in 0..3 {
+        let filtered = if p.weight != 0.0 {
+            (p.contrib[c] * inv).max(0.0)
+        } else {
+            0.0
+        };
+        out[c] = ((filtered + splat[c] * splat_scale) * scale) as f32;
+    }
+    out
 }
 
 /// Makes film tiles: [`Film::tile`] without a borrow of the film.
@@ -289,6 +429,7 @@ impl TileMaker {
             uniform_weight: self.uniform_weight,
             max_sample_luminance: self.max_sample_luminance,
             pixels: vec![PixelSums::default(); pixel_bounds.area().max(0) as usize],
+            splats: Vec::new(),
         }
     }
 }
@@ -304,6 +445,8 @@ pub struct FilmTile {
     uniform_weight: Option<f32>,
     max_sample_luminance: f32,
     pixels: Vec<PixelSums>,
+    /// The tile's splats in sample order (they land anywhere on the film).
+    splats: Vec<Splat>,
 }
 
 /// The value of a filter table whose entries are all equal (bit for bit).
@@ -322,6 +465,12 @@ const MAX_CACHED_FOOTPRINT: usize = 32;
 impl FilmTile {
     pub fn pixel_bounds(&self) -> Bounds2i {
         self.pixel_bounds
+    }
+
+    /// Gives the tile its samples' splats (in sample order), which
+    /// [`Film::merge_tile`] adds to the film.
+    pub fn set_splats(&mut self, splats: Vec<Splat>) {
+        self.splats = splats;
     }
 
     /// Splats radiance `l` seen through raster position `p_film` onto the

@@ -17,9 +17,13 @@
 //!   bit pattern as two UINT channels (`<sum>.hi`, `<sum>.lo`, the high and
 //!   low 32 bits), for R, G, B and the weight. Merging adds the parts' sums
 //!   in f64 in the order of A and divides; the full render adds the same
-//!   terms in another order (see [`merge`] for the bound).
+//!   terms in another order (see [`merge`] for the bound). A film with
+//!   splats (bdpt's light tracing) also stores its f64 splat sums
+//!   (`splat.R.hi`, ... `splat.B.lo`), added the same way and divided by
+//!   the spp. bdpt refuses tiles: its splats from any pixel reach every
+//!   tile.
 
-use super::{pixel_rgb, Film, Image, PixelSums};
+use super::{pixel_rgb, pixel_rgb_splat, Film, Image, PixelSums};
 use crate::geometry::Bounds2i;
 use crate::scene::SceneDescription;
 use glam::{IVec2, Vec2};
@@ -238,6 +242,9 @@ pub struct Part {
     /// The data window (image pixel coordinates, exclusive max).
     pub window: Bounds2i,
     pub data: PartData,
+    /// A sample range's splat sums over the window (bdpt's light
+    /// tracing), if it has any.
+    pub splats: Option<Vec<[f64; 3]>>,
 }
 
 #[derive(Clone, Debug)]
@@ -249,6 +256,30 @@ pub enum PartData {
 }
 
 const SUM_CHANNELS: [&str; 4] = ["R", "G", "B", "W"];
+
+/// The channels of a sample range's splat sums (present only when the
+/// film has splats).
+const SPLAT_CHANNELS: [&str; 3] = ["splat.R", "splat.G", "splat.B"];
+
+/// `v`'s f64 bit patterns as the two UINT channels `<name>.hi`, `.lo`.
+fn f64_channels(
+    name: &str,
+    v: impl Iterator<Item = f64>,
+    out: &mut Vec<exr::prelude::AnyChannel<exr::prelude::FlatSamples>>,
+) {
+    use exr::prelude::{AnyChannel, FlatSamples};
+    let bits: Vec<u64> = v.map(f64::to_bits).collect();
+    let hi = bits.iter().map(|b| (b >> 32) as u32).collect();
+    let lo = bits.iter().map(|&b| b as u32).collect();
+    out.push(AnyChannel::new(
+        format!("{name}.hi").as_str(),
+        FlatSamples::U32(hi),
+    ));
+    out.push(AnyChannel::new(
+        format!("{name}.lo").as_str(),
+        FlatSamples::U32(lo),
+    ));
+}
 
 fn exr_bounds(b: Bounds2i) -> exr::meta::attribute::IntegerBounds {
     exr::meta::attribute::IntegerBounds::new(
@@ -312,25 +343,20 @@ pub fn write_tile_part(path: &Path, header: &PartHeader, film: &Film) -> Result<
 /// Writes the sums of every pixel of `film` as part `header.kind`
 /// (samples A..B) to `path`, atomically.
 pub fn write_samples_part(path: &Path, header: &PartHeader, film: &Film) -> Result<(), String> {
-    use exr::prelude::{AnyChannel, FlatSamples};
     let pb = film.pixel_bounds();
     let sums: Vec<PixelSums> = pb.iter().map(|p| film.pixel_sums(p)).collect();
     let mut channels = Vec::with_capacity(8);
     for (c, name) in SUM_CHANNELS.iter().enumerate() {
-        let bits: Vec<u64> = sums
+        let v = sums
             .iter()
-            .map(|s| if c < 3 { s.contrib[c] } else { s.weight }.to_bits())
-            .collect();
-        let hi = bits.iter().map(|b| (b >> 32) as u32).collect();
-        let lo = bits.iter().map(|&b| b as u32).collect();
-        channels.push(AnyChannel::new(
-            format!("{name}.hi").as_str(),
-            FlatSamples::U32(hi),
-        ));
-        channels.push(AnyChannel::new(
-            format!("{name}.lo").as_str(),
-            FlatSamples::U32(lo),
-        ));
+            .map(|s| if c < 3 { s.contrib[c] } else { s.weight });
+        f64_channels(name, v, &mut channels);
+    }
+    let splats = film.splat_sums();
+    if !splats.is_empty() {
+        for (c, name) in SPLAT_CHANNELS.iter().enumerate() {
+            f64_channels(name, splats.iter().map(|s| s[c]), &mut channels);
+        }
     }
     let bytes =
         encode_part(header, pb, pb, channels).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -440,11 +466,34 @@ pub fn read_part(path: &Path) -> Result<Part, String> {
             PartData::Sums(sums)
         }
     };
+    let has_splats = layer
+        .channel_data
+        .list
+        .iter()
+        .any(|c| c.name.to_string() == format!("{}.hi", SPLAT_CHANNELS[0]));
+    let splats = if has_splats && matches!(header.kind, PartKind::Samples { .. }) {
+        let mut v = vec![[0.0f64; 3]; n];
+        for (c, name) in SPLAT_CHANNELS.iter().enumerate() {
+            let (FlatSamples::U32(hi), FlatSamples::U32(lo)) = (
+                channel(&format!("{name}.hi"))?,
+                channel(&format!("{name}.lo"))?,
+            ) else {
+                return Err(fail(format!("channels {name}.hi/.lo are not UINT")));
+            };
+            for (i, s) in v.iter_mut().enumerate() {
+                s[c] = f64::from_bits(((hi[i] as u64) << 32) | lo[i] as u64);
+            }
+        }
+        Some(v)
+    } else {
+        None
+    };
     Ok(Part {
         path: path.to_path_buf(),
         header,
         window,
         data,
+        splats,
     })
 }
 
@@ -689,9 +738,31 @@ fn merge_samples(
             d.weight += s.weight;
         }
     }
+    // Splats (bdpt's light tracing) are added in the same order and
+    // divided by the spp, as the film does.
+    let mut splats: Vec<[f64; 3]> = Vec::new();
+    for &(_, _, p) in &order {
+        if let Some(sp) = &p.splats {
+            if splats.is_empty() {
+                splats = vec![[0.0; 3]; sums.len()];
+            }
+            for (d, s) in splats.iter_mut().zip(sp) {
+                for c in 0..3 {
+                    d[c] += s[c];
+                }
+            }
+        }
+    }
     let scale = scale as f64;
-    for (i, s) in sums.iter().enumerate() {
-        img.data[3 * i..3 * i + 3].copy_from_slice(&pixel_rgb(s, scale));
+    if splats.is_empty() {
+        for (i, s) in sums.iter().enumerate() {
+            img.data[3 * i..3 * i + 3].copy_from_slice(&pixel_rgb(s, scale));
+        }
+    } else {
+        let ss = 1.0 / spp as f64;
+        for (i, (s, sp)) in sums.iter().zip(&splats).enumerate() {
+            img.data[3 * i..3 * i + 3].copy_from_slice(&pixel_rgb_splat(s, sp, ss, scale));
+        }
     }
     Ok(())
 }

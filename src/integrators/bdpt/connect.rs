@@ -1,0 +1,283 @@
+//! Connecting a light subpath's first s vertices to a camera subpath's
+//! first t (pbrt-v3's `ConnectBDPT`), and the power-heuristic weight of
+//! that strategy against every other that could have made the same path
+//! (pbrt-v3's `MISWeight`, with its remapping of delta densities to 1).
+
+use super::vertex::{Kind, Mode, Vertex};
+use super::Ctx;
+use crate::geometry::{spawn_ray_to, Ray};
+use crate::integrators::volpath::transmittance;
+use crate::integrators::Scratch;
+use crate::lights::Light;
+use crate::samplers::Sampler;
+use glam::{Vec2, Vec3};
+
+/// What one strategy gives: its weighted contribution, its MIS weight and,
+/// for t = 1, where on the film it lands.
+pub(crate) struct Strategy {
+    pub l: Vec3,
+    pub weight: f32,
+    pub p_raster: Option<Vec2>,
+}
+
+/// Transmittance between two vertices (pbrt-v3's `VisibilityTester::Tr`):
+/// 0 if a surface is in the way, else that of the media crossed.
+fn tr(c: &Ctx, a: &Vertex, b: &Vertex, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
+    let ray = spawn_ray_to(a.p, a.p_error, a.n, b.p, b.p_error, b.n);
+    let medium = if c.scene.media.is_empty() {
+        None
+    } else {
+        a.medium_towards(b.p - a.p)
+    };
+    transmittance(c.scene, &ray, a.time, medium, sampler, scratch)
+}
+
+/// pbrt-v3's `G`: the geometry term between two vertices, with their
+/// transmittance.
+fn g(c: &Ctx, v0: &Vertex, v1: &Vertex, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
+    let d = v0.p - v1.p;
+    let mut g = 1.0 / d.length_squared();
+    let d = d * g.sqrt();
+    if v0.on_surface() {
+        g *= v0.ns.dot(d).abs();
+    }
+    if v1.on_surface() {
+        g *= v1.ns.dot(d).abs();
+    }
+    g * tr(c, v0, v1, sampler, scratch)
+}
+
+/// Strategy (s, t) over the subpaths `light` and `camera`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn connect<'a>(
+    c: &Ctx<'a>,
+    light: &mut [Vertex<'a>],
+    camera: &mut [Vertex<'a>],
+    s: usize,
+    t: usize,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Strategy {
+    let none = Strategy {
+        l: Vec3::ZERO,
+        weight: 0.0,
+        p_raster: None,
+    };
+    if t > 1 && s != 0 && camera[t - 1].kind == Kind::Light {
+        return none;
+    }
+    let mut sampled: Option<Vertex<'a>> = None;
+    let mut p_raster = None;
+    let mut l = Vec3::ZERO;
+    if s == 0 {
+        let pt = &camera[t - 1];
+        if pt.is_light() {
+            l = pt.le(c, &camera[t - 2]) * pt.beta;
+        }
+    } else if t == 1 {
+        let qs = &light[s - 1];
+        if qs.is_connectible(c) {
+            let u = sampler.get_2d();
+            if let Some(is) = c.camera.sample_wi(qs.p, u, qs.time) {
+                p_raster = Some(is.p_raster);
+                if is.pdf > 0.0 && is.we != Vec3::ZERO {
+                    let v = Vertex::at(
+                        Kind::Camera,
+                        is.p_lens,
+                        is.n,
+                        is.we / is.pdf,
+                        qs.time,
+                        c.camera_medium,
+                    );
+                    l = qs.beta * qs.f(&v, Mode::Importance) * v.beta;
+                    if qs.on_surface() {
+                        l *= is.wi.dot(qs.ns).abs();
+                    }
+                    if l != Vec3::ZERO {
+                        l *= tr(c, qs, &v, sampler, scratch);
+                    }
+                    sampled = Some(v);
+                }
+            }
+        }
+    } else if s == 1 {
+        let pt = &camera[t - 1];
+        if pt.is_connectible(c) {
+            let u = sampler.get_1d();
+            let chosen = c.lights.sample(
+                c.p_camera,
+                Vec3::ZERO,
+                u,
+                &c.scene.lights,
+                &c.scene.aggregate,
+            );
+            let u2 = sampler.get_2d();
+            if let Some((i, pmf)) = chosen {
+                if let Some((v, shadow, wi)) = light_vertex(c, pt, i, pmf, u2) {
+                    l = pt.beta * pt.f(&v, Mode::Radiance) * v.beta;
+                    if pt.on_surface() {
+                        l *= wi.dot(pt.ns).abs();
+                    }
+                    if l != Vec3::ZERO {
+                        let medium = pt.medium_towards(wi);
+                        l *= transmittance(c.scene, &shadow, pt.time, medium, sampler, scratch);
+                    }
+                    sampled = Some(v);
+                }
+            }
+        }
+    } else {
+        let (qs, pt) = (&light[s - 1], &camera[t - 1]);
+        if qs.is_connectible(c) && pt.is_connectible(c) {
+            l = qs.beta * qs.f(pt, Mode::Importance) * pt.f(qs, Mode::Radiance) * pt.beta;
+            if l != Vec3::ZERO {
+                l *= g(c, qs, pt, sampler, scratch);
+            }
+        }
+    }
+    let weight = if l == Vec3::ZERO {
+        0.0
+    } else {
+        mis_weight(c, light, camera, sampled, s, t)
+    };
+    Strategy {
+        l: l * weight,
+        weight,
+        p_raster,
+    }
+}
+
+/// The light vertex of the s = 1 strategy: light `i` (chosen with
+/// probability `pmf`) sampled from `pt` (pbrt-v3's `Sample_Li`), with its
+/// density of origin; its shadow ray and direction.
+fn light_vertex<'a>(
+    c: &Ctx<'a>,
+    pt: &Vertex<'a>,
+    i: u32,
+    pmf: f32,
+    u: Vec2,
+) -> Option<(Vertex<'a>, Ray, Vec3)> {
+    let light = &c.scene.lights[i as usize];
+    let r = crate::shapes::SurfacePoint {
+        p: pt.p,
+        p_error: pt.p_error,
+        n: pt.n,
+        ns: pt.ns,
+    };
+    let (ls, p, n) = match light {
+        Light::Diffuse(d) => d.sample_li_at(&r, u, &c.scene.aggregate)?,
+        _ => {
+            let ls = light.sample_li(&r, u, &c.scene.aggregate)?;
+            let p = if ls.shadow.t_max.is_finite() {
+                ls.shadow.o + ls.shadow.d
+            } else {
+                pt.p + ls.wi
+            };
+            (ls, p, Vec3::ZERO)
+        }
+    };
+    if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
+        return None;
+    }
+    let mut v = Vertex::at(Kind::Light, p, n, ls.li / (ls.pdf * pmf), pt.time, None);
+    v.light = Some(i);
+    v.pdf_fwd = v.pdf_light_origin(c, pt);
+    Some((v, ls.shadow, ls.wi))
+}
+
+/// pbrt-v3's `MISWeight`: the subpaths' reverse densities are set for
+/// this strategy (and the sampled endpoint put in place), the ratios of
+/// every other strategy's density to this one's summed, and the subpaths
+/// restored.
+fn mis_weight<'a>(
+    c: &Ctx<'a>,
+    light: &mut [Vertex<'a>],
+    camera: &mut [Vertex<'a>],
+    sampled: Option<Vertex<'a>>,
+    s: usize,
+    t: usize,
+) -> f32 {
+    if s + t == 2 {
+        return 1.0;
+    }
+    // The sampled endpoint replaces the subpath's.
+    let mut swapped = None;
+    if let Some(v) = sampled {
+        let slot = if s == 1 {
+            &mut light[0]
+        } else {
+            &mut camera[0]
+        };
+        swapped = Some(std::mem::replace(slot, v));
+    }
+    // The new reverse densities, computed before any is set.
+    let (qs, pt) = (s.checked_sub(1), t - 1);
+    let (qs_m, pt_m) = (s.checked_sub(2), t.checked_sub(2));
+    let pt_rev = match qs {
+        Some(q) => light[q].pdf(c, qs_m.map(|i| &light[i]), &camera[pt]),
+        None => camera[pt].pdf_light_origin(c, &camera[pt_m.unwrap_or(0)]),
+    };
+    let pt_m_rev = pt_m.map(|m| match qs {
+        Some(q) => camera[pt].pdf(c, Some(&light[q]), &camera[m]),
+        None => camera[pt].pdf_light(c, &camera[m]),
+    });
+    let qs_rev = qs.map(|q| camera[pt].pdf(c, pt_m.map(|i| &camera[i]), &light[q]));
+    let qs_m_rev = qs_m.map(|m| light[m + 1].pdf(c, Some(&camera[pt]), &light[m]));
+    // Set them (and clear the endpoints' delta flags), keeping the old.
+    let saved_pt = (camera[pt].pdf_rev, camera[pt].delta);
+    camera[pt].pdf_rev = pt_rev;
+    camera[pt].delta = false;
+    let saved_pt_m =
+        pt_m.map(|m| std::mem::replace(&mut camera[m].pdf_rev, pt_m_rev.unwrap_or(0.0)));
+    let saved_qs = qs.map(|q| {
+        let old = (light[q].pdf_rev, light[q].delta);
+        light[q].pdf_rev = qs_rev.unwrap_or(0.0);
+        light[q].delta = false;
+        old
+    });
+    let saved_qs_m =
+        qs_m.map(|m| std::mem::replace(&mut light[m].pdf_rev, qs_m_rev.unwrap_or(0.0)));
+
+    let remap0 = |f: f32| if f != 0.0 { f } else { 1.0 };
+    let mut sum_ri = 0.0f32;
+    let mut ri = 1.0f32;
+    for i in (1..t).rev() {
+        ri *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
+        if !camera[i].delta && !camera[i - 1].delta {
+            sum_ri += ri;
+        }
+    }
+    ri = 1.0;
+    for i in (0..s).rev() {
+        ri *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
+        let delta_light = if i > 0 {
+            light[i - 1].delta
+        } else {
+            light[0].is_delta_light(c)
+        };
+        if !light[i].delta && !delta_light {
+            sum_ri += ri;
+        }
+    }
+
+    // Restore.
+    (camera[pt].pdf_rev, camera[pt].delta) = saved_pt;
+    if let (Some(m), Some(v)) = (pt_m, saved_pt_m) {
+        camera[m].pdf_rev = v;
+    }
+    if let (Some(q), Some((r, d))) = (qs, saved_qs) {
+        light[q].pdf_rev = r;
+        light[q].delta = d;
+    }
+    if let (Some(m), Some(v)) = (qs_m, saved_qs_m) {
+        light[m].pdf_rev = v;
+    }
+    if let Some(old) = swapped {
+        if s == 1 {
+            light[0] = old;
+        } else {
+            camera[0] = old;
+        }
+    }
+    1.0 / (1.0 + sum_ri)
+}
