@@ -8,6 +8,7 @@ use crate::image::compare::compare;
 use crate::image::io::{read_image, write_atomic};
 use crate::loader::{load_scene, print_diagnostics};
 use crate::render::driver::{RenderOptions, Renderer};
+use crate::scene::IntegratorSettings;
 use clap::Args as ClapArgs;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -66,6 +67,16 @@ pub fn log_log_slope(points: &[(f64, f64)]) -> f64 {
     sxy / sxx
 }
 
+/// What a step's count is: samples per pixel, sppm's iterations or mlt's
+/// mutations per pixel.
+fn effort_unit(i: &IntegratorSettings) -> &'static str {
+    match i {
+        IntegratorSettings::Sppm(_) => "iterations",
+        IntegratorSettings::Mlt(_) => "mutations/px",
+        _ => "spp",
+    }
+}
+
 fn label(p: &std::path::Path) -> String {
     p.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -108,24 +119,50 @@ pub fn run(args: &ConvergeArgs) -> i32 {
         desc.film.yresolution = reference.height;
         desc.film.cropwindow = [0.0, 1.0, 0.0, 1.0];
         desc.sampler.pixel_samples = args.spp_max;
-        let mut r = match Renderer::new(
-            &desc,
-            &RenderOptions {
-                threads: args.threads,
-                seed: args.seed,
-                ..Default::default()
-            },
-        ) {
-            Ok(r) => r,
-            Err(e) => {
-                eprintln!("error: {e}");
-                return 1;
-            }
+        // sppm and mlt are not progressive in samples: each step is a
+        // render of its own with that many iterations (sppm) or mutations
+        // per pixel (mlt), timed alone.
+        let own_effort = matches!(
+            desc.integrator,
+            IntegratorSettings::Sppm(_) | IntegratorSettings::Mlt(_)
+        );
+        let options = RenderOptions {
+            threads: args.threads,
+            seed: args.seed,
+            ..Default::default()
         };
+        let mut progressive = None;
         let mut steps = Vec::new();
         let (mut done, mut spp) = (0u32, 1u32);
         while spp <= args.spp_max {
-            r.render_samples(done..spp, &|_, _| {});
+            let made = if own_effort {
+                let mut d = desc.clone();
+                match &mut d.integrator {
+                    IntegratorSettings::Sppm(s) => s.iterations = spp,
+                    IntegratorSettings::Mlt(m) => m.mutations_per_pixel = spp,
+                    _ => {}
+                }
+                Renderer::new(&d, &options).map(|mut r| {
+                    r.render_samples(0..spp, &|_, _| {});
+                    r
+                })
+            } else {
+                let r = match progressive.take() {
+                    Some(r) => Ok(r),
+                    None => Renderer::new(&desc, &options),
+                };
+                r.map(|mut r| {
+                    r.render_samples(done..spp, &|_, _| {});
+                    r
+                })
+            };
+            let r = match made {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return 1;
+                }
+            };
             done = spp;
             let st = r.stats();
             let c = compare(&r.image(), &reference);
@@ -137,15 +174,19 @@ pub fn run(args: &ConvergeArgs) -> i32 {
                 block_error: c.block_error,
             };
             eprintln!(
-                "{}: {:>6} spp {:>8.3} s  RMSE {:.5}  rel. MSE {:.3e}  block {:.3e}",
+                "{}: {:>6} {} {:>8.3} s  RMSE {:.5}  rel. MSE {:.3e}  block {:.3e}",
                 label(scene),
                 step.spp,
+                effort_unit(&desc.integrator),
                 step.seconds,
                 step.rmse,
                 step.relative_mse,
                 step.block_error
             );
             steps.push(step);
+            if !own_effort {
+                progressive = Some(r);
+            }
             spp = match spp.checked_mul(2) {
                 Some(s) => s,
                 None => break,
