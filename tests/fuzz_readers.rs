@@ -223,8 +223,10 @@ fn meshes() {
 
 #[test]
 fn spectra_bsdfs_and_lenses() {
-    check("spd, bsdf, lens", &[".spd", ".bsdf", ".dat"], |p, b| {
-        match p.extension().unwrap().to_str().unwrap() {
+    check(
+        "spd, bsdf, lens",
+        &[".spd", ".bsdf", ".dat"],
+        |p, b| match p.extension().unwrap().to_str().unwrap() {
             "spd" => {
                 let _ = pbrs::loader::spd::parse(&String::from_utf8_lossy(b));
             }
@@ -234,8 +236,8 @@ fn spectra_bsdfs_and_lenses() {
             _ => {
                 let _ = pbrs::cameras::realistic::parse_lens_file(&String::from_utf8_lossy(b));
             }
-        }
-    });
+        },
+    );
 }
 
 #[test]

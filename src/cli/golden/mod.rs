@@ -203,6 +203,10 @@ fn run_scene(
             return Err(format!("{}: the scene did not load", file.display()));
         }
     };
+    if !args.quiet && !loaded.warnings.is_empty() {
+        // A warning (a missing texture rendered grey, say) may explain a failure.
+        bar.suspend(|| print_diagnostics(&loaded.warnings));
+    }
     let desc = &mut loaded.scene;
     if let Some(spp) = entry.settings.spp {
         desc.sampler.pixel_samples = spp;

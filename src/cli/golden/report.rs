@@ -228,7 +228,10 @@ pub fn write_html(out: &Path, dir: &Path, results: &[SceneResult]) -> Result<Pat
                 let files = [
                     ("golden", golden.clone()),
                     ("render", img.clone()),
-                    ("difference", false_colour_difference_scaled(img, golden, white)),
+                    (
+                        "difference",
+                        false_colour_difference_scaled(img, golden, white),
+                    ),
                 ];
                 for (kind, im) in &files {
                     write_image(&out.join(format!("{}-{kind}.png", r.entry.name)), im)?;
