@@ -124,6 +124,16 @@ fn noise_passes_and_real_changes_fail() {
     // The default seed, and a fresh seed: noise only.
     let t = expect(&pbrs(&["test", "s"], &d), 0);
     assert!(t.contains("2 passed, 0 failed"), "{t}");
+    // By default the test render takes seed 2, independent of the golden's
+    // seeds 0 and 1: the figures of --seed 2.
+    let figures = |t: &str| {
+        let l = t.lines().find(|l| l.starts_with("ok    box")).unwrap();
+        l.split_once("): ").unwrap().1.to_string()
+    };
+    let t2 = expect(&pbrs(&["test", "s", "--seed", "2"], &d), 0);
+    assert_eq!(figures(&t), figures(&t2));
+    let t0 = expect(&pbrs(&["test", "s", "--seed", "0"], &d), 0);
+    assert_ne!(figures(&t), figures(&t0));
     let t = expect(
         &pbrs(&["test", "s", "--seed", "7", "--junit", "j.xml"], &d),
         0,
