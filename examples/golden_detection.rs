@@ -42,7 +42,7 @@ fn args(dir: &Path, seed: u64, update: bool) -> TestArgs {
     TestArgs {
         dir: dir.to_path_buf(),
         update,
-        seed,
+        seed: Some(seed),
         threads: None,
         junit: None,
         report: None,

@@ -1,8 +1,9 @@
 //! `pbrs test` (golden-image regression for a folder of scenes) and `pbrs img
 //! diff|convert|info`, through the binary: every exit status, on a Cornell
-//! box at 32×32, 16 spp. A re-render that differs only by noise passes; a 3%
-//! brighter light, a changed wall colour and a moved box each fail; bad
-//! input exits 2 with the file named and nothing written.
+//! box at 32×32, 16 spp. A re-render that differs only by noise (another
+//! seed, another thread count) passes; a 3% brighter light, a changed wall
+//! colour, a missing texture (now grey) and a moved box each fail; bad input
+//! exits 2 with the file named and nothing written.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -24,6 +25,14 @@ struct Change {
     light_scale: f64,
     red_wall: Option<[f64; 3]>,
     box_dx: f64,
+    /// The short box's colour from the image texture `tex.pfm`.
+    textured: bool,
+}
+
+/// The texture of a textured box: a constant green, far from the 0.5 grey
+/// pbrs (like pbrt-v3) substitutes for a missing texture file.
+fn write_texture(dir: &Path) {
+    pfm(&dir.join("tex.pfm"), 2, 2, |_, _| [0.15, 0.6, 0.15]);
 }
 
 /// The Cornell box (`scenes/cornell-path.pbrt`'s geometry) at 32×32, 16 spp.
@@ -43,11 +52,17 @@ fn cornell(c: Change) -> String {
             &format!("[{} {} {}]", r[0], r[1], r[2]),
         );
     }
+    let material = if c.textured {
+        "Texture \"tex\" \"spectrum\" \"imagemap\" \"string filename\" \"tex.pfm\"\n\
+         Material \"matte\" \"texture Kd\" \"tex\""
+    } else {
+        "Material \"matte\" \"rgb Kd\" [0.725 0.71 0.68]"
+    };
     format!(
         "Scale -1 1 1\nLookAt 0 1 6.8  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" [19.5]\n\
          Film \"image\" \"integer xresolution\" [32] \"integer yresolution\" [32] \"string filename\" \"out.exr\"\n\
          Sampler \"halton\" \"integer pixelsamples\" [16]\nIntegrator \"path\" \"integer maxdepth\" [8]\n\
-         WorldBegin\n{common}\nAttributeBegin\nMaterial \"matte\" \"rgb Kd\" [0.725 0.71 0.68]\n\
+         WorldBegin\n{common}\nAttributeBegin\n{material}\n\
          Translate {} 0.3 0.37\nRotate -17 0 1 0\nScale 0.6 0.6 0.6\n{cube}\nAttributeEnd\nWorldEnd\n",
         0.33 + c.box_dx
     )
@@ -76,11 +91,21 @@ fn expect(o: &Output, code: i32) -> String {
     t
 }
 
-/// A folder with the Cornell box and a second scene, goldens written.
+/// The Cornell box with its textured short box.
+const TEXTURED: Change = Change {
+    light_scale: 0.0,
+    red_wall: None,
+    box_dx: 0.0,
+    textured: true,
+};
+
+/// A folder with the Cornell box (short box textured) and a second scene,
+/// goldens written.
 fn folder(name: &str) -> PathBuf {
     let d = tmp(name);
     std::fs::create_dir_all(d.join("s")).unwrap();
-    std::fs::write(d.join("s/box.pbrt"), cornell(Change::default())).unwrap();
+    std::fs::write(d.join("s/box.pbrt"), cornell(TEXTURED)).unwrap();
+    write_texture(&d.join("s"));
     let moved = Change {
         box_dx: -0.05,
         ..Default::default()
@@ -99,6 +124,16 @@ fn noise_passes_and_real_changes_fail() {
     // The default seed, and a fresh seed: noise only.
     let t = expect(&pbrs(&["test", "s"], &d), 0);
     assert!(t.contains("2 passed, 0 failed"), "{t}");
+    // By default the test render takes seed 2, independent of the golden's
+    // seeds 0 and 1: the figures of --seed 2.
+    let figures = |t: &str| {
+        let l = t.lines().find(|l| l.starts_with("ok    box")).unwrap();
+        l.split_once("): ").unwrap().1.to_string()
+    };
+    let t2 = expect(&pbrs(&["test", "s", "--seed", "2"], &d), 0);
+    assert_eq!(figures(&t), figures(&t2));
+    let t0 = expect(&pbrs(&["test", "s", "--seed", "0"], &d), 0);
+    assert_ne!(figures(&t), figures(&t0));
     let t = expect(
         &pbrs(&["test", "s", "--seed", "7", "--junit", "j.xml"], &d),
         0,
@@ -110,32 +145,52 @@ fn noise_passes_and_real_changes_fail() {
             && j.contains("<testcase name=\"box\""),
         "{j}"
     );
+    // One thread: the same pixels as all of them, so it passes; goldens
+    // written with one thread equal those written with all.
+    expect(
+        &pbrs(&["test", "s", "--seed", "7", "--nthreads", "1"], &d),
+        0,
+    );
+    std::fs::create_dir_all(d.join("t")).unwrap();
+    std::fs::copy(d.join("s/box.pbrt"), d.join("t/box.pbrt")).unwrap();
+    write_texture(&d.join("t"));
+    expect(&pbrs(&["test", "t", "--update", "--nthreads", "1"], &d), 0);
+    let t = expect(
+        &pbrs(&["img", "diff", "t/golden/box.exr", "s/golden/box.exr"], &d),
+        0,
+    );
+    assert!(t.contains("max |A−B|      0.000000e0"), "{t}");
     // Real changes, each caught.
     let changes = [
         (
             "light 3% brighter",
             Change {
                 light_scale: 1.03,
-                ..Default::default()
+                ..TEXTURED
             },
         ),
         (
             "red wall changed",
             Change {
                 red_wall: Some([0.55, 0.065, 0.05]),
-                ..Default::default()
+                ..TEXTURED
             },
         ),
         (
             "box moved",
             Change {
                 box_dx: 0.1,
-                ..Default::default()
+                ..TEXTURED
             },
         ),
+        // The scene unchanged but its texture file gone: grey instead.
+        ("texture missing", TEXTURED),
     ];
     for (what, c) in changes {
         std::fs::write(d.join("s/box.pbrt"), cornell(c)).unwrap();
+        if what == "texture missing" {
+            std::fs::remove_file(d.join("s/tex.pfm")).unwrap();
+        }
         let o = pbrs(
             &[
                 "test", "s", "--seed", "7", "--junit", "j.xml", "--report", "rep",
@@ -147,6 +202,10 @@ fn noise_passes_and_real_changes_fail() {
             t.contains("FAIL") && t.contains("1 passed, 1 failed"),
             "{what}: {t}"
         );
+        if what == "texture missing" {
+            // The loader's warning says why.
+            assert!(t.contains("tex.pfm"), "{t}");
+        }
         let j = std::fs::read_to_string(d.join("j.xml")).unwrap();
         assert!(
             j.contains("failures=\"1\"")
@@ -220,6 +279,16 @@ fn bad_input_exits_2_and_the_other_scenes_still_run() {
         "WorldBegin\nShape \"sphere\" \"float radius\" [\nWorldEnd\n",
     )
     .unwrap();
+    // --update: the other goldens are written, none for the broken scene,
+    // and nothing else lands in golden/.
+    let t = expect(&pbrs(&["test", "s", "--update"], &d), 2);
+    assert!(t.contains("0 failed, 1 errors, 2 goldens written"), "{t}");
+    let mut files: Vec<String> = std::fs::read_dir(d.join("s/golden"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert_eq!(files, ["box.exr", "other.exr"]);
     let t = expect(&pbrs(&["test", "s", "--junit", "j.xml"], &d), 2);
     assert!(
         t.contains("broken.pbrt") && t.contains("the scene did not load"),
@@ -385,6 +454,30 @@ fn img_diff_exit_statuses_and_error_image() {
     );
     assert!(t.contains("a.pfm is 16×8 but c.pfm is 8×8"), "{t}");
     assert!(!d.join("f.png").exists());
+    // A grey PFM against a colour one: a clear error naming both.
+    let mut grey = b"Pf\n16 8\n-1.0\n".to_vec();
+    for _ in 0..16 * 8 {
+        grey.extend_from_slice(&0.5f32.to_le_bytes());
+    }
+    std::fs::write(d.join("g.pfm"), grey).unwrap();
+    let t = expect(&pbrs(&["img", "diff", "a.pfm", "g.pfm"], &d), 2);
+    assert!(t.contains("a.pfm has channels RGB but g.pfm has Y"), "{t}");
+    // Non-finite pixels are counted and fail whatever the tolerance.
+    pfm(&d.join("n.pfm"), 16, 8, |x, y| {
+        if (x, y) == (3, 2) {
+            [f32::NAN, 0.0, 0.5]
+        } else {
+            [x as f32 / 16.0, y as f32 / 8.0, 0.5]
+        }
+    });
+    let t = expect(
+        &pbrs(&["img", "diff", "n.pfm", "a.pfm", "--tol", "1e9"], &d),
+        1,
+    );
+    assert!(
+        t.contains("non-finite     A 1, B 0") && t.contains("DIFFERENT"),
+        "{t}"
+    );
     std::fs::write(d.join("bad.exr"), b"not an exr").unwrap();
     let t = expect(&pbrs(&["img", "diff", "a.pfm", "bad.exr"], &d), 2);
     assert!(t.contains("bad.exr: cannot read it as EXR"), "{t}");
@@ -431,16 +524,48 @@ fn img_convert_formats_exposure_crop_flip_and_non_finite() {
         (p.x - 0.4).abs() < 1e-6 && (p.y - 0.8).abs() < 1e-6 && (p.z - 0.5).abs() < 1e-6,
         "{p}"
     );
-    // --clamp and --gamma on 8-bit output.
+    // --clamp: exposure +3 multiplies by 8, then values above 1 are 1.
     expect(
         &pbrs(
             &[
-                "img", "convert", "in.pfm", "g.png", "--clamp", "--gamma", "2.2",
+                "img",
+                "convert",
+                "in.pfm",
+                "c.pfm",
+                "--exposure",
+                "3",
+                "--clamp",
             ],
             &d,
         ),
         0,
     );
+    let c = pbrs::image::io::read_image(&d.join("c.pfm")).unwrap();
+    let (p1, p2) = (c.pixel(1, 0), c.pixel(2, 0));
+    assert!(
+        (p1.x - 0.8).abs() < 1e-6 && p2.x == 1.0 && p1.z == 1.0,
+        "{p1} {p2}"
+    );
+    assert!(c.data.iter().all(|&v| (0.0..=1.0).contains(&v)));
+    // 8-bit outputs are sRGB-encoded; --gamma G encodes v^(1/G) instead:
+    // blue 0.25 is byte 137 in sRGB, 64 with gamma 1, 136 with gamma 2.2.
+    for (args, want) in [
+        (&[][..], 137u8),
+        (&["--gamma", "1"][..], 64),
+        (&["--gamma", "2.2", "--clamp"][..], 136),
+    ] {
+        let mut a = vec!["img", "convert", "in.pfm", "g.png"];
+        a.extend_from_slice(args);
+        expect(&pbrs(&a, &d), 0);
+        let bytes = std::fs::read(d.join("g.png")).unwrap();
+        let mut r = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; r.output_buffer_size().unwrap()];
+        r.next_frame(&mut buf).unwrap();
+        let blue = buf[2];
+        assert!(blue.abs_diff(want) <= 1, "{args:?}: {blue} vs {want}");
+    }
     // A NaN and an infinite pixel: reported, black in 8-bit files.
     pfm(&d.join("nan.pfm"), 2, 1, |x, _| {
         if x == 0 {

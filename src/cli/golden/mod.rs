@@ -3,7 +3,8 @@
 //! Each scene is rendered (all threads, one scene at a time) and judged
 //! against its golden `DIR/golden/NAME.exr` by [`crate::image::verdict`], the
 //! verdict of the project's own golden test. A golden is the mean of two
-//! renders with seeds s and s + 1 (`--update`, s = `--seed`); its header
+//! renders with seeds s and s + 1 (`--update`, s = `--seed`, default 0; a
+//! test render's default seed is s + 2); its header
 //! records the noise of one render measured from the two ([`Noise`]), so
 //! the bounds are multiples of the noise expected between a fresh render
 //! and the golden. Nothing but `--update` writes goldens.
@@ -39,9 +40,11 @@ pub struct TestArgs {
     /// of checking against them.
     #[arg(long)]
     pub update: bool,
-    /// Sampler seed of the test renders (with --update: of the first golden render).
-    #[arg(long, default_value_t = 0, value_name = "N")]
-    pub seed: u64,
+    /// Sampler seed of the test renders; default: two more than the
+    /// golden's first seed, a render independent of the golden's two. With
+    /// --update: the seed of the golden's first render (default 0).
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
     /// Worker threads; absent or 0: all cores. Images do not depend on it.
     #[arg(long = "nthreads", visible_alias = "threads", value_name = "N")]
     pub threads: Option<usize>,
@@ -203,6 +206,10 @@ fn run_scene(
             return Err(format!("{}: the scene did not load", file.display()));
         }
     };
+    if !args.quiet && !loaded.warnings.is_empty() {
+        // A warning (a missing texture rendered grey, say) may explain a failure.
+        bar.suspend(|| print_diagnostics(&loaded.warnings));
+    }
     let desc = &mut loaded.scene;
     if let Some(spp) = entry.settings.spp {
         desc.sampler.pixel_samples = spp;
@@ -236,8 +243,9 @@ fn run_scene(
         )
     };
     if args.update {
-        let (a, ta) = render(args.seed)?;
-        let (b, tb) = render(args.seed.wrapping_add(1))?;
+        let seed = args.seed.unwrap_or(0);
+        let (a, ta) = render(seed)?;
+        let (b, tb) = render(seed.wrapping_add(1))?;
         let golden = Image {
             data: a
                 .data
@@ -255,7 +263,7 @@ fn run_scene(
             ));
         }
         let noise = Noise::measure(&a, &b);
-        let mut m = meta(args.seed, ta + tb);
+        let mut m = meta(seed, ta + tb);
         m.push((KEY_RENDERS.into(), "2".into()));
         m.push((KEY_NOISE.into(), noise_text(&noise)));
         std::fs::create_dir_all(golden_dir)
@@ -263,9 +271,11 @@ fn run_scene(
         write_image_with(&golden_path, &golden, &m)?;
         return Ok(Outcome::Updated);
     }
-    let (golden, noise, renders) = read_golden(&golden_path)?;
+    let (golden, noise, renders, golden_seed) = read_golden(&golden_path)?;
     let expect = (golden.width, golden.height);
-    let (img, _) = render(args.seed)?;
+    // The golden averages seeds s and s + 1: by default a third seed, so the
+    // render's noise is independent of the golden's, as the bounds assume.
+    let (img, _) = render(args.seed.unwrap_or(golden_seed.wrapping_add(2)))?;
     if (img.width, img.height) != expect {
         return Err(format!(
             "{}: the golden is {}×{} but the render is {}×{} (run pbrs test --update if the change is meant)",
@@ -327,8 +337,9 @@ fn parse_noise(t: &str) -> Option<Noise> {
     all.iter().all(|x| x.is_finite() && *x >= 0.0).then_some(n)
 }
 
-/// The golden image, its noise and the number of renders it averages.
-fn read_golden(path: &Path) -> Result<(Image, Noise, f64), String> {
+/// The golden image, its noise, the number of renders it averages and the
+/// seed of the first.
+fn read_golden(path: &Path) -> Result<(Image, Noise, f64, u64), String> {
     if !path.exists() {
         return Err(format!(
             "{}: no golden (run pbrs test --update to make it)",
@@ -347,5 +358,9 @@ fn read_golden(path: &Path) -> Result<(Image, Noise, f64), String> {
         .and_then(|r| r.parse::<f64>().ok())
         .filter(|r| *r >= 1.0)
         .unwrap_or(1.0);
-    Ok((f.image, noise, renders))
+    let seed = f
+        .get(crate::image::meta::KEY_SEED)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    Ok((f.image, noise, renders, seed))
 }
