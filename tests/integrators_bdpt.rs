@@ -10,26 +10,13 @@
 
 mod common;
 
-use common::{assert_matches, error_text, load, reference, Bounds};
+use common::{assert_matches, block_means, error_text, load, reference, render_threads, Bounds};
 use pbrs::image::io::read_image;
 use pbrs::image::Image;
 use pbrs::integrators::{BdptSettings, PathSettings};
-use pbrs::render::driver::{render, render_part, RenderOptions};
+use pbrs::render::driver::{render_part, RenderOptions};
 use pbrs::render::film::part::{merge, read_part, PartKind};
 use pbrs::scene::{IntegratorSettings, SceneDescription};
-
-fn render_with(desc: &SceneDescription, threads: usize) -> Image {
-    render(
-        desc,
-        &RenderOptions {
-            threads: Some(threads),
-            ..Default::default()
-        },
-        &|_, _| {},
-    )
-    .expect("render")
-    .0
-}
 
 fn sized(mut d: SceneDescription, w: u32, h: u32, spp: u32) -> SceneDescription {
     d.film.xresolution = w;
@@ -46,20 +33,6 @@ fn means(img: &Image) -> [f64; 3] {
         }
     }
     m.map(|v| v / (img.data.len() / 3) as f64)
-}
-
-/// Means of `b`×`b` blocks of pixels (all channels).
-fn block_means(img: &Image, b: u32) -> Vec<f64> {
-    let (nx, ny) = (img.width / b, img.height / b);
-    let mut out = vec![0.0; (nx * ny) as usize];
-    for y in 0..ny * b {
-        for x in 0..nx * b {
-            let i = ((y * img.width + x) * 3) as usize;
-            let s: f64 = img.data[i..i + 3].iter().map(|&v| v as f64).sum();
-            out[((y / b) * nx + x / b) as usize] += s / (3 * b * b) as f64;
-        }
-    }
-    out
 }
 
 /// The largest difference of `a`'s block means from `r`'s, relative to
@@ -90,7 +63,7 @@ fn the_caustic_matches_pbrt_v3_and_path_misses_it() {
     // 1.5× pbrt-v3's 64-spp figure scaled by 1/4, block error within 2×
     // pbrt-v3's 64-spp figure, mean within 1%.
     let d = sized(load("scenes/bdpt/caustic.pbrt"), 32, 32, 256);
-    let img = render_with(&d, 2);
+    let img = render_threads(&d, 2);
     let r = reference("bdpt-caustic");
     let b64 = Bounds::against_pbrt("bdpt-caustic");
     assert_matches(
@@ -109,7 +82,7 @@ fn the_caustic_matches_pbrt_v3_and_path_misses_it() {
         max_depth: 8,
         ..PathSettings::default()
     });
-    let path = render_with(&p, 2);
+    let path = render_threads(&p, 2);
     let (mb, mp) = (means(&img)[0], means(&path)[0]);
     eprintln!("caustic mean: bdpt {mb:.5}, path {mp:.5}");
     assert!(mp < 0.9 * mb, "path {mp} vs bdpt {mb}");
@@ -120,7 +93,7 @@ fn a_diffuse_scene_converges_to_paths_image() {
     // The Cornell box at 64×64 against path's converged 128×128 reference
     // taken down by 2×2 averages.
     let d = sized(load("scenes/bdpt/cornell.pbrt"), 64, 64, 64);
-    let img = render_with(&d, 2);
+    let img = render_threads(&d, 2);
     let full = reference("cornell-path");
     let mut r = Image::new(64, 64);
     for y in 0..64 {
@@ -143,13 +116,13 @@ fn a_diffuse_scene_converges_to_paths_image() {
 #[test]
 fn fog_converges_to_volpaths_image() {
     let d = sized(load("scenes/bdpt/fog.pbrt"), 40, 32, 64);
-    let img = render_with(&d, 2);
+    let img = render_threads(&d, 2);
     let mut v = sized(d.clone(), 40, 32, 256);
     v.integrator = IntegratorSettings::VolPath(PathSettings {
         max_depth: 8,
         ..PathSettings::default()
     });
-    let r = render_with(&v, 2);
+    let r = render_threads(&v, 2);
     let (md, be) = (mean_difference(&img, &r), block_error(&img, &r, 8));
     eprintln!("fog: mean difference {md:.5}, 8×8 block error {be:.5}");
     assert!(md < 0.02, "mean differs by {md}");
@@ -159,8 +132,8 @@ fn fog_converges_to_volpaths_image() {
 #[test]
 fn the_image_with_its_splats_does_not_depend_on_the_thread_count() {
     let d = sized(load("scenes/bdpt/caustic.pbrt"), 24, 24, 8);
-    let a = render_with(&d, 1);
-    let b = render_with(&d, 2);
+    let a = render_threads(&d, 1);
+    let b = render_threads(&d, 2);
     assert!(means(&a)[0] > 0.0);
     assert!(
         a.data
@@ -188,7 +161,7 @@ fn sample_parts_carry_their_splats_and_tiles_are_refused() {
         parts.push(p);
     }
     let merged = merge(&parts).expect("merge");
-    let whole = render_with(&d, 2);
+    let whole = render_threads(&d, 2);
     for (i, (m, w)) in merged.data.iter().zip(&whole.data).enumerate() {
         assert!(
             (m - w).abs() <= 1e-5 * w.abs().max(1e-3),
@@ -225,7 +198,7 @@ fn the_weighted_strategy_images_add_up_to_the_image() {
         let _ = std::fs::remove_file(dir.join(name));
     }
     d.film.filename = dir.join("caustic.pfm");
-    let img = render_with(&d, 2);
+    let img = render_threads(&d, 2);
     let mut sum = Image::new(16, 16);
     for (_, name) in &files {
         let layer = read_image(&dir.join(name)).expect(name);

@@ -18,25 +18,12 @@
 
 mod common;
 
-use common::{error_text, load, reference};
+use common::{error_text, load, reference, render_threads};
 use pbrs::image::compare::compare;
 use pbrs::image::Image;
-use pbrs::render::driver::{render, render_part, RenderOptions};
+use pbrs::render::driver::{render_part, RenderOptions};
 use pbrs::render::film::part::PartKind;
-use pbrs::scene::{IntegratorSettings, SceneDescription};
-
-fn render_with(desc: &SceneDescription, threads: usize) -> Image {
-    render(
-        desc,
-        &RenderOptions {
-            threads: Some(threads),
-            ..Default::default()
-        },
-        &|_, _| {},
-    )
-    .expect("render")
-    .0
-}
+use pbrs::scene::IntegratorSettings;
 
 fn luminance(m: [f64; 3]) -> f64 {
     0.212671 * m[0] + 0.715160 * m[1] + 0.072169 * m[2]
@@ -74,7 +61,7 @@ fn the_caustic_converges_to_pbrt_v3s() {
     // 0–4: mean off by 0.3–1.6%, relative MSE 0.0042–0.0070, block error
     // 0.020–0.041 (pbrt-v3's mlt at these settings: mean off 0.09%,
     // relative MSE 0.0042, block error 0.0177).
-    let img = render_with(&load("scenes/mlt/caustic.pbrt"), 2);
+    let img = render_threads(&load("scenes/mlt/caustic.pbrt"), 2);
     check(
         "mlt caustic",
         &img,
@@ -94,7 +81,7 @@ fn the_cornell_box_converges_to_paths_image() {
     // relative MSE 0.0092–0.0102, block error 0.029–0.032 (pbrt-v3's mlt
     // at these settings: luminance mean off 1.0%, channels up to 1.7%,
     // relative MSE 0.0108, block error 0.038).
-    let img = render_with(&load("scenes/mlt/cornell.pbrt"), 2);
+    let img = render_threads(&load("scenes/mlt/cornell.pbrt"), 2);
     let full = reference("cornell-path");
     let mut r = Image::new(64, 64);
     for y in 0..64 {
@@ -120,8 +107,8 @@ fn the_image_does_not_depend_on_the_thread_count() {
         panic!("not mlt")
     };
     m.bootstrap_samples = 4096;
-    let a = render_with(&d, 1);
-    let b = render_with(&d, 2);
+    let a = render_threads(&d, 1);
+    let b = render_threads(&d, 2);
     assert!(a.data.iter().any(|&v| v > 0.0));
     assert!(
         a.data

@@ -9,41 +9,13 @@
 
 mod common;
 
-use common::{load, load_text, repo, warning_text};
+use common::{block_means, load, load_text, render_threads, repo, warning_text};
 use pbrs::image::Image;
 use pbrs::integrators::{PathSettings, SppmSettings};
-use pbrs::render::driver::{render, RenderOptions};
 use pbrs::scene::{IntegratorSettings, SceneDescription};
-
-fn render_with(desc: &SceneDescription, threads: usize) -> Image {
-    render(
-        desc,
-        &RenderOptions {
-            threads: Some(threads),
-            ..Default::default()
-        },
-        &|_, _| {},
-    )
-    .expect("render")
-    .0
-}
 
 fn mean(img: &Image) -> f64 {
     img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len() as f64
-}
-
-/// Means of `b`×`b` blocks of pixels (all channels).
-fn block_means(img: &Image, b: u32) -> Vec<f64> {
-    let (nx, ny) = (img.width / b, img.height / b);
-    let mut out = vec![0.0; (nx * ny) as usize];
-    for y in 0..ny * b {
-        for x in 0..nx * b {
-            let i = ((y * img.width + x) * 3) as usize;
-            let s: f64 = img.data[i..i + 3].iter().map(|&v| v as f64).sum();
-            out[((y / b) * nx + x / b) as usize] += s / (3 * b * b) as f64;
-        }
-    }
-    out
 }
 
 /// The caustic scene with fewer iterations (the golden test renders it
@@ -64,8 +36,8 @@ fn the_image_does_not_depend_on_the_thread_count() {
     if let IntegratorSettings::Sppm(s) = &mut d.integrator {
         s.photons_per_iteration = 20_000;
     }
-    let a = render_with(&d, 1);
-    let b = render_with(&d, 2);
+    let a = render_threads(&d, 1);
+    let b = render_threads(&d, 2);
     assert!(mean(&a) > 0.0);
     assert_eq!(a.data.len(), b.data.len());
     assert!(
@@ -80,14 +52,14 @@ fn the_image_does_not_depend_on_the_thread_count() {
 #[test]
 fn the_caustic_path_cannot_find_is_there() {
     let d = caustic(16);
-    let sppm = render_with(&d, 2);
+    let sppm = render_threads(&d, 2);
     let mut p = d.clone();
     p.integrator = IntegratorSettings::Path(PathSettings {
         max_depth: 8,
         ..PathSettings::default()
     });
     p.sampler.pixel_samples = 64;
-    let path = render_with(&p, 2);
+    let path = render_threads(&p, 2);
     // The caustic is under the sphere, in its shadow: the brightest pixel
     // of sppm's image, (nearly) black in the path tracer's.
     let lum = |img: &Image, i: usize| img.data[3 * i..3 * i + 3].iter().sum::<f32>();
@@ -121,8 +93,8 @@ fn on_a_diffuse_scene_sppm_converges_to_path() {
         radius: 0.04,
         write_frequency: 0,
     });
-    let sppm = render_with(&d, 2);
-    let path = render_with(&p, 2);
+    let sppm = render_threads(&d, 2);
+    let path = render_threads(&p, 2);
     let (ms, mp) = (mean(&sppm), mean(&path));
     assert!((ms - mp).abs() < 0.02 * mp, "means: sppm {ms}, path {mp}");
     let (bs, bp) = (block_means(&sppm, 4), block_means(&path, 4));
@@ -145,7 +117,7 @@ fn intermediate_images_are_written() {
     let out = dir.join("caustic.pfm");
     let _ = std::fs::remove_file(&out);
     d.film.filename = out.clone();
-    let img = render_with(&d, 2);
+    let img = render_threads(&d, 2);
     // Written after iteration 2 (the end's image is the caller's to write).
     let written = pbrs::image::io::read_image(&out).expect("an intermediate image");
     assert_eq!((written.width, written.height), (img.width, img.height));
@@ -200,5 +172,5 @@ fn bad_parameters_are_located_warnings() {
         load_text(&scene("\"integer iterations\" 2").replace("LightSource \"point\"", "")).scene;
     d.film.xresolution = 4;
     d.film.yresolution = 3;
-    assert_eq!(mean(&render_with(&d, 2)), 0.0);
+    assert_eq!(mean(&render_threads(&d, 2)), 0.0);
 }

@@ -367,3 +367,31 @@ pub fn assert_fast_is_scalar(desc: &SceneDescription, what: &str) -> (RenderStat
     assert!(sum > 0.0, "{what}: a black image proves nothing");
     (fast_stats, slow_stats)
 }
+
+/// `desc` rendered with `threads` threads and the default seed.
+pub fn render_threads(desc: &SceneDescription, threads: usize) -> Image {
+    render(
+        desc,
+        &RenderOptions {
+            threads: Some(threads),
+            ..Default::default()
+        },
+        &|_, _| {},
+    )
+    .expect("render")
+    .0
+}
+
+/// Means of `b`×`b` blocks of pixels (all channels).
+pub fn block_means(img: &Image, b: u32) -> Vec<f64> {
+    let (nx, ny) = (img.width / b, img.height / b);
+    let mut out = vec![0.0; (nx * ny) as usize];
+    for y in 0..ny * b {
+        for x in 0..nx * b {
+            let i = ((y * img.width + x) * 3) as usize;
+            let s: f64 = img.data[i..i + 3].iter().map(|&v| v as f64).sum();
+            out[((y / b) * nx + x / b) as usize] += s / (3 * b * b) as f64;
+        }
+    }
+    out
+}
