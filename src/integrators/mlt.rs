@@ -368,9 +368,10 @@ impl Mlt {
                     .enumerate()
                     .map(|(k, chunk)| {
                         let mut scratch = Scratch::default();
+                        let mut sampler = sampler_for(0);
                         for (j, w) in chunk.iter_mut().enumerate() {
                             let index = first + k * chunk_len + j;
-                            let mut sampler = sampler_for(index);
+                            mlt(&mut sampler).restart(sequence(index as u64, seed));
                             let depth = (index % depths) as u32;
                             *w = luminance(paths.path(&mut sampler, depth, &mut scratch).0);
                         }

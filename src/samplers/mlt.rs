@@ -78,6 +78,19 @@ impl MltSampler {
         }
     }
 
+    /// This sampler as [`MltSampler::new`] makes it with `sequence`,
+    /// keeping its storage (the bootstrap makes a fresh sampler per path).
+    pub fn restart(&mut self, sequence: u64) {
+        self.rng = Pcg32::with_sequence(sequence);
+        self.x.clear();
+        self.iteration = 0;
+        self.large_step = true;
+        self.last_large_step = 0;
+        self.stream = 0;
+        self.index = 0;
+        self.arrays = ArrayStore::default();
+    }
+
     pub fn samples_per_pixel(&self) -> u32 {
         self.mutations_per_pixel
     }

@@ -418,7 +418,10 @@ pub(crate) fn random_walk<'a>(
                 ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
                 continue;
             }
-            let mut v = Vertex::at(Kind::Surface, s.point.p, s.point.n, beta, time, medium);
+            // Made in place: a vertex holds its BSDF, too big to move.
+            path.push(Vertex::at(Kind::Surface, s.point.p, s.point.n, beta, time, medium));
+            let (before, new) = path.split_at_mut(prev + 1);
+            let v = &mut new[0];
             shade(
                 scene,
                 &h,
@@ -438,8 +441,7 @@ pub(crate) fn random_walk<'a>(
                 .get(s.material as usize)
                 .copied()
                 .flatten();
-            v.pdf_fwd = path[prev].convert_density(pdf_fwd, &v, c);
-            path.push(v);
+            v.pdf_fwd = before[prev].convert_density(pdf_fwd, v, c);
             bounces += 1;
             if bounces >= max_depth {
                 break;
