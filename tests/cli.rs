@@ -260,6 +260,20 @@ fn pbrt_v4_flags() {
     assert!(stderr(&out).contains("statistics:"), "{}", stderr(&out));
     // 40 × 30 pixels at 2 spp.
     assert!(stderr(&out).contains("samples: 2400"), "{}", stderr(&out));
+    // Load, build and render time, on the summary line and in the statistics.
+    let times = |line: &str, prefix: &str| {
+        line.split(prefix).nth(1).is_some_and(|rest| {
+            ["load ", "build ", "render "]
+                .iter()
+                .all(|k| rest.contains(k))
+        })
+    };
+    assert!(
+        stderr(&out).lines().any(|l| times(l, "threads; "))
+            && stderr(&out).lines().any(|l| times(l, "times: ")),
+        "{}",
+        stderr(&out)
+    );
     let full_img = image(&full);
 
     // --pixelbounds x0 x1 y0 y1, in either form: exactly those pixels.

@@ -343,6 +343,9 @@ pub fn run(args: &Args) -> i32 {
             return 1;
         }
     };
+    // Reading and parsing the scene files and everything they name
+    // (meshes, textures, media): all scenes of the run together.
+    let load_time = started.elapsed();
     if scenes.is_empty() && args.warnings() {
         eprintln!("warning: {label}: the scene is empty: nothing to render (as pbrt-v3)");
     }
@@ -352,7 +355,13 @@ pub fn run(args: &Args) -> i32 {
         if args.warnings() {
             print_diagnostics(&loaded.warnings);
         }
-        let status = render_one(args, loaded.scene, loaded.film_has_cropwindow, started);
+        let status = render_one(
+            args,
+            loaded.scene,
+            loaded.film_has_cropwindow,
+            started,
+            load_time,
+        );
         if status != 0 {
             return status;
         }
@@ -366,6 +375,7 @@ fn render_one(
     mut desc: SceneDescription,
     film_has_cropwindow: bool,
     started: Instant,
+    load_time: std::time::Duration,
 ) -> i32 {
     // Command-line overrides, validated before any work is done.
     // A value the flags cannot take is a usage error.
@@ -473,7 +483,7 @@ fn render_one(
             format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0))
         });
         eprintln!(
-            "{}: {}x{} px, {}, {} threads; build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
+            "{}: {}x{} px, {}, {} threads; load {:.2} s, build {:.2} s, render {:.2} s; {:.1} M rays ({:.1} M closest-hit + {:.1} M shadow), {:.2} Mrays/s; {} samples dropped (NaN {}, Inf {}, negative {}); peak memory {}",
             out.display(),
             image.width,
             image.height,
@@ -483,6 +493,7 @@ fn render_one(
                 _ => format!("{} spp", desc.sampler.pixel_samples),
             },
             stats.threads,
+            load_time.as_secs_f64(),
             stats.build_time.as_secs_f64(),
             stats.render_time.as_secs_f64(),
             stats.rays.total() as f64 / 1e6,
@@ -503,6 +514,12 @@ fn render_one(
     }
     if args.stats {
         eprintln!("statistics:");
+        eprintln!(
+            "  times: load {:.3} s (scene text and the files it names), build {:.3} s (BVH, lights, film), render {:.3} s",
+            load_time.as_secs_f64(),
+            stats.build_time.as_secs_f64(),
+            stats.render_time.as_secs_f64()
+        );
         for n in desc
             .skipped
             .iter()
