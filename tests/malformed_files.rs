@@ -180,6 +180,22 @@ fn extreme_cases() -> Vec<Case> {
             &["case.pbrt:5:", "maxdepth", "100000"],
         ));
     }
+    // bdpt and mlt have no Russian roulette and connect every pair of
+    // subpath lengths: their depth is clamped lower, in a closed room too.
+    const MATTE_ROOM: &str =
+        "Material \"matte\" \"rgb Kd\" [0.9 0.9 0.9] Shape \"sphere\" \"float radius\" 10";
+    for (name, opts, world) in [
+        ("bdpt mirrors", "Integrator \"bdpt\" \"integer maxdepth\" 1000000000", MIRROR_ROOM),
+        ("bdpt matte", "Integrator \"bdpt\" \"integer maxdepth\" 1000000000", MATTE_ROOM),
+        ("mlt matte", "Integrator \"mlt\" \"integer maxdepth\" 1000000000 \"integer bootstrapsamples\" 100 \"integer chains\" 4 \"integer mutationsperpixel\" 1", MATTE_ROOM),
+    ] {
+        out.push(render(
+            &format!("maxdepth {name}"),
+            scene(opts, world),
+            0,
+            &["case.pbrt:5:", "maxdepth", "at most 128 deep"],
+        ));
+    }
     for class in ["wrinkled", "fbm"] {
         let world = format!("Texture \"n\" \"float\" \"{class}\" \"integer octaves\" 2000000000 Material \"matte\" \"texture sigma\" \"n\" Shape \"sphere\"");
         out.push(render(

@@ -37,7 +37,7 @@ pub(crate) mod vertex;
 
 use super::common::light_sampler;
 use super::path::light_sample_strategy;
-use super::{max_depth, Integrate, IntegratorKind, IntegratorSettings, Scratch, Splat};
+use super::{max_depth_bidirectional, Integrate, IntegratorKind, IntegratorSettings, Scratch, Splat};
 use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::cameras::CameraImportance;
 use crate::geometry::{Bounds2i, Ray, RayDiff};
@@ -107,7 +107,7 @@ impl Default for BdptSettings {
 impl BdptSettings {
     /// The settings of a statement's parameters, checked as pbrt-v3 does.
     pub fn read(p: &ParamValues, r: &mut dyn Report) -> BdptSettings {
-        let mut max_depth = max_depth(p, r);
+        let mut max_depth = max_depth_bidirectional(p, r, "bdpt");
         let visualize_strategies = p.boolean("visualizestrategies");
         let visualize_weights = p.boolean("visualizeweights");
         if (visualize_strategies || visualize_weights) && max_depth > 5 {

@@ -37,7 +37,7 @@
 
 use super::bdpt::{camera_subpath, connect, light_subpath, recycle, Ctx};
 use super::common::light_sampler;
-use super::{max_depth, Integrate, IntegratorKind, IntegratorSettings, RayCounts, Scratch, Splat};
+use super::{max_depth_bidirectional, Integrate, IntegratorKind, IntegratorSettings, RayCounts, Scratch, Splat};
 use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::cameras::CameraImportance;
 use crate::geometry::{luminance, Bounds2i, Ray, RayDiff};
@@ -129,7 +129,7 @@ impl MltSettings {
     /// non-finite sigma) are errors here.
     pub fn read(p: &ParamValues, r: &mut dyn Report) -> MltSettings {
         let d = MltSettings::default();
-        let max_depth = max_depth(p, r);
+        let max_depth = max_depth_bidirectional(p, r, "mlt");
         let mut count = |name: &'static str, default: u32| {
             let v = p.int(name);
             if v < 1 {

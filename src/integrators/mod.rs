@@ -166,6 +166,30 @@ fn max_depth(p: &ParamValues, r: &mut dyn Report) -> u32 {
     }
 }
 
+/// The deepest `maxdepth` bdpt and mlt follow. Their work per sample grows
+/// with the square of the depth (every pair of subpath lengths is
+/// connected, and each connection's MIS weight walks both subpaths), and
+/// they have no Russian roulette: in a closed room every path reaches
+/// `maxdepth`. pbrt-v3's own bdpt stops near depth 110, where its Halton
+/// and Sobol samplers run out of dimensions (about 9 per bounce).
+pub const MAX_BIDIRECTIONAL_DEPTH: u32 = 128;
+
+/// [`max_depth`] for bdpt and mlt: beyond [`MAX_BIDIRECTIONAL_DEPTH`] it
+/// is clamped with a warning.
+fn max_depth_bidirectional(p: &ParamValues, r: &mut dyn Report, kind: &str) -> u32 {
+    let md = p.int("maxdepth");
+    if md > MAX_BIDIRECTIONAL_DEPTH as i32 {
+        r.warn(
+            Some("maxdepth"),
+            format!("\"maxdepth\" is {md}: {kind} follows paths at most {MAX_BIDIRECTIONAL_DEPTH} deep in pbrs (its work per sample grows with the square of the depth, and pbrt-v3's samplers run out of dimensions near depth 110), which is used"),
+            "depth clamped",
+        );
+        MAX_BIDIRECTIONAL_DEPTH
+    } else {
+        max_depth(p, r)
+    }
+}
+
 /// What a runtime integrator does; each kind's struct implements it (only
 /// `li` is required) and [`Integrator`] delegates to it.
 pub trait Integrate {
