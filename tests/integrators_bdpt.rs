@@ -135,13 +135,7 @@ fn the_image_with_its_splats_does_not_depend_on_the_thread_count() {
     let a = render_threads(&d, 1);
     let b = render_threads(&d, 2);
     assert!(means(&a)[0] > 0.0);
-    assert!(
-        a.data
-            .iter()
-            .zip(&b.data)
-            .all(|(x, y)| x.to_bits() == y.to_bits()),
-        "1 and 2 threads differ"
-    );
+    common::assert_bit_identical(&a, &b, "1 and 2 threads");
 }
 
 #[test]

@@ -110,13 +110,7 @@ fn the_image_does_not_depend_on_the_thread_count() {
     let a = render_threads(&d, 1);
     let b = render_threads(&d, 2);
     assert!(a.data.iter().any(|&v| v > 0.0));
-    assert!(
-        a.data
-            .iter()
-            .zip(&b.data)
-            .all(|(x, y)| x.to_bits() == y.to_bits()),
-        "1 and 2 threads differ"
-    );
+    common::assert_bit_identical(&a, &b, "1 and 2 threads");
 }
 
 #[test]

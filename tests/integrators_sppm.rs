@@ -39,14 +39,7 @@ fn the_image_does_not_depend_on_the_thread_count() {
     let a = render_threads(&d, 1);
     let b = render_threads(&d, 2);
     assert!(mean(&a) > 0.0);
-    assert_eq!(a.data.len(), b.data.len());
-    assert!(
-        a.data
-            .iter()
-            .zip(&b.data)
-            .all(|(x, y)| x.to_bits() == y.to_bits()),
-        "1 and 2 threads differ"
-    );
+    common::assert_bit_identical(&a, &b, "1 and 2 threads");
 }
 
 #[test]

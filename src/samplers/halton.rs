@@ -6,8 +6,8 @@ use super::lowdiscrepancy::{
     DigitBase, PermutationTables, BLOCK_DIM_END, BLOCK_LANES, PRIME_TABLE_SIZE,
 };
 use super::{
-    count, global_1d_array, global_2d_array, ArrayStore, GlobalSequence, SamplerKindEntry,
-    PIXELSAMPLES_16,
+    count, global_1d_array, global_2d_array, past_arrays, ArrayStore, GlobalSequence,
+    SamplerKindEntry, PIXELSAMPLES_16,
 };
 use crate::geometry::Bounds2i;
 use crate::sampling::rng::{hash_to_unit, mix64};
@@ -131,9 +131,7 @@ impl HaltonSampler {
     }
 
     fn update_array_end(&mut self) {
-        self.array_end_dim = ARRAY_START_DIM
-            + self.arrays.sizes_1d.len() as u32
-            + 2 * self.arrays.sizes_2d.len() as u32;
+        self.array_end_dim = ARRAY_START_DIM + self.arrays.dimensions();
     }
 
     /// pbrt-v3's `GetIndexForSample`: the global index of sample `sample_num`
@@ -249,17 +247,13 @@ impl HaltonSampler {
     /// Consumes the dimensions `get_2d` would, without computing them.
     #[inline]
     pub fn skip_2d(&mut self) {
-        if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
-            self.dimension = self.array_end_dim;
-        }
+        self.dimension = past_arrays(self.dimension, 2, ARRAY_START_DIM, self.array_end_dim);
         self.dimension += 2;
     }
 
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
-        if self.dimension >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
-            self.dimension = self.array_end_dim;
-        }
+        self.dimension = past_arrays(self.dimension, 1, ARRAY_START_DIM, self.array_end_dim);
         let v = self.sample_dimension(self.interval_index, self.dimension);
         self.dimension += 1;
         v
@@ -267,9 +261,7 @@ impl HaltonSampler {
 
     #[inline]
     pub fn get_2d(&mut self) -> Vec2 {
-        if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
-            self.dimension = self.array_end_dim;
-        }
+        self.dimension = past_arrays(self.dimension, 2, ARRAY_START_DIM, self.array_end_dim);
         let p = self.sample_2d_dimensions(self.interval_index, self.dimension);
         self.dimension += 2;
         p

@@ -427,6 +427,18 @@ pub(crate) fn global_2d_array<S: GlobalSequence>(s: &mut S, n: u32) -> Option<&[
     s.arrays().get_2d(n, 0)
 }
 
+/// pbrt-v3's `GlobalSampler::Get1D`/`Get2D`: the dimension at which the
+/// next `width` (1 or 2) values start, moved past the sample arrays'
+/// dimensions `[start, end)` when they would overlap them.
+#[inline(always)]
+pub(crate) fn past_arrays(dimension: u32, width: u32, start: u32, end: u32) -> u32 {
+    if dimension + width > start && dimension < end {
+        end
+    } else {
+        dimension
+    }
+}
+
 /// Requested sample arrays and their current contents.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ArrayStore {
@@ -441,6 +453,12 @@ pub(crate) struct ArrayStore {
 }
 
 impl ArrayStore {
+    /// The dimensions the requested arrays take: one per 1D array, two
+    /// per 2D array.
+    pub fn dimensions(&self) -> u32 {
+        self.sizes_1d.len() as u32 + 2 * self.sizes_2d.len() as u32
+    }
+
     pub fn request_1d(&mut self, n: u32, copies: u32) {
         self.sizes_1d.push(n);
         self.data_1d.push(vec![0.0; n as usize * copies as usize]);

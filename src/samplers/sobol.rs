@@ -14,8 +14,8 @@ use super::sobolmatrices::{
     NUM_SOBOL_DIMENSIONS,
 };
 use super::{
-    count, global_1d_array, global_2d_array, ArrayStore, GlobalSequence, SamplerKindEntry,
-    PIXELSAMPLES_16,
+    count, global_1d_array, global_2d_array, past_arrays, ArrayStore, GlobalSequence,
+    SamplerKindEntry, PIXELSAMPLES_16,
 };
 use crate::geometry::Bounds2i;
 use crate::sampling::rng::{hash_to_unit, mix64, ONE_MINUS_EPSILON};
@@ -115,9 +115,7 @@ impl SobolSampler {
     }
 
     fn update_array_end(&mut self) {
-        self.array_end_dim = ARRAY_START_DIM
-            + self.arrays.sizes_1d.len() as u32
-            + 2 * self.arrays.sizes_2d.len() as u32;
+        self.array_end_dim = ARRAY_START_DIM + self.arrays.dimensions();
     }
 
     /// pbrt-v3's `GetIndexForSample`: the global index of sample
@@ -174,9 +172,7 @@ impl SobolSampler {
 
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
-        if self.dimension >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
-            self.dimension = self.array_end_dim;
-        }
+        self.dimension = past_arrays(self.dimension, 1, ARRAY_START_DIM, self.array_end_dim);
         let v = self.sample_dimension(self.interval_index, self.dimension);
         self.dimension += 1;
         v
@@ -184,9 +180,7 @@ impl SobolSampler {
 
     #[inline]
     pub fn get_2d(&mut self) -> Vec2 {
-        if self.dimension + 1 >= ARRAY_START_DIM && self.dimension < self.array_end_dim {
-            self.dimension = self.array_end_dim;
-        }
+        self.dimension = past_arrays(self.dimension, 2, ARRAY_START_DIM, self.array_end_dim);
         let p = Vec2::new(
             self.sample_dimension(self.interval_index, self.dimension),
             self.sample_dimension(self.interval_index, self.dimension + 1),

@@ -395,3 +395,20 @@ pub fn block_means(img: &Image, b: u32) -> Vec<f64> {
     }
     out
 }
+
+/// Asserts that `a` and `b` are the same image bit for bit (`what` names
+/// the two renders in the failure).
+pub fn assert_bit_identical(a: &Image, b: &Image, what: &str) {
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "{what}: sizes differ"
+    );
+    assert!(
+        a.data
+            .iter()
+            .zip(&b.data)
+            .all(|(x, y)| x.to_bits() == y.to_bits()),
+        "{what} differ"
+    );
+}
