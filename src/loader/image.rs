@@ -38,13 +38,16 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Files read so far, by path: what each read gave (a value or an error).
+type ReadResults<T> = HashMap<PathBuf, Result<Arc<T>, String>>;
+
 /// Images read so far in this scene.
 #[derive(Default)]
 pub struct ImageCache {
-    raw: HashMap<PathBuf, Result<Arc<RgbImage>, String>>,
+    raw: ReadResults<RgbImage>,
     decoded: HashMap<(PathBuf, Decode), Arc<RgbImage>>,
     /// Ptex files read so far (`ptex` textures).
-    ptex: HashMap<PathBuf, Result<Arc<PtexFile>, String>>,
+    ptex: ReadResults<PtexFile>,
     /// Files actually read (for tests of the cache).
     reads: usize,
 }
@@ -54,6 +57,27 @@ impl ImageCache {
     pub fn reads(&self) -> usize {
         self.reads
     }
+}
+
+/// The file at `path` read and parsed once per scene: the result, value
+/// or error, is kept in the `cache` map of [`ImageCache`] for later uses.
+fn read_once<T>(
+    ctx: &mut Ctx,
+    path: &Path,
+    cache: fn(&mut ImageCache) -> &mut ReadResults<T>,
+    parse: impl FnOnce(&mut Ctx, Vec<u8>) -> Result<T, String>,
+) -> Result<Arc<T>, String> {
+    if let Some(r) = cache(&mut ctx.images).get(path) {
+        return r.clone();
+    }
+    ctx.images.reads += 1;
+    let r = ctx
+        .loader
+        .load(path)
+        .and_then(|bytes| parse(ctx, bytes))
+        .map(Arc::new);
+    cache(&mut ctx.images).insert(path.to_path_buf(), r.clone());
+    r
 }
 
 /// The image `filename` converted as `decode` says, or `None` after a located
@@ -69,29 +93,22 @@ pub fn load_image(
     if let Some(img) = ctx.images.decoded.get(&(path.clone(), decode)) {
         return Some(img.clone());
     }
-    let raw = match ctx.images.raw.get(&path) {
-        Some(r) => r.clone(),
-        None => {
-            ctx.images.reads += 1;
-            let r = ctx
-                .loader
-                .load(&path)
-                .and_then(|bytes| decode_image(&bytes, &path))
-                .map(|img| {
-                    let (img, bad) = clamp_texels(img);
-                    if bad > 0 {
-                        ctx.warn(
-                            loc,
-                            format!("image \"{}\" has {bad} texel values that are NaN, infinite or negative: they are read as 0", path.display()),
-                            "texels clamped",
-                        );
-                    }
-                    Arc::new(img)
-                });
-            ctx.images.raw.insert(path.clone(), r.clone());
-            r
-        }
-    };
+    let raw = read_once(
+        ctx,
+        &path,
+        |c| &mut c.raw,
+        |ctx, bytes| {
+            let (img, bad) = clamp_texels(decode_image(&bytes, &path)?);
+            if bad > 0 {
+                ctx.warn(
+                loc,
+                format!("image \"{}\" has {bad} texel values that are NaN, infinite or negative: they are read as 0", path.display()),
+                "texels clamped",
+            );
+            }
+            Ok(img)
+        },
+    );
     match raw {
         Ok(raw) => {
             let img = match decode {
@@ -127,19 +144,12 @@ pub fn load_ptex(
     substitute: &str,
 ) -> Option<Arc<PtexFile>> {
     let path = ctx.resolve(loc, filename);
-    let file = match ctx.images.ptex.get(&path) {
-        Some(r) => r.clone(),
-        None => {
-            ctx.images.reads += 1;
-            let r = ctx
-                .loader
-                .load(&path)
-                .and_then(|bytes| PtexFile::parse(&bytes))
-                .map(Arc::new);
-            ctx.images.ptex.insert(path.clone(), r.clone());
-            r
-        }
-    };
+    let file = read_once(
+        ctx,
+        &path,
+        |c| &mut c.ptex,
+        |_, bytes| PtexFile::parse(&bytes),
+    );
     let file = match file {
         Ok(f) if f.nchannels == 1 || f.nchannels == 3 => f,
         Ok(f) => {
