@@ -228,6 +228,13 @@ impl<'a> Bsdf<'a> {
             return 0.0;
         }
         let wi = self.frame.to_local(wi_w);
+        if let [l] = self.lobes.as_slice() {
+            // One lobe (the common case): the same value as the sum.
+            if !l.flags.matches(flags) {
+                return 0.0;
+            }
+            return lambertian_inline_pdf(&l.bxdf, wo, wi);
+        }
         let mut pdf = 0.0;
         let mut matching = 0u32;
         for l in &self.lobes {
@@ -365,6 +372,16 @@ fn lambertian_inline_f_pdf(b: &Bxdf, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     match b {
         Bxdf::LambertianReflection(l) => l.f_pdf(wo, wi),
         _ => b.f_pdf(wo, wi),
+    }
+}
+
+/// `b.pdf` with Lambertian reflection inline (see
+/// [`lambertian_inline_f_pdf`]).
+#[inline(always)]
+fn lambertian_inline_pdf(b: &Bxdf, wo: Vec3, wi: Vec3) -> f32 {
+    match b {
+        Bxdf::LambertianReflection(l) => l.pdf(wo, wi),
+        _ => b.pdf(wo, wi),
     }
 }
 

@@ -69,6 +69,9 @@ pub(crate) fn connect<'a>(
     let mut sampled: Option<Vertex<'a>> = None;
     let mut p_raster = None;
     let mut l = Vec3::ZERO;
+    // The scattering densities the connection's BSDF values came with:
+    // at qs towards pt and at pt towards qs (solid angle).
+    let mut dens = Densities::default();
     if s == 0 {
         let pt = &camera[t - 1];
         if pt.is_light() {
@@ -89,7 +92,9 @@ pub(crate) fn connect<'a>(
                         qs.time,
                         c.camera_medium,
                     );
-                    l = qs.beta * qs.f(&v, Mode::Importance) * v.beta;
+                    let (f, pdf) = qs.f(&v, Mode::Importance);
+                    dens.at_qs = qs.scatters().then_some(pdf);
+                    l = qs.beta * f * v.beta;
                     if qs.on_surface() {
                         l *= is.wi.dot(qs.ns).abs();
                     }
@@ -114,7 +119,9 @@ pub(crate) fn connect<'a>(
             let u2 = sampler.get_2d();
             if let Some((i, pmf)) = chosen {
                 if let Some((v, shadow, wi)) = light_vertex(c, pt, i, pmf, u2) {
-                    l = pt.beta * pt.f(&v, Mode::Radiance) * v.beta;
+                    let (f, pdf) = pt.f(&v, Mode::Radiance);
+                    dens.at_pt = pt.scatters().then_some(pdf);
+                    l = pt.beta * f * v.beta;
                     if pt.on_surface() {
                         l *= wi.dot(pt.ns).abs();
                     }
@@ -129,7 +136,11 @@ pub(crate) fn connect<'a>(
     } else {
         let (qs, pt) = (&light[s - 1], &camera[t - 1]);
         if qs.is_connectible(c) && pt.is_connectible(c) {
-            l = qs.beta * qs.f(pt, Mode::Importance) * pt.f(qs, Mode::Radiance) * pt.beta;
+            let (fq, pdf_q) = qs.f(pt, Mode::Importance);
+            let (fp, pdf_p) = pt.f(qs, Mode::Radiance);
+            dens.at_qs = qs.scatters().then_some(pdf_q);
+            dens.at_pt = pt.scatters().then_some(pdf_p);
+            l = qs.beta * fq * fp * pt.beta;
             if l != Vec3::ZERO {
                 l *= g(c, qs, pt, sampler, scratch);
             }
@@ -138,13 +149,24 @@ pub(crate) fn connect<'a>(
     let weight = if l == Vec3::ZERO {
         0.0
     } else {
-        mis_weight(c, light, camera, sampled, s, t)
+        mis_weight(c, light, camera, sampled.as_mut(), dens, s, t)
     };
     Strategy {
         l: l * weight,
         weight,
         p_raster,
     }
+}
+
+/// Solid-angle densities of scattering across the connection, where the
+/// connection's BSDF evaluations gave them.
+#[derive(Clone, Copy, Default)]
+struct Densities {
+    /// At the light subpath's end (qs) towards the camera subpath's (pt),
+    /// arriving from qs's predecessor.
+    at_qs: Option<f32>,
+    /// At pt towards qs, arriving from pt's predecessor.
+    at_pt: Option<f32>,
 }
 
 /// The light vertex of the s = 1 strategy: light `i` (chosen with
@@ -193,7 +215,8 @@ fn mis_weight<'a>(
     c: &Ctx<'a>,
     light: &mut [Vertex<'a>],
     camera: &mut [Vertex<'a>],
-    sampled: Option<Vertex<'a>>,
+    mut sampled: Option<&mut Vertex<'a>>,
+    dens: Densities,
     s: usize,
     t: usize,
 ) -> f32 {
@@ -201,27 +224,32 @@ fn mis_weight<'a>(
         return 1.0;
     }
     // The sampled endpoint replaces the subpath's.
-    let mut swapped = None;
-    if let Some(v) = sampled {
+    if let Some(v) = sampled.as_deref_mut() {
         let slot = if s == 1 {
             &mut light[0]
         } else {
             &mut camera[0]
         };
-        swapped = Some(std::mem::replace(slot, v));
+        slot.swap_endpoint(v);
     }
     // The new reverse densities, computed before any is set.
     let (qs, pt) = (s.checked_sub(1), t - 1);
     let (qs_m, pt_m) = (s.checked_sub(2), t.checked_sub(2));
     let pt_rev = match qs {
-        Some(q) => light[q].pdf(c, qs_m.map(|i| &light[i]), &camera[pt]),
+        Some(q) => match dens.at_qs {
+            Some(pdf) => light[q].convert_density(pdf, &camera[pt], c),
+            None => light[q].pdf(c, qs_m.map(|i| &light[i]), &camera[pt]),
+        },
         None => camera[pt].pdf_light_origin(c, &camera[pt_m.unwrap_or(0)]),
     };
     let pt_m_rev = pt_m.map(|m| match qs {
         Some(q) => camera[pt].pdf(c, Some(&light[q]), &camera[m]),
         None => camera[pt].pdf_light(c, &camera[m]),
     });
-    let qs_rev = qs.map(|q| camera[pt].pdf(c, pt_m.map(|i| &camera[i]), &light[q]));
+    let qs_rev = qs.map(|q| match dens.at_pt {
+        Some(pdf) => camera[pt].convert_density(pdf, &light[q], c),
+        None => camera[pt].pdf(c, pt_m.map(|i| &camera[i]), &light[q]),
+    });
     let qs_m_rev = qs_m.map(|m| light[m + 1].pdf(c, Some(&camera[pt]), &light[m]));
     // Set them (and clear the endpoints' delta flags), keeping the old.
     let saved_pt = (camera[pt].pdf_rev, camera[pt].delta);
@@ -272,12 +300,13 @@ fn mis_weight<'a>(
     if let (Some(m), Some(v)) = (qs_m, saved_qs_m) {
         light[m].pdf_rev = v;
     }
-    if let Some(old) = swapped {
-        if s == 1 {
-            light[0] = old;
+    if let Some(v) = sampled {
+        let slot = if s == 1 {
+            &mut light[0]
         } else {
-            camera[0] = old;
-        }
+            &mut camera[0]
+        };
+        slot.swap_endpoint(v);
     }
     1.0 / (1.0 + sum_ri)
 }

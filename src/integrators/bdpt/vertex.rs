@@ -87,6 +87,47 @@ impl<'a> Vertex<'a> {
         }
     }
 
+    /// Exchanges everything but the BSDF and phase function with `other`:
+    /// how a strategy's sampled camera or light vertex takes the place of
+    /// the subpath's endpoint (neither scatters, so they have neither)
+    /// without moving a BSDF's worth of bytes.
+    pub fn swap_endpoint(&mut self, other: &mut Vertex<'a>) {
+        use std::mem::swap;
+        // Written out in full, so that a new field must be placed here.
+        let Vertex {
+            kind,
+            beta,
+            p,
+            p_error,
+            n,
+            ns,
+            wo,
+            time,
+            medium,
+            media,
+            light,
+            bsdf: _,
+            phase: _,
+            delta,
+            pdf_fwd,
+            pdf_rev,
+        } = self;
+        swap(kind, &mut other.kind);
+        swap(beta, &mut other.beta);
+        swap(p, &mut other.p);
+        swap(p_error, &mut other.p_error);
+        swap(n, &mut other.n);
+        swap(ns, &mut other.ns);
+        swap(wo, &mut other.wo);
+        swap(time, &mut other.time);
+        swap(medium, &mut other.medium);
+        swap(media, &mut other.media);
+        swap(light, &mut other.light);
+        swap(delta, &mut other.delta);
+        swap(pdf_fwd, &mut other.pdf_fwd);
+        swap(pdf_rev, &mut other.pdf_rev);
+    }
+
     #[inline]
     pub fn on_surface(&self) -> bool {
         self.n != Vec3::ZERO
@@ -152,26 +193,42 @@ impl<'a> Vertex<'a> {
     /// the adjoint BSDF's corrections for importance: the shading normal's
     /// (pbrt-v3's `CorrectShadingNormal`) and, through a dielectric
     /// boundary, the (η_t/η_i)² that radiance's BTDFs divide by.
-    pub fn f(&self, next: &Vertex, mode: Mode) -> Vec3 {
+    ///
+    /// Also returns the solid-angle density of sampling `next` from here
+    /// having arrived along `wo` (what [`Vertex::pdf`] gives before its
+    /// conversion to area, up to rounding in `wo`), which the MIS weight
+    /// of the strategy connecting here needs; 0 off surfaces and media.
+    pub fn f(&self, next: &Vertex, mode: Mode) -> (Vec3, f32) {
         let wi = next.p - self.p;
         if wi.length_squared() == 0.0 {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0.0);
         }
         let wi = wi.normalize();
         match self.kind {
             Kind::Surface => {
-                let f = self.bsdf.f(self.wo, wi, BxdfFlags::ALL);
-                match mode {
+                let (f, pdf) = self.bsdf.f_pdf(self.wo, wi, BxdfFlags::ALL);
+                let f = match mode {
                     Mode::Radiance => f,
                     Mode::Importance => {
                         let f = f + self.transmission_excess(wi);
                         f * correct_shading_normal(self, self.wo, wi)
                     }
-                }
+                };
+                (f, pdf)
             }
-            Kind::Medium => Vec3::splat(self.phase.p(self.wo, wi)),
-            _ => Vec3::ZERO,
+            Kind::Medium => {
+                let p = self.phase.p(self.wo, wi);
+                (Vec3::splat(p), p)
+            }
+            _ => (Vec3::ZERO, 0.0),
         }
+    }
+
+    /// Whether [`Vertex::pdf`] is a density of scattering (a surface or a
+    /// medium), which [`Vertex::f`] gives with its value.
+    #[inline]
+    pub fn scatters(&self) -> bool {
+        matches!(self.kind, Kind::Surface | Kind::Medium)
     }
 
     /// What importance's BTDF adds to radiance's for the pair (wo, wi)
