@@ -256,21 +256,24 @@ struct VisiblePoint<'a> {
     beta: Vec3,
 }
 
-/// What SPPM keeps per pixel (pbrt-v3's `SPPMPixel`).
-struct Pixel<'a> {
+/// What SPPM keeps per pixel across iterations (pbrt-v3's `SPPMPixel`
+/// without its visible point, which is kept apart: the per-pixel loops
+/// between passes then read a few bytes per pixel, not a BSDF's worth).
+struct Pixel {
     radius: f32,
     /// Emitted and directly sampled light, summed over iterations.
     ld: Vec3,
-    /// This iteration's visible point.
-    vp: Option<VisiblePoint<'a>>,
     /// Photons accumulated so far (γ-weighted) and the flux they carried.
     n: f32,
     tau: Vec3,
 }
 
-/// Bytes SPPM keeps per pixel (its state with the visible point's BSDF),
-/// for the driver's memory check before anything is allocated.
-pub const PIXEL_BYTES: u64 = std::mem::size_of::<Pixel<'static>>() as u64;
+/// Bytes SPPM keeps per pixel (its state, its visible point with a BSDF
+/// and the photon grid's copy of the point), for the driver's memory check
+/// before anything is allocated.
+pub const PIXEL_BYTES: u64 = (std::mem::size_of::<Pixel>()
+    + std::mem::size_of::<Option<VisiblePoint<'static>>>()
+    + std::mem::size_of::<(Vec3, f32)>()) as u64;
 
 /// What [`Sppm::render`] needs of the render: the scene, the film's
 /// (cropped) pixel bounds, the seed of the camera pass's Halton sampler and
@@ -283,8 +286,13 @@ pub struct SppmRun<'r> {
 }
 
 /// Photons per chunk: the unit of parallel work whose contributions are
-/// added in order.
-const PHOTON_CHUNK: u32 = 8192;
+/// added in order (small enough that an iteration of one photon per pixel
+/// of a small film still keeps every thread busy to its end).
+const PHOTON_CHUNK: u32 = 1024;
+
+/// Chunks in flight per thread: their records are kept until the group is
+/// added in.
+const CHUNKS_PER_THREAD: usize = 32;
 
 impl Sppm {
     /// Renders all iterations. `done(k, image)` is called after iteration
@@ -304,11 +312,11 @@ impl Sppm {
             .map(|_| Pixel {
                 radius: s.radius,
                 ld: Vec3::ZERO,
-                vp: None,
                 n: 0.0,
                 tau: Vec3::ZERO,
             })
             .collect();
+        let mut vps: Vec<Option<VisiblePoint>> = (0..n_pixels).map(|_| None).collect();
         let desc = SamplerDesc {
             kind: SamplerKind::Halton,
             pixel_samples: s.iterations,
@@ -319,22 +327,25 @@ impl Sppm {
         let mut counts = RayCounts::default();
         let mut image = vec![Vec3::ZERO; n_pixels];
         for iter in 0..s.iterations {
-            counts.add(&self.camera_pass(run, &sampler, &mut pixels, iter));
-            let grid = Grid::new(&pixels);
-            let (acc, c) = self.photon_pass(run, &grid, &pixels, &bases, iter, photons);
+            counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
+            let grid = run.pool.install(|| Grid::new(&pixels, &vps));
+            let (acc, c) = self.photon_pass(run, &grid, &vps, &bases, iter, photons);
             counts.add(&c);
-            for (p, (phi, m)) in pixels.iter_mut().zip(acc) {
-                update_pixel(p, phi, m);
-            }
             let k = iter + 1;
             let write = k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
             let np = k as u64 * photons as u64;
-            for (l, p) in image.iter_mut().zip(&pixels) {
-                *l = p.ld / k as f32;
-                if np > 0 && p.radius > 0.0 {
-                    *l += p.tau / (np as f32 * std::f32::consts::PI * p.radius * p.radius);
-                }
-            }
+            // Each pixel on its own: in parallel, the same values.
+            run.pool.install(|| {
+                (pixels.par_iter_mut(), vps.par_iter_mut(), acc.into_par_iter(), image.par_iter_mut())
+                    .into_par_iter()
+                    .for_each(|(p, vp, (phi, m), l)| {
+                        update_pixel(p, vp, phi, m);
+                        *l = p.ld / k as f32;
+                        if np > 0 && p.radius > 0.0 {
+                            *l += p.tau / (np as f32 * std::f32::consts::PI * p.radius * p.radius);
+                        }
+                    })
+            });
             done(k, &image, write);
         }
         counts
@@ -346,7 +357,8 @@ impl Sppm {
         &self,
         run: &SppmRun<'a>,
         sampler: &Sampler,
-        pixels: &mut [Pixel<'a>],
+        pixels: &mut [Pixel],
+        vps: &mut [Option<VisiblePoint<'a>>],
         iter: u32,
     ) -> RayCounts {
         let pb = run.pixel_bounds;
@@ -355,15 +367,16 @@ impl Sppm {
         let rows: Vec<RayCounts> = run.pool.install(|| {
             pixels
             .par_chunks_mut(w)
+            .zip(vps.par_chunks_mut(w))
             .enumerate()
-            .map(|(row, px)| {
+            .map(|(row, (px, vp))| {
                 let mut sampler = sampler.clone();
                 let mut scratch = Scratch::default();
                 let y = pb.min.y + row as i32;
-                for (i, p) in px.iter_mut().enumerate() {
+                for (i, (p, vp)) in px.iter_mut().zip(vp).enumerate() {
                     let pixel = IVec2::new(pb.min.x + i as i32, y);
                     sampler.start_pixel_sample(pixel, iter);
-                    self.visible_point(scene, &mut sampler, &mut scratch, pixel, p);
+                    self.visible_point(scene, &mut sampler, &mut scratch, pixel, (p, vp));
                 }
                 scratch.counts()
             })
@@ -382,7 +395,7 @@ impl Sppm {
         sampler: &mut Sampler,
         scratch: &mut Scratch,
         pixel: IVec2,
-        px: &mut Pixel<'a>,
+        (px, vp): (&mut Pixel, &mut Option<VisiblePoint<'a>>),
     ) {
         let lens = scene.camera.uses_lens() || scene.camera.is_moving();
         let cs: CameraSample = sampler.camera_sample(pixel, lens);
@@ -425,7 +438,7 @@ impl Sppm {
                 BxdfFlags::GLOSSY.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
             )) > 0;
             if diffuse || (glossy && depth + 1 == max_depth) {
-                px.vp = Some(VisiblePoint {
+                *vp = Some(VisiblePoint {
                     p: s.point.p,
                     wo,
                     bsdf,
@@ -463,20 +476,20 @@ impl Sppm {
         &self,
         run: &SppmRun,
         grid: &Grid,
-        pixels: &[Pixel],
+        vps: &[Option<VisiblePoint>],
         bases: &[DigitBase],
         iter: u32,
         photons: u32,
     ) -> (Vec<(DVec3, u32)>, RayCounts) {
         let mut counts = RayCounts::default();
-        let mut acc = vec![(DVec3::ZERO, 0u32); pixels.len()];
+        let mut acc = vec![(DVec3::ZERO, 0u32); vps.len()];
         if grid.is_empty() || run.scene.lights.is_empty() {
             return (acc, counts);
         }
         let chunks = photons.div_ceil(PHOTON_CHUNK);
         // Chunks in flight at once: enough for every thread, few enough
         // that their records stay small.
-        let group = (run.pool.current_num_threads().max(1) * 4) as u32;
+        let group = (run.pool.current_num_threads().max(1) * CHUNKS_PER_THREAD) as u32;
         let mut all: Vec<(Vec<(u32, Vec3)>, RayCounts)> = Vec::new();
         let mut first = 0;
         while first < chunks {
@@ -492,7 +505,7 @@ impl Sppm {
                     let mut counts = RayCounts::default();
                     for i in start..end {
                         let index = iter as u64 * photons as u64 + i as u64;
-                        self.trace_photon(run.scene, grid, pixels, bases, index, &mut recs, &mut counts);
+                        self.trace_photon(run.scene, grid, vps, bases, index, &mut recs, &mut counts);
                     }
                     (recs, counts)
                 })
@@ -515,17 +528,17 @@ impl Sppm {
 /// pbrt-v3's per-pixel update after an iteration's photons: the radius
 /// shrinks so that the pixel keeps γ = 2/3 of the new photons, τ is
 /// rescaled to the new disc; the visible point is dropped.
-fn update_pixel(p: &mut Pixel, phi: DVec3, m: u32) {
+fn update_pixel(p: &mut Pixel, vp: &mut Option<VisiblePoint>, phi: DVec3, m: u32) {
     if m > 0 {
         let gamma = 2.0f32 / 3.0;
         let n_new = p.n + gamma * m as f32;
         let r_new = p.radius * (n_new / (p.n + m as f32)).sqrt();
-        let beta = p.vp.as_ref().map_or(Vec3::ZERO, |v| v.beta);
+        let beta = vp.as_ref().map_or(Vec3::ZERO, |v| v.beta);
         p.tau = (p.tau + beta * phi.as_vec3()) * (r_new * r_new) / (p.radius * p.radius);
         p.n = n_new;
         p.radius = r_new;
     }
-    p.vp = None;
+    *vp = None;
 }
 
 /// The radical inverses of one photon's index, dimension by dimension.
@@ -557,7 +570,7 @@ impl Sppm {
         &self,
         scene: &RenderScene,
         grid: &Grid,
-        pixels: &[Pixel],
+        vps: &[Option<VisiblePoint>],
         bases: &[DigitBase],
         index: u64,
         recs: &mut Vec<(u32, Vec3)>,
@@ -602,7 +615,7 @@ impl Sppm {
             };
             let mut s = scene.aggregate.surface_at(&hit, time);
             if depth > 0 {
-                grid.gather(s.point.p, -ray.d, beta, pixels, recs);
+                grid.gather(s.point.p, -ray.d, beta, vps, recs);
             }
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
@@ -660,26 +673,47 @@ struct Grid {
     /// Bucket b lists `entries[starts[b]..starts[b + 1]]`.
     starts: Vec<u32>,
     entries: Vec<u32>,
+    /// Each pixel's visible point and search radius, by pixel index (read
+    /// only for the pixels the buckets list).
+    points: Vec<(Vec3, f32)>,
 }
 
 impl Grid {
-    fn new(pixels: &[Pixel]) -> Grid {
-        let mut bounds = Bounds3::EMPTY;
-        let mut max_radius = 0.0f32;
-        for p in pixels {
-            if let Some(vp) = visible(p) {
-                bounds = bounds
-                    .union_point(vp.p - Vec3::splat(p.radius))
-                    .union_point(vp.p + Vec3::splat(p.radius));
-                max_radius = max_radius.max(p.radius);
-            }
-        }
+    /// Builds the grid on the current thread pool; the same grid for any
+    /// number of threads.
+    fn new(pixels: &[Pixel], vps: &[Option<VisiblePoint>]) -> Grid {
+        let points: Vec<Option<(Vec3, f32)>> = pixels
+            .par_iter()
+            .zip(vps)
+            .map(|(p, vp)| visible(vp).map(|vp| (vp.p, p.radius)))
+            .collect();
+        // Minima and maxima: exact, so in any order.
+        let (bounds, max_radius) = points
+            .par_iter()
+            .flatten()
+            .fold(
+                || (Bounds3::EMPTY, 0.0f32),
+                |(b, m), &(p, r)| {
+                    let b = b
+                        .union_point(p - Vec3::splat(r))
+                        .union_point(p + Vec3::splat(r));
+                    (b, m.max(r))
+                },
+            )
+            .reduce(
+                || (Bounds3::EMPTY, 0.0f32),
+                |(a, ma), (b, mb)| (a.union(&b), ma.max(mb)),
+            );
         let size = pixels.len().max(1);
         let mut grid = Grid {
             bounds,
             res: IVec3::ONE,
             starts: vec![0; size + 1],
             entries: Vec::new(),
+            points: points
+                .iter()
+                .map(|p| p.unwrap_or((Vec3::ZERO, 0.0)))
+                .collect(),
         };
         if max_radius <= 0.0 {
             return grid;
@@ -692,34 +726,40 @@ impl Grid {
             ((base as f32 * diag.y / max_diag) as i32).max(1),
             ((base as f32 * diag.z / max_diag) as i32).max(1),
         );
-        // Count, then fill: buckets list pixels in pixel order.
-        for pass in 0..2 {
-            let mut fill = grid.starts.clone();
-            for (i, p) in pixels.iter().enumerate() {
-                let Some(vp) = visible(p) else { continue };
-                let r = Vec3::splat(p.radius);
-                let (lo, _) = grid.cell(vp.p - r);
-                let (hi, _) = grid.cell(vp.p + r);
-                for z in lo.z..=hi.z {
-                    for y in lo.y..=hi.y {
-                        for x in lo.x..=hi.x {
-                            let b = hash(IVec3::new(x, y, z), size);
-                            if pass == 0 {
-                                grid.starts[b + 1] += 1;
-                            } else {
-                                grid.entries[fill[b] as usize] = i as u32;
-                                fill[b] += 1;
-                            }
-                        }
+        // Every (bucket, pixel) pair in pixel order, made in parallel; then
+        // counted and filled so that buckets list pixels in pixel order.
+        let g = &grid;
+        let pairs: Vec<(u32, u32)> = points
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(i, pt)| {
+                let (lo, hi) = match pt {
+                    Some((p, radius)) => {
+                        let r = Vec3::splat(*radius);
+                        (g.cell(*p - r).0, g.cell(*p + r).0)
                     }
-                }
-            }
-            if pass == 0 {
-                for b in 0..size {
-                    grid.starts[b + 1] += grid.starts[b];
-                }
-                grid.entries = vec![0; grid.starts[size] as usize];
-            }
+                    // An empty range.
+                    None => (IVec3::ONE, IVec3::ZERO),
+                };
+                (lo.z..=hi.z).flat_map(move |z| {
+                    (lo.y..=hi.y).flat_map(move |y| {
+                        (lo.x..=hi.x)
+                            .map(move |x| (hash(IVec3::new(x, y, z), size) as u32, i as u32))
+                    })
+                })
+            })
+            .collect();
+        for &(b, _) in &pairs {
+            grid.starts[b as usize + 1] += 1;
+        }
+        for b in 0..size {
+            grid.starts[b + 1] += grid.starts[b];
+        }
+        grid.entries = vec![0; pairs.len()];
+        let mut fill = grid.starts.clone();
+        for &(b, i) in &pairs {
+            grid.entries[fill[b as usize] as usize] = i;
+            fill[b as usize] += 1;
         }
         grid
     }
@@ -751,7 +791,14 @@ impl Grid {
     /// A photon at `p` arriving from `wi` with flux `beta`: a record for
     /// every visible point within its pixel's radius.
     #[inline]
-    fn gather(&self, p: Vec3, wi: Vec3, beta: Vec3, pixels: &[Pixel], recs: &mut Vec<(u32, Vec3)>) {
+    fn gather(
+        &self,
+        p: Vec3,
+        wi: Vec3,
+        beta: Vec3,
+        vps: &[Option<VisiblePoint>],
+        recs: &mut Vec<(u32, Vec3)>,
+    ) {
         let (c, inside) = self.cell(p);
         if !inside {
             return;
@@ -759,11 +806,12 @@ impl Grid {
         let b = hash(c, self.starts.len() - 1);
         let (lo, hi) = (self.starts[b] as usize, self.starts[b + 1] as usize);
         for &i in &self.entries[lo..hi] {
-            let px = &pixels[i as usize];
-            let Some(vp) = visible(px) else { continue };
-            if vp.p.distance_squared(p) > px.radius * px.radius {
+            // Only pixels with a visible point are listed.
+            let (q, radius) = self.points[i as usize];
+            if q.distance_squared(p) > radius * radius {
                 continue;
             }
+            let Some(vp) = &vps[i as usize] else { continue };
             let phi = beta * vp.bsdf.f(vp.wo, wi, BxdfFlags::ALL);
             recs.push((i, phi));
         }
@@ -772,8 +820,8 @@ impl Grid {
 
 /// The pixel's visible point if it has one that carries light.
 #[inline]
-fn visible<'p, 'a>(p: &'p Pixel<'a>) -> Option<&'p VisiblePoint<'a>> {
-    p.vp.as_ref().filter(|v| v.beta != Vec3::ZERO)
+fn visible<'p, 'a>(vp: &'p Option<VisiblePoint<'a>>) -> Option<&'p VisiblePoint<'a>> {
+    vp.as_ref().filter(|v| v.beta != Vec3::ZERO)
 }
 
 /// pbrt-v3's grid hash.
