@@ -248,7 +248,8 @@ impl Integrate for Sppm {
     }
 }
 
-/// A pixel's visible point: where its camera path met a diffuse surface.
+/// A pixel's visible point: where its camera path met a diffuse surface;
+/// none while `beta` is zero. Its BSDF is shaded in place.
 struct VisiblePoint<'a> {
     p: Vec3,
     wo: Vec3,
@@ -272,7 +273,7 @@ struct Pixel {
 /// and the photon grid's copy of the point), for the driver's memory check
 /// before anything is allocated.
 pub const PIXEL_BYTES: u64 = (std::mem::size_of::<Pixel>()
-    + std::mem::size_of::<Option<VisiblePoint<'static>>>()
+    + std::mem::size_of::<VisiblePoint<'static>>()
     + std::mem::size_of::<(Vec3, f32)>()) as u64;
 
 /// What [`Sppm::render`] needs of the render: the scene, the film's
@@ -316,7 +317,14 @@ impl Sppm {
                 tau: Vec3::ZERO,
             })
             .collect();
-        let mut vps: Vec<Option<VisiblePoint>> = (0..n_pixels).map(|_| None).collect();
+        let mut vps: Vec<VisiblePoint> = (0..n_pixels)
+            .map(|_| VisiblePoint {
+                p: Vec3::ZERO,
+                wo: Vec3::ZERO,
+                bsdf: Bsdf::empty(),
+                beta: Vec3::ZERO,
+            })
+            .collect();
         let desc = SamplerDesc {
             kind: SamplerKind::Halton,
             pixel_samples: s.iterations,
@@ -358,7 +366,7 @@ impl Sppm {
         run: &SppmRun<'a>,
         sampler: &Sampler,
         pixels: &mut [Pixel],
-        vps: &mut [Option<VisiblePoint<'a>>],
+        vps: &mut [VisiblePoint<'a>],
         iter: u32,
     ) -> RayCounts {
         let pb = run.pixel_bounds;
@@ -395,7 +403,7 @@ impl Sppm {
         sampler: &mut Sampler,
         scratch: &mut Scratch,
         pixel: IVec2,
-        (px, vp): (&mut Pixel, &mut Option<VisiblePoint<'a>>),
+        (px, vp): (&mut Pixel, &mut VisiblePoint<'a>),
     ) {
         let lens = scene.camera.uses_lens() || scene.camera.is_moving();
         let cs: CameraSample = sampler.camera_sample(pixel, lens);
@@ -424,13 +432,13 @@ impl Sppm {
                 ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
                 continue;
             }
-            let mut bsdf = Bsdf::empty();
-            shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
+            shade(scene, &hit, &mut s, material, true, None, &mut vp.bsdf);
+            let bsdf = &vp.bsdf;
             let wo = -ray.d;
             if depth == 0 || specular_bounce {
                 px.ld += beta * emitted(scene, &s, wo);
             }
-            px.ld += beta * sample_one_light(scene, &s, &bsdf, wo, sampler, scratch, &self.direct);
+            px.ld += beta * sample_one_light(scene, &s, bsdf, wo, sampler, scratch, &self.direct);
             let diffuse = bsdf.num_components(BxdfFlags(
                 BxdfFlags::DIFFUSE.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
             )) > 0;
@@ -438,12 +446,9 @@ impl Sppm {
                 BxdfFlags::GLOSSY.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
             )) > 0;
             if diffuse || (glossy && depth + 1 == max_depth) {
-                *vp = Some(VisiblePoint {
-                    p: s.point.p,
-                    wo,
-                    bsdf,
-                    beta,
-                });
+                vp.p = s.point.p;
+                vp.wo = wo;
+                vp.beta = beta;
                 return;
             }
             if depth + 1 < max_depth {
@@ -476,7 +481,7 @@ impl Sppm {
         &self,
         run: &SppmRun,
         grid: &Grid,
-        vps: &[Option<VisiblePoint>],
+        vps: &[VisiblePoint],
         bases: &[DigitBase],
         iter: u32,
         photons: u32,
@@ -528,17 +533,17 @@ impl Sppm {
 /// pbrt-v3's per-pixel update after an iteration's photons: the radius
 /// shrinks so that the pixel keeps γ = 2/3 of the new photons, τ is
 /// rescaled to the new disc; the visible point is dropped.
-fn update_pixel(p: &mut Pixel, vp: &mut Option<VisiblePoint>, phi: DVec3, m: u32) {
+fn update_pixel(p: &mut Pixel, vp: &mut VisiblePoint, phi: DVec3, m: u32) {
     if m > 0 {
         let gamma = 2.0f32 / 3.0;
         let n_new = p.n + gamma * m as f32;
         let r_new = p.radius * (n_new / (p.n + m as f32)).sqrt();
-        let beta = vp.as_ref().map_or(Vec3::ZERO, |v| v.beta);
+        let beta = vp.beta;
         p.tau = (p.tau + beta * phi.as_vec3()) * (r_new * r_new) / (p.radius * p.radius);
         p.n = n_new;
         p.radius = r_new;
     }
-    *vp = None;
+    vp.beta = Vec3::ZERO;
 }
 
 /// The radical inverses of one photon's index, dimension by dimension.
@@ -570,7 +575,7 @@ impl Sppm {
         &self,
         scene: &RenderScene,
         grid: &Grid,
-        vps: &[Option<VisiblePoint>],
+        vps: &[VisiblePoint],
         bases: &[DigitBase],
         index: u64,
         recs: &mut Vec<(u32, Vec3)>,
@@ -681,7 +686,7 @@ struct Grid {
 impl Grid {
     /// Builds the grid on the current thread pool; the same grid for any
     /// number of threads.
-    fn new(pixels: &[Pixel], vps: &[Option<VisiblePoint>]) -> Grid {
+    fn new(pixels: &[Pixel], vps: &[VisiblePoint]) -> Grid {
         let points: Vec<Option<(Vec3, f32)>> = pixels
             .par_iter()
             .zip(vps)
@@ -796,7 +801,7 @@ impl Grid {
         p: Vec3,
         wi: Vec3,
         beta: Vec3,
-        vps: &[Option<VisiblePoint>],
+        vps: &[VisiblePoint],
         recs: &mut Vec<(u32, Vec3)>,
     ) {
         let (c, inside) = self.cell(p);
@@ -811,7 +816,7 @@ impl Grid {
             if q.distance_squared(p) > radius * radius {
                 continue;
             }
-            let Some(vp) = &vps[i as usize] else { continue };
+            let vp = &vps[i as usize];
             let phi = beta * vp.bsdf.f(vp.wo, wi, BxdfFlags::ALL);
             recs.push((i, phi));
         }
@@ -820,8 +825,8 @@ impl Grid {
 
 /// The pixel's visible point if it has one that carries light.
 #[inline]
-fn visible<'p, 'a>(vp: &'p Option<VisiblePoint<'a>>) -> Option<&'p VisiblePoint<'a>> {
-    vp.as_ref().filter(|v| v.beta != Vec3::ZERO)
+fn visible<'p, 'a>(vp: &'p VisiblePoint<'a>) -> Option<&'p VisiblePoint<'a>> {
+    Some(vp).filter(|v| v.beta != Vec3::ZERO)
 }
 
 /// pbrt-v3's grid hash.
