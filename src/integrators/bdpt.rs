@@ -48,7 +48,7 @@ use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
 use crate::shapes::SurfacePoint;
 use glam::{Vec2, Vec3};
-use vertex::{random_walk, Kind, Mode, Vertex, Walk};
+use vertex::{push_at, random_walk, Kind, Mode, Vertex, Walk};
 
 pub const PARAMS: &[ParamSpec] = &[
     MAX_DEPTH,
@@ -384,14 +384,14 @@ pub(super) fn camera_subpath<'a>(
     scratch: &mut Scratch,
 ) -> usize {
     let pdf_dir = c.camera.pdf_we(ray.o, ray.d, time).1;
-    cam.push(Vertex::at(
+    push_at(
+        cam,
         Kind::Camera,
         ray.o,
         Vec3::ZERO,
         Vec3::ONE,
-        time,
-        c.camera_medium,
-    ));
+        (time, c.camera_medium),
+    );
     let walk = Walk {
         ray,
         diff,
@@ -429,10 +429,10 @@ pub(super) fn light_subpath<'a>(
     if e.pdf_pos == 0.0 || e.pdf_dir == 0.0 || e.le == Vec3::ZERO {
         return 0;
     }
-    let mut v = Vertex::at(Kind::Light, e.ray.o, e.n, e.le, time, c.camera_medium);
+    push_at(path, Kind::Light, e.ray.o, e.n, e.le, (time, c.camera_medium));
+    let v = &mut path[0];
     v.light = Some(i);
     v.pdf_fwd = e.pdf_pos * pmf;
-    path.push(v);
     let beta = e.le * e.n.dot(e.ray.d).abs() / (pmf * e.pdf_pos * e.pdf_dir);
     let walk = Walk {
         ray: e.ray,

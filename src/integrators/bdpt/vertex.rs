@@ -16,6 +16,24 @@ use crate::media::HenyeyGreenstein;
 use crate::samplers::Sampler;
 use glam::Vec3;
 
+/// Appends [`Vertex::at`]`(kind, p, n, beta, time, medium)` to `path`,
+/// built in the vector's next slot: a vertex holds its BSDF's storage,
+/// which a vertex built on the stack and pushed would copy whole.
+pub(crate) fn push_at<'a>(
+    path: &mut Vec<Vertex<'a>>,
+    kind: Kind,
+    p: Vec3,
+    n: Vec3,
+    beta: Vec3,
+    (time, medium): (f32, Option<u32>),
+) {
+    path.reserve(1);
+    let len = path.len();
+    path.spare_capacity_mut()[0].write(Vertex::at(kind, p, n, beta, time, medium));
+    // SAFETY: `reserve` made slot `len` exist and it was just written.
+    unsafe { path.set_len(len + 1) };
+}
+
 /// What a vertex is (pbrt-v3's `VertexType`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kind {
@@ -439,11 +457,12 @@ pub(crate) fn random_walk<'a>(
         let prev = path.len() - 1;
         if let Some((t, phase)) = scattered {
             let p = ray.at(t);
-            let mut v = Vertex::at(Kind::Medium, p, Vec3::ZERO, beta, time, medium);
+            push_at(path, Kind::Medium, p, Vec3::ZERO, beta, (time, medium));
+            let (before, new) = path.split_at_mut(prev + 1);
+            let v = &mut new[0];
             v.wo = -ray.d.normalize();
             v.phase = phase;
-            v.pdf_fwd = path[prev].convert_density(pdf_fwd, &v, c);
-            path.push(v);
+            v.pdf_fwd = before[prev].convert_density(pdf_fwd, v, c);
             bounces += 1;
             if bounces >= max_depth {
                 break;
@@ -457,9 +476,8 @@ pub(crate) fn random_walk<'a>(
         } else {
             let Some(h) = hit else {
                 if mode == Mode::Radiance {
-                    let mut v = Vertex::at(Kind::Light, ray.o + ray.d, -ray.d, beta, time, medium);
-                    v.pdf_fwd = pdf_fwd;
-                    path.push(v);
+                    push_at(path, Kind::Light, ray.o + ray.d, -ray.d, beta, (time, medium));
+                    path[prev + 1].pdf_fwd = pdf_fwd;
                     bounces += 1;
                 }
                 break;
@@ -475,8 +493,7 @@ pub(crate) fn random_walk<'a>(
                 ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
                 continue;
             }
-            // Made in place: a vertex holds its BSDF, too big to move.
-            path.push(Vertex::at(Kind::Surface, s.point.p, s.point.n, beta, time, medium));
+            push_at(path, Kind::Surface, s.point.p, s.point.n, beta, (time, medium));
             let (before, new) = path.split_at_mut(prev + 1);
             let v = &mut new[0];
             shade(
