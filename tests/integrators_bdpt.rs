@@ -94,19 +94,7 @@ fn a_diffuse_scene_converges_to_paths_image() {
     // taken down by 2×2 averages.
     let d = sized(load("scenes/bdpt/cornell.pbrt"), 64, 64, 64);
     let img = render_threads(&d, 2);
-    let full = reference("cornell-path");
-    let mut r = Image::new(64, 64);
-    for y in 0..64 {
-        for x in 0..64 {
-            for c in 0..3 {
-                let v = |dx: u32, dy: u32| {
-                    full.data[(((2 * y + dy) * 128 + 2 * x + dx) * 3 + c) as usize]
-                };
-                r.data[((y * 64 + x) * 3 + c) as usize] =
-                    (v(0, 0) + v(1, 0) + v(0, 1) + v(1, 1)) / 4.0;
-            }
-        }
-    }
+    let r = common::halved(&reference("cornell-path"));
     let (md, be) = (mean_difference(&img, &r), block_error(&img, &r, 8));
     eprintln!("cornell: mean difference {md:.5}, 8×8 block error {be:.5}");
     assert!(md < 0.01, "mean differs by {md}");

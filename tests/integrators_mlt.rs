@@ -82,19 +82,7 @@ fn the_cornell_box_converges_to_paths_image() {
     // at these settings: luminance mean off 1.0%, channels up to 1.7%,
     // relative MSE 0.0108, block error 0.038).
     let img = render_threads(&load("scenes/mlt/cornell.pbrt"), 2);
-    let full = reference("cornell-path");
-    let mut r = Image::new(64, 64);
-    for y in 0..64 {
-        for x in 0..64 {
-            for c in 0..3 {
-                let v = |dx: u32, dy: u32| {
-                    full.data[(((2 * y + dy) * 128 + 2 * x + dx) * 3 + c) as usize]
-                };
-                r.data[((y * 64 + x) * 3 + c) as usize] =
-                    (v(0, 0) + v(1, 0) + v(0, 1) + v(1, 1)) / 4.0;
-            }
-        }
-    }
+    let r = common::halved(&reference("cornell-path"));
     check("mlt cornell", &img, &r, 0.03, 0.05, 0.02, 0.07);
 }
 

@@ -274,7 +274,7 @@ struct Pixel {
 /// before anything is allocated.
 pub const PIXEL_BYTES: u64 = (std::mem::size_of::<Pixel>()
     + std::mem::size_of::<VisiblePoint<'static>>()
-    + std::mem::size_of::<(Vec3, f32)>()) as u64;
+    + std::mem::size_of::<Option<(Vec3, f32)>>()) as u64;
 
 /// What [`Sppm::render`] needs of the render: the scene, the film's
 /// (cropped) pixel bounds, the seed of the camera pass's Halton sampler and
@@ -678,9 +678,9 @@ struct Grid {
     /// Bucket b lists `entries[starts[b]..starts[b + 1]]`.
     starts: Vec<u32>,
     entries: Vec<u32>,
-    /// Each pixel's visible point and search radius, by pixel index (read
-    /// only for the pixels the buckets list).
-    points: Vec<(Vec3, f32)>,
+    /// Each pixel's visible point and search radius, by pixel index (none
+    /// where the pixel has no visible point that carries light).
+    points: Vec<Option<(Vec3, f32)>>,
 }
 
 impl Grid {
@@ -690,7 +690,7 @@ impl Grid {
         let points: Vec<Option<(Vec3, f32)>> = pixels
             .par_iter()
             .zip(vps)
-            .map(|(p, vp)| visible(vp).map(|vp| (vp.p, p.radius)))
+            .map(|(p, vp)| (vp.beta != Vec3::ZERO).then_some((vp.p, p.radius)))
             .collect();
         // Minima and maxima: exact, so in any order.
         let (bounds, max_radius) = points
@@ -715,10 +715,7 @@ impl Grid {
             res: IVec3::ONE,
             starts: vec![0; size + 1],
             entries: Vec::new(),
-            points: points
-                .iter()
-                .map(|p| p.unwrap_or((Vec3::ZERO, 0.0)))
-                .collect(),
+            points,
         };
         if max_radius <= 0.0 {
             return grid;
@@ -734,7 +731,8 @@ impl Grid {
         // Every (bucket, pixel) pair in pixel order, made in parallel; then
         // counted and filled so that buckets list pixels in pixel order.
         let g = &grid;
-        let pairs: Vec<(u32, u32)> = points
+        let pairs: Vec<(u32, u32)> = g
+            .points
             .par_iter()
             .enumerate()
             .flat_map_iter(|(i, pt)| {
@@ -812,7 +810,9 @@ impl Grid {
         let (lo, hi) = (self.starts[b] as usize, self.starts[b + 1] as usize);
         for &i in &self.entries[lo..hi] {
             // Only pixels with a visible point are listed.
-            let (q, radius) = self.points[i as usize];
+            let Some((q, radius)) = self.points[i as usize] else {
+                continue;
+            };
             if q.distance_squared(p) > radius * radius {
                 continue;
             }
@@ -821,12 +821,6 @@ impl Grid {
             recs.push((i, phi));
         }
     }
-}
-
-/// The pixel's visible point if it has one that carries light.
-#[inline]
-fn visible<'p, 'a>(vp: &'p VisiblePoint<'a>) -> Option<&'p VisiblePoint<'a>> {
-    Some(vp).filter(|v| v.beta != Vec3::ZERO)
 }
 
 /// pbrt-v3's grid hash.

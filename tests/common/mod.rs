@@ -204,6 +204,25 @@ pub fn average(images: &[Image]) -> Image {
     out
 }
 
+/// `img` at half its width and height, each pixel the mean of the 2×2 it
+/// covers (a converged reference taken down to a test's smaller film).
+pub fn halved(img: &Image) -> Image {
+    let (w, h) = (img.width / 2, img.height / 2);
+    let mut r = Image::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            for c in 0..3 {
+                let v = |dx: u32, dy: u32| {
+                    img.data[(((2 * y + dy) * img.width + 2 * x + dx) * 3 + c) as usize]
+                };
+                r.data[((y * w + x) * 3 + c) as usize] =
+                    (v(0, 0) + v(1, 0) + v(0, 1) + v(1, 1)) / 4.0;
+            }
+        }
+    }
+    r
+}
+
 /// The materials of `Material {decl}` (after the named materials it refers
 /// to, in the scene's order, linked as the renderer links them) and the
 /// index of the statement's own, loaded through the real scene loader.

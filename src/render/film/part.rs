@@ -432,6 +432,21 @@ pub fn read_part(path: &Path) -> Result<Part, String> {
             .filter(|s| s.len() == n)
             .ok_or_else(|| fail(format!("the part has no channel {name} of {n} samples")))
     };
+    // The f64 sums `name` from its bit patterns (the channels
+    // `f64_channels` writes).
+    let f64_channel = |name: &str| -> std::result::Result<Vec<f64>, String> {
+        let (FlatSamples::U32(hi), FlatSamples::U32(lo)) = (
+            channel(&format!("{name}.hi"))?,
+            channel(&format!("{name}.lo"))?,
+        ) else {
+            return Err(fail(format!("channels {name}.hi/.lo are not UINT")));
+        };
+        Ok(hi
+            .iter()
+            .zip(lo)
+            .map(|(&h, &l)| f64::from_bits(((h as u64) << 32) | l as u64))
+            .collect())
+    };
     let data = match header.kind {
         PartKind::Tile { .. } => {
             let mut rgb = vec![0.0f32; 3 * n];
@@ -448,14 +463,7 @@ pub fn read_part(path: &Path) -> Result<Part, String> {
         PartKind::Samples { .. } => {
             let mut sums = vec![PixelSums::default(); n];
             for (c, name) in SUM_CHANNELS.iter().enumerate() {
-                let (FlatSamples::U32(hi), FlatSamples::U32(lo)) = (
-                    channel(&format!("{name}.hi"))?,
-                    channel(&format!("{name}.lo"))?,
-                ) else {
-                    return Err(fail(format!("channels {name}.hi/.lo are not UINT")));
-                };
-                for (i, s) in sums.iter_mut().enumerate() {
-                    let v = f64::from_bits(((hi[i] as u64) << 32) | lo[i] as u64);
+                for (s, v) in sums.iter_mut().zip(f64_channel(name)?) {
                     if c < 3 {
                         s.contrib[c] = v;
                     } else {
@@ -474,14 +482,8 @@ pub fn read_part(path: &Path) -> Result<Part, String> {
     let splats = if has_splats && matches!(header.kind, PartKind::Samples { .. }) {
         let mut v = vec![[0.0f64; 3]; n];
         for (c, name) in SPLAT_CHANNELS.iter().enumerate() {
-            let (FlatSamples::U32(hi), FlatSamples::U32(lo)) = (
-                channel(&format!("{name}.hi"))?,
-                channel(&format!("{name}.lo"))?,
-            ) else {
-                return Err(fail(format!("channels {name}.hi/.lo are not UINT")));
-            };
-            for (i, s) in v.iter_mut().enumerate() {
-                s[c] = f64::from_bits(((hi[i] as u64) << 32) | lo[i] as u64);
+            for (s, x) in v.iter_mut().zip(f64_channel(name)?) {
+                s[c] = x;
             }
         }
         Some(v)
