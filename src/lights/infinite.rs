@@ -28,7 +28,10 @@
 //!   `pdf(s, t) / (2π² sin θ)`, 0 at the poles.
 //! - Power: `π r² · Lookup((0.5, 0.5), 0.5)`, r the scene's bounding radius
 //!   (set when the scene is built, [`LightModel::preprocess`]).
-//! - A one-pixel map is the same as no map: both are a 1 × 1 MIP map.
+//! - A one-pixel map is the same as no map: both are a 1 × 1 MIP map. Its
+//!   lookups are its value and its distribution is uniform in (s, t), so
+//!   pbrs evaluates them as such (equal to pbrt-v3's bilinear lookups and
+//!   2 × 2 distribution up to rounding).
 //!
 //! `sampling "uniform"` samples the sphere uniformly instead (density
 //! 1/4π), for comparisons with the importance-sampled map (`pbrs converge`);
@@ -249,6 +252,10 @@ impl Level {
 pub struct EnvMap {
     levels: Vec<Level>,
     distribution: Distribution2D,
+    /// The radiance of a one-texel map (no map, or a 1 × 1 image): then
+    /// every lookup is this value and the sampling distribution uniform in
+    /// (φ, θ), so lookups and sampling skip the map's arithmetic.
+    constant: Option<Vec3>,
     sampling: EnvSampling,
     light_to_world: Mat3,
     world_to_light: Mat3,
@@ -368,9 +375,13 @@ impl EnvMap {
         } else {
             glam::DMat3::IDENTITY
         };
+        // (Only with light to sample: a dark one keeps the map's handling.)
+        let constant =
+            Some(levels[0].texels[0]).filter(|&l| w == 1 && h == 1 && luminance(l) > 0.0);
         let mut map = EnvMap {
             levels,
             distribution: Distribution2D::new(&[1.0], 1, 1),
+            constant,
             sampling,
             light_to_world: lin.as_mat3(),
             world_to_light: inv.as_mat3(),
@@ -423,6 +434,9 @@ impl EnvMap {
     /// scene (pbrt-v3's `Le`).
     #[inline]
     pub fn le(&self, d: Vec3) -> Vec3 {
+        if let Some(l) = self.constant {
+            return l;
+        }
         let w = (self.world_to_light * d).normalize();
         self.levels[0].bilerp(Self::st(w))
     }
@@ -434,7 +448,10 @@ impl EnvMap {
             let wi = uniform_sample_sphere(u);
             return Some((wi, self.le(wi), uniform_sphere_pdf()));
         }
-        let (uv, map_pdf) = self.distribution.sample_continuous(u);
+        let (uv, map_pdf) = match self.constant {
+            Some(_) => (u, 1.0),
+            None => self.distribution.sample_continuous(u),
+        };
         if map_pdf == 0.0 {
             return None;
         }
@@ -447,7 +464,11 @@ impl EnvMap {
             return None;
         }
         let pdf = map_pdf / (2.0 * PI * PI * sin_theta);
-        Some((wi, self.levels[0].bilerp(uv), pdf))
+        let li = match self.constant {
+            Some(l) => l,
+            None => self.levels[0].bilerp(uv),
+        };
+        Some((wi, li, pdf))
     }
 
     /// Solid-angle density of `sample` choosing world direction `wi`.
@@ -457,6 +478,15 @@ impl EnvMap {
             return uniform_sphere_pdf();
         }
         let w = (self.world_to_light * wi).normalize();
+        if self.constant.is_some() {
+            // Uniform in (φ, θ): sin θ from the direction alone.
+            let z = w.z.clamp(-1.0, 1.0);
+            let sin_theta = (1.0 - z * z).max(0.0).sqrt();
+            if sin_theta == 0.0 {
+                return 0.0;
+            }
+            return 1.0 / (2.0 * PI * PI * sin_theta);
+        }
         let st = Self::st(w);
         let sin_theta = (st.y * PI).sin();
         if sin_theta == 0.0 {
@@ -502,6 +532,52 @@ mod tests {
 
     fn rotated() -> DMat4 {
         DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2) * DMat4::from_rotation_z(0.3)
+    }
+
+    /// A one-texel map takes the constant shortcuts; the same map without
+    /// them takes the general path (bilinear lookups, the search of its 2 × 2
+    /// distribution, θ from acos): both give the same radiance, directions
+    /// and densities up to rounding.
+    #[test]
+    fn constant_map_matches_the_general_path() {
+        let l = Vec3::new(0.3, 0.5, 0.9);
+        let one = EnvMap::new(None, l, rotated(), EnvSampling::Map);
+        let mut general = EnvMap::new(
+            Some(&image(1, 1, |_, _| l)),
+            Vec3::ONE,
+            rotated(),
+            EnvSampling::Map,
+        );
+        assert!(one.constant.is_some() && general.constant.is_some());
+        general.constant = None;
+        let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()).max(1e-3);
+        let mut rng = crate::sampling::Pcg32::with_sequence(11);
+        for _ in 0..10_000 {
+            let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+            let (a, b) = (one.sample(u), general.sample(u));
+            let (Some((wa, la, pa)), Some((wb, lb, pb))) = (a, b) else {
+                assert_eq!(a.is_some(), b.is_some(), "u = {u}");
+                continue;
+            };
+            assert!((wa - wb).length() < 1e-4, "u = {u}: {wa} against {wb}");
+            assert!(close(pa, pb), "u = {u}: pdf {pa} against {pb}");
+            assert!((la - lb).abs().max_element() < 1e-5 && (la - l).abs().max_element() < 1e-6);
+            let d = Vec3::new(
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+                rng.uniform_f32() - 0.5,
+            );
+            if d.length() > 1e-3 {
+                let d = d.normalize();
+                assert!(
+                    close(one.pdf(d), general.pdf(d)),
+                    "{d}: {} against {}",
+                    one.pdf(d),
+                    general.pdf(d)
+                );
+                assert!((one.le(d) - general.le(d)).abs().max_element() < 1e-5);
+            }
+        }
     }
 
     /// Chi-square test of `sample` (directions) against `pdf` (solid angle),
