@@ -10,7 +10,7 @@
 //! | `mapname` | string (image file) | none: constant `L` | lat-long map, read raw |
 //! | `nsamples` | integer | 1 | shadow samples for `directlighting` "all" |
 //! | `samples` | integer | `nsamples` | the same; wins over `nsamples` |
-//! | `sampling` | string: `"map"` or `"uniform"` | `"map"` | how directions are sampled (**pbrs extension**) |
+//! | `sampling` | string: `"map"`, `"alias"` or `"uniform"` | `"map"` | how directions are sampled (**pbrs extension**) |
 //!
 //! As pbrt-v3 does it:
 //! - The map is read raw (8-bit files are not sRGB-decoded) and multiplied
@@ -34,8 +34,12 @@
 //!   2 × 2 distribution up to rounding).
 //!
 //! `sampling "uniform"` samples the sphere uniformly instead (density
-//! 1/4π), for comparisons with the importance-sampled map (`pbrs converge`);
-//! another value: warning, `"map"`. Directions leave the light's transform
+//! 1/4π), for comparisons with the importance-sampled map (`pbrs converge`).
+//! `sampling "alias"` samples pbrt-v3's density with alias tables: one
+//! table entry per dimension instead of two binary searches of CDFs that,
+//! for a large map, do not fit in cache; the same density (so the same
+//! expected image and MIS weights), other directions for the same sample
+//! values. Another value: warning, `"map"`. Directions leave the light's transform
 //! normalised (pbrt-v3 leaves them as transformed, which differs only for a
 //! transform that scales).
 
@@ -43,6 +47,7 @@ use super::{disk_ray, EmittedRay, LightKind, LightModel, LightSample};
 use crate::accel::Aggregate;
 use crate::geometry::spawn_ray;
 use crate::geometry::{luminance, Ray};
+use crate::sampling::alias::Alias2D;
 use crate::sampling::{uniform_sample_sphere, uniform_sphere_pdf, Distribution2D};
 use crate::scene::RgbImage;
 use crate::scene::{Decode, ParamSpec, ParamValues, Report, Support};
@@ -73,7 +78,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::string(
         "sampling",
         "map",
-        "pbrs extension: \"map\" (importance by the map, pbrt-v3's) or \"uniform\" (the sphere uniformly)",
+        "pbrs extension: \"map\" (importance by the map, pbrt-v3's), \"alias\" (the same density in constant time by alias tables) or \"uniform\" (the sphere uniformly)",
     ),
 ];
 
@@ -97,6 +102,11 @@ pub enum EnvSampling {
     /// Uniformly over the sphere: the pbrs extension `"string sampling"
     /// "uniform"`, to compare against importance sampling.
     Uniform,
+    /// pbrt-v3's density, sampled in constant time by alias tables
+    /// ([`Alias2D`]) instead of by searching the CDFs: the pbrs extension
+    /// `"string sampling" "alias"`. Other directions for the same sample
+    /// values, so other noise; the same expected image.
+    Alias,
 }
 
 #[derive(Clone, Debug)]
@@ -115,10 +125,11 @@ impl InfiniteLight {
         let sampling = match p.string("sampling") {
             "map" => EnvSampling::Map,
             "uniform" => EnvSampling::Uniform,
+            "alias" => EnvSampling::Alias,
             other => {
                 report.warn(
                     Some("sampling"),
-                    format!("unknown infinite light sampling \"{other}\" (pbrs has \"map\" and \"uniform\"): \"map\" is used"),
+                    format!("unknown infinite light sampling \"{other}\" (pbrs has \"map\", \"alias\" and \"uniform\"): \"map\" is used"),
                     "unknown sampling",
                 );
                 EnvSampling::Map
@@ -252,6 +263,8 @@ impl Level {
 pub struct EnvMap {
     levels: Vec<Level>,
     distribution: Distribution2D,
+    /// The alias tables of `distribution` (`sampling "alias"` only).
+    alias: Option<Box<Alias2D>>,
     /// The radiance of a one-texel map (no map, or a 1 × 1 image): then
     /// every lookup is this value and the sampling distribution uniform in
     /// (φ, θ), so lookups and sampling skip the map's arithmetic.
@@ -381,12 +394,13 @@ impl EnvMap {
         let mut map = EnvMap {
             levels,
             distribution: Distribution2D::new(&[1.0], 1, 1),
+            alias: None,
             constant,
             sampling,
             light_to_world: lin.as_mat3(),
             world_to_light: inv.as_mat3(),
         };
-        if sampling == EnvSampling::Map {
+        if sampling != EnvSampling::Uniform {
             let (dw, dh) = (2 * w, 2 * h);
             let fwidth = 0.5 / dw.min(dh) as f32;
             let mut f = vec![0.0f32; dw * dh];
@@ -399,6 +413,9 @@ impl EnvMap {
                 }
             });
             map.distribution = Distribution2D::new(&f, dw, dh);
+            if sampling == EnvSampling::Alias {
+                map.alias = Some(Box::new(Alias2D::new(&map.distribution)));
+            }
         }
         map
     }
@@ -448,9 +465,10 @@ impl EnvMap {
             let wi = uniform_sample_sphere(u);
             return Some((wi, self.le(wi), uniform_sphere_pdf()));
         }
-        let (uv, map_pdf) = match self.constant {
-            Some(_) => (u, 1.0),
-            None => self.distribution.sample_continuous(u),
+        let (uv, map_pdf) = match (self.constant, &self.alias) {
+            (Some(_), _) => (u, 1.0),
+            (None, Some(alias)) => alias.sample_continuous(u),
+            (None, None) => self.distribution.sample_continuous(u),
         };
         if map_pdf == 0.0 {
             return None;
@@ -589,8 +607,13 @@ mod tests {
     fn sample_li_matches_pdf_li_chi_square() {
         use crate::sampling::chi2::chi2_survival;
         use std::f64::consts::PI as PI64;
-        for (w, h) in [(16, 8), (12, 5)] {
-            let map = EnvMap::new(Some(&lumpy(w, h)), Vec3::ONE, rotated(), EnvSampling::Map);
+        for (w, h, sampling) in [
+            (16, 8, EnvSampling::Map),
+            (12, 5, EnvSampling::Map),
+            (16, 8, EnvSampling::Alias),
+            (12, 5, EnvSampling::Alias),
+        ] {
+            let map = EnvMap::new(Some(&lumpy(w, h)), Vec3::ONE, rotated(), sampling);
             // Both maps give a 32 × 16 distribution (12 × 5 is resampled to 16 × 8).
             let (np, nt) = (32usize, 16usize);
             let to_light = |d: Vec3| (map.world_to_light * d).normalize();

@@ -67,7 +67,7 @@ pub(crate) fn find_interval_by(len: usize, u: f32, cdf: impl Fn(usize) -> f32) -
 /// `(offset + du) / n` strictly inside bin `offset` and strictly below 1, so
 /// that `pdf(x)` finds the bin the sample came from.
 #[inline]
-fn point_in_bin(offset: usize, du: f32, n: usize) -> f32 {
+pub(crate) fn point_in_bin(offset: usize, du: f32, n: usize) -> f32 {
     let nf = n as f32;
     let mut x = ((offset as f32 + du) / nf).min(ONE_MINUS_EPSILON);
     // Rounding can push x onto the next bin's edge: step down until it maps back.

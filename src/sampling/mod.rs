@@ -2,6 +2,7 @@
 //! warps from the unit square with their densities, MIS heuristics, and a
 //! reusable chi-square harness ([`chi2`]) to test any of them.
 
+pub mod alias;
 pub mod chi2;
 pub mod distribution;
 pub mod interpolation;
