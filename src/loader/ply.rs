@@ -319,7 +319,8 @@ fn read_vertices(r: &mut Reader, el: &Element, mesh: &mut MeshData) -> Result<()
         &format!("the mesh's {} vertices", el.count),
         (el.count as u64).saturating_mul(per),
     )?;
-    mesh.positions.reserve(el.count);
+    let positions = std::sync::Arc::make_mut(&mut mesh.positions);
+    positions.reserve(el.count);
     let mut normals = Vec::with_capacity(if normal.is_some() { el.count } else { 0 });
     let mut uvs = Vec::with_capacity(if uv.is_some() { el.count } else { 0 });
     let mut vals = vec![0.0f64; el.props.len()];
@@ -327,8 +328,7 @@ fn read_vertices(r: &mut Reader, el: &Element, mesh: &mut MeshData) -> Result<()
         for (k, p) in el.props.iter().enumerate() {
             vals[k] = read_prop(r, p)?.unwrap_or(0.0);
         }
-        mesh.positions
-            .push(Vec3::new(vals[x] as f32, vals[y] as f32, vals[z] as f32));
+        positions.push(Vec3::new(vals[x] as f32, vals[y] as f32, vals[z] as f32));
         if let Some([a, b, c]) = normal {
             normals.push(Vec3::new(vals[a] as f32, vals[b] as f32, vals[c] as f32));
         }
@@ -364,9 +364,9 @@ fn read_faces(
     if li.is_some_and(|i| !el.props[i].ty.is_integer()) {
         return Err("`vertex_indices` is not a list of integers".into());
     }
-    mesh.indices
-        .reserve(el.count.saturating_mul(3).min(r.left()));
     let nverts = mesh.positions.len();
+    let indices = std::sync::Arc::make_mut(&mut mesh.indices);
+    indices.reserve(el.count.saturating_mul(3).min(r.left()));
     // pbrt-v3's `face_indices`: a Ptex face per face (both triangles of a
     // quad get it).
     let fi = el
@@ -408,15 +408,14 @@ fn read_faces(
                 ));
             }
         }
-        let p: Vec<u32> = poly.iter().map(|&v| v as u32).collect();
-        match p.len() {
+        let p = |k: usize| poly[k] as u32;
+        match poly.len() {
             3 => {
-                mesh.indices.extend_from_slice(&p);
+                indices.extend_from_slice(&[p(0), p(1), p(2)]);
                 face_indices.push(face_index);
             }
             4 => {
-                mesh.indices
-                    .extend_from_slice(&[p[0], p[1], p[2], p[0], p[2], p[3]]);
+                indices.extend_from_slice(&[p(0), p(1), p(2), p(0), p(2), p(3)]);
                 face_indices.extend_from_slice(&[face_index, face_index]);
             }
             _ => skipped += 1,
@@ -471,7 +470,7 @@ mod tests {
     fn face_indices_per_triangle() {
         let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar uint vertex_indices\nproperty int face_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 7\n3 0 2 3 -2\n";
         let m = read_ply(text.as_bytes()).unwrap().mesh;
-        assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 3]);
+        assert_eq!(*m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 3]);
         assert_eq!(m.face_indices, Some(vec![7, 7, -2]));
         let plain = read_ply(
             text.replace("property int face_indices\n", "")
@@ -488,7 +487,7 @@ mod tests {
     fn ascii_quad() {
         let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n";
         let m = read_ply(text.as_bytes()).unwrap().mesh;
-        assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3]);
+        assert_eq!(*m.indices, vec![0, 1, 2, 0, 2, 3]);
         assert_eq!(m.uvs.unwrap()[2], Vec2::new(1.0, 1.0));
     }
 
