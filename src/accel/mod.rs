@@ -453,6 +453,26 @@ impl Level {
 /// collapse.
 const BINNED_MIN: usize = 262_144;
 
+/// Bytes per primitive a big level's BVH holds at its peak: about 67
+/// measured (10 M triangles: 64 in leaves of 3.8 triangles with their
+/// vertices, nodes of 128 bytes, the 8-byte primitive order), with room for
+/// worse-filled leaves; the build's own arrays (32-byte references) are
+/// freed before the leaves are made.
+pub const BVH_BYTES_PER_TRIANGLE: u64 = 80;
+/// The same for small levels, built by PLOC (its binary tree, the
+/// reinsertion and the collapse plan live next to the result).
+const PLOC_BYTES_PER_PRIMITIVE: u64 = 320;
+
+/// The bytes a level's BVH over `primitives` will need at most (see
+/// [`BVH_BYTES_PER_TRIANGLE`]), for the loader's memory check.
+pub fn bvh_memory_estimate(primitives: u64) -> u64 {
+    if primitives > BINNED_MIN as u64 {
+        primitives.saturating_mul(BVH_BYTES_PER_TRIANGLE)
+    } else {
+        primitives * PLOC_BYTES_PER_PRIMITIVE
+    }
+}
+
 /// Primitives of a level numbered one after the other: each mesh's
 /// triangles, the quadrics, the instances, the moving instances.
 struct Numbering {

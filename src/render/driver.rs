@@ -33,6 +33,8 @@ pub struct RenderOptions {
 #[derive(Clone, Debug, Default)]
 pub struct RenderStats {
     pub build_time: Duration,
+    /// The part of `build_time` spent on the BVHs.
+    pub bvh_time: Duration,
     pub render_time: Duration,
     pub rays: RayCounts,
     pub samples: u64,
@@ -113,6 +115,7 @@ impl Renderer {
         };
         let stats = RenderStats {
             build_time: t0.elapsed(),
+            bvh_time: scene.aggregate.build_time,
             threads: pool.current_num_threads(),
             ..Default::default()
         };
