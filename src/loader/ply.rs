@@ -323,6 +323,43 @@ fn read_vertices(r: &mut Reader, el: &Element, mesh: &mut MeshData) -> Result<()
     positions.reserve(el.count);
     let mut normals = Vec::with_capacity(if normal.is_some() { el.count } else { 0 });
     let mut uvs = Vec::with_capacity(if uv.is_some() { el.count } else { 0 });
+    if r.format != Format::Ascii && el.props.iter().all(|p| p.list.is_none()) {
+        // Binary records of a fixed size (the common case): decoded in
+        // place, without the per-scalar reader.
+        let offsets: Vec<usize> = el
+            .props
+            .iter()
+            .scan(0, |at, p| {
+                let o = *at;
+                *at += p.ty.size();
+                Some(o)
+            })
+            .collect();
+        let stride: usize = el.props.iter().map(|p| p.ty.size()).sum();
+        let bytes = el.count * stride;
+        if r.left() < bytes {
+            return Err("the file ends before all elements were read (truncated)".into());
+        }
+        let le = r.format == Format::BinaryLe;
+        let field = |rec: &[u8], k: usize| scalar(el.props[k].ty, &rec[offsets[k]..], le) as f32;
+        for rec in r.data[r.pos..r.pos + bytes].chunks_exact(stride.max(1)) {
+            positions.push(Vec3::new(field(rec, x), field(rec, y), field(rec, z)));
+            if let Some([a, b, c]) = normal {
+                normals.push(Vec3::new(field(rec, a), field(rec, b), field(rec, c)));
+            }
+            if let Some([a, b]) = uv {
+                uvs.push(Vec2::new(field(rec, a), field(rec, b)));
+            }
+        }
+        r.pos += bytes;
+        if normal.is_some() {
+            mesh.normals = Some(normals);
+        }
+        if uv.is_some() {
+            mesh.uvs = Some(uvs);
+        }
+        return Ok(());
+    }
     let mut vals = vec![0.0f64; el.props.len()];
     for _ in 0..el.count {
         for (k, p) in el.props.iter().enumerate() {
@@ -374,6 +411,51 @@ fn read_faces(
         .iter()
         .position(|p| p.list.is_none() && p.name == "face_indices" && p.ty.is_integer());
     let mut face_indices: Vec<i32> = Vec::new();
+    if r.format != Format::Ascii && el.props.len() == 1 && have_vertices {
+        // Binary faces with nothing but the index list (the common case).
+        let p = &el.props[0];
+        let (ct, it) = (p.list.expect("the index list"), p.ty);
+        let (cs, is) = (ct.size(), it.size());
+        let le = r.format == Format::BinaryLe;
+        for f in 0..el.count {
+            if r.left() < cs {
+                return Err("the file ends before all elements were read (truncated)".into());
+            }
+            let n = scalar(ct, &r.data[r.pos..], le);
+            r.pos += cs;
+            if n < 0.0 {
+                return Err(format!("face {f} has a bad vertex count {n}"));
+            }
+            if n * is as f64 > r.left() as f64 {
+                return Err("the file ends before all elements were read (truncated)".into());
+            }
+            if n == 0.0 {
+                return Err(format!("face {f} has no vertex indices"));
+            }
+            let n = n as usize;
+            let mut poly = [0u32; 4];
+            let list = &r.data[r.pos..r.pos + n * is];
+            for (k, b) in list.chunks_exact(is).enumerate() {
+                let v = scalar(it, b, le);
+                if v < 0.0 || v >= nverts as f64 {
+                    return Err(format!(
+                        "face {f} has vertex index {v}, out of range (the file has {nverts} vertices)"
+                    ));
+                }
+                if let Some(slot) = poly.get_mut(k) {
+                    *slot = v as u32;
+                }
+            }
+            r.pos += n * is;
+            match n {
+                3 => indices.extend_from_slice(&poly[..3]),
+                4 => indices
+                    .extend_from_slice(&[poly[0], poly[1], poly[2], poly[0], poly[2], poly[3]]),
+                _ => skipped += 1,
+            }
+        }
+        return Ok(skipped);
+    }
     let mut face_index = 0;
     let mut poly: Vec<f64> = Vec::with_capacity(8);
     for f in 0..el.count {
@@ -425,6 +507,33 @@ fn read_faces(
         mesh.face_indices = Some(face_indices);
     }
     Ok(skipped)
+}
+
+/// A binary scalar at the start of `b` (which holds at least its size).
+#[inline(always)]
+fn scalar(ty: Scalar, b: &[u8], le: bool) -> f64 {
+    macro_rules! get {
+        ($t:ty) => {{
+            let arr: [u8; std::mem::size_of::<$t>()] = b[..std::mem::size_of::<$t>()]
+                .try_into()
+                .expect("size checked");
+            if le {
+                <$t>::from_le_bytes(arr)
+            } else {
+                <$t>::from_be_bytes(arr)
+            }
+        }};
+    }
+    match ty {
+        Scalar::I8 => b[0] as i8 as f64,
+        Scalar::U8 => b[0] as f64,
+        Scalar::I16 => get!(i16) as f64,
+        Scalar::U16 => get!(u16) as f64,
+        Scalar::I32 => get!(i32) as f64,
+        Scalar::U32 => get!(u32) as f64,
+        Scalar::F32 => get!(f32) as f64,
+        Scalar::F64 => get!(f64),
+    }
 }
 
 /// Reads one property (a scalar, or a list whose values are discarded).
@@ -481,6 +590,66 @@ mod tests {
         .unwrap()
         .mesh;
         assert_eq!(plain.face_indices, None);
+    }
+
+    /// Binary records (decoded in place) read as the same file in ascii
+    /// (read scalar by scalar): doubles, big endian, normals, uv, a quad, a
+    /// pentagon skipped, a `face_indices` property (the general path).
+    #[test]
+    fn binary_records_match_ascii() {
+        let verts = [
+            [0.5f64, -1.25, 2.0, 0.0, 0.0, 1.0, 0.25, 0.75],
+            [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0],
+            [1.0, 1.0, 3.5, 1.0, 0.0, 0.0, 1.0, 1.0],
+            [0.0, 1.0, -7.0, 0.0, 0.0, -1.0, 0.0, 1.0],
+            [0.1, 0.2, 0.3, 0.0, 1.0, 0.0, 0.5, 0.5],
+        ];
+        let faces: [&[u16]; 3] = [&[0, 1, 2, 3], &[4, 2, 1], &[0, 1, 2, 3, 4]];
+        let header = |fmt: &str, extra: &str| {
+            format!(
+                "ply\nformat {fmt} 1.0\nelement vertex 5\nproperty double x\nproperty double y\nproperty double z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty double u\nproperty float v\nelement face 3\nproperty list uchar ushort vertex_indices\n{extra}end_header\n"
+            )
+        };
+        let mut text = header("ascii", "");
+        for v in &verts {
+            let line: Vec<String> = v.iter().map(|x| x.to_string()).collect();
+            text += &(line.join(" ") + "\n");
+        }
+        for f in faces {
+            let line: Vec<String> = f.iter().map(|x| x.to_string()).collect();
+            text += &format!("{} {}\n", f.len(), line.join(" "));
+        }
+        let ascii = read_ply(text.as_bytes()).unwrap();
+        for extra in ["", "property int face_indices\n"] {
+            let mut bin = header("binary_big_endian", extra).into_bytes();
+            for v in &verts {
+                for (k, x) in v.iter().enumerate() {
+                    if k == 0 || k == 1 || k == 2 || k == 6 {
+                        bin.extend_from_slice(&x.to_be_bytes());
+                    } else {
+                        bin.extend_from_slice(&(*x as f32).to_be_bytes());
+                    }
+                }
+            }
+            for f in faces {
+                bin.push(f.len() as u8);
+                for i in f {
+                    bin.extend_from_slice(&i.to_be_bytes());
+                }
+                if !extra.is_empty() {
+                    bin.extend_from_slice(&5i32.to_be_bytes());
+                }
+            }
+            let b = read_ply(&bin).unwrap();
+            assert_eq!(b.mesh.positions, ascii.mesh.positions);
+            assert_eq!(b.mesh.normals, ascii.mesh.normals);
+            assert_eq!(b.mesh.uvs, ascii.mesh.uvs);
+            assert_eq!(*b.mesh.indices, vec![0, 1, 2, 0, 2, 3, 4, 2, 1]);
+            assert_eq!(b.notes, ascii.notes);
+            assert!(read_ply(&bin[..bin.len() - 1])
+                .unwrap_err()
+                .contains("truncated"));
+        }
     }
 
     #[test]
