@@ -401,17 +401,23 @@ fn split(refs: &mut [Ref], range: &Range, depth: usize, sah_depth: usize) -> (Ra
     }
 }
 
-/// A subtree under construction: its nodes (the root first; inner child
-/// references local to this array, leaf children `LEAF | first << 2 |
-/// count - 1`) and depth.
+/// A subtree under construction: its nodes (the root first; inner children
+/// local to this array, `SUB | k` for the root of `subs[k]`, leaf children
+/// `LEAF | first << 2 | count - 1` with `first` absolute), the subtrees
+/// built as tasks of their own, and its depth. [`flatten`] joins them.
 struct Subtree {
     nodes: Vec<Node>,
+    subs: Vec<Subtree>,
     depth: usize,
 }
 
-fn leaf_ref(r: &Range) -> u32 {
+/// Marks a child that is the root of another [`Subtree`].
+const SUB: u32 = 1 << 30;
+
+/// A leaf child over `r` (whose start is relative to `base`).
+fn leaf_ref(r: &Range, base: usize) -> u32 {
     debug_assert!((1..=LEAF_SIZE).contains(&r.len()));
-    LEAF | (r.start as u32) << 2 | (r.len() as u32 - 1)
+    LEAF | ((base + r.start) as u32) << 2 | (r.len() as u32 - 1)
 }
 
 /// The (at most four) children of a node over `range`: its widest part
@@ -458,10 +464,12 @@ fn make_node(kids: &[Range], child: [u32; 4]) -> Node {
     node
 }
 
-/// Builds the subtree of `range` (heavier than a leaf) sequentially,
-/// appending its nodes to `out`; returns its root's index and its depth.
+/// Builds the subtree of `range` (heavier than a leaf; `refs[0]` is
+/// reference `base`) sequentially, appending its nodes to `out`; returns
+/// its root's index and its depth.
 fn build_seq(
     refs: &mut [Ref],
+    base: usize,
     range: Range,
     depth: usize,
     sah_depth: usize,
@@ -474,9 +482,9 @@ fn build_seq(
     let mut deepest = depth;
     for (slot, k) in kids.iter().enumerate() {
         child[slot] = if is_leaf(k) {
-            leaf_ref(k)
+            leaf_ref(k, base)
         } else {
-            let (c, d) = build_seq(refs, *k, depth + 1, sah_depth, out);
+            let (c, d) = build_seq(refs, base, *k, depth + 1, sah_depth, out);
             deepest = deepest.max(d);
             c
         };
@@ -485,21 +493,32 @@ fn build_seq(
     (at as u32, deepest)
 }
 
-/// Builds the subtree of `range` (heavier than a leaf), big children as
-/// parallel tasks.
-fn build_par(refs: &mut [Ref], range: Range, depth: usize, sah_depth: usize) -> Subtree {
+/// Builds the subtree over all of `refs` (reference `base` first; heavier
+/// than a leaf), big children as parallel tasks.
+fn build_par(
+    refs: &mut [Ref],
+    base: usize,
+    range: Range,
+    depth: usize,
+    sah_depth: usize,
+) -> Subtree {
+    debug_assert!(range.start == 0 && range.end == refs.len());
     if range.len() < PAR_TREE {
-        let mut nodes = Vec::new();
-        let (_, d) = build_seq(refs, range, depth, sah_depth, &mut nodes);
-        nodes.shrink_to_fit();
-        return Subtree { nodes, depth: d };
+        // About one node per 7.6 triangles in practice: reserve a little
+        // more, so that the array is not regrown (fresh pages are costly).
+        let mut nodes = Vec::with_capacity(range.len() / 6 + 8);
+        let (_, d) = build_seq(refs, base, range, depth, sah_depth, &mut nodes);
+        return Subtree {
+            nodes,
+            subs: Vec::new(),
+            depth: d,
+        };
     }
     let kids = children(refs, range, depth, sah_depth);
-    // Hand each child its own part of the references (they are disjoint
-    // and in order).
+    // Each child gets its own part of the references (disjoint, in order).
     let mut parts: Vec<(&mut [Ref], Range)> = Vec::with_capacity(kids.len());
-    let mut rest = &mut refs[range.start..range.end];
-    let mut at = range.start;
+    let mut rest = &mut refs[..];
+    let mut at = 0;
     for k in &kids {
         let (head, tail) = rest.split_at_mut(k.end - at);
         parts.push((head, *k));
@@ -509,63 +528,102 @@ fn build_par(refs: &mut [Ref], range: Range, depth: usize, sah_depth: usize) -> 
     let subs: Vec<Option<Subtree>> = parts
         .into_par_iter()
         .map(|(part, k)| {
-            if is_leaf(&k) {
-                return None;
-            }
-            // The part starts at `k.start`: give the builder a view in
-            // which indices are absolute.
-            Some(build_par_at(part, k, depth + 1, sah_depth))
+            let local = Range {
+                start: 0,
+                end: k.len(),
+                ..k
+            };
+            (!is_leaf(&k)).then(|| build_par(part, base + k.start, local, depth + 1, sah_depth))
         })
         .collect();
-    // Exactly the room needed (the nodes are a third of the BVH's bytes).
-    let total = 1 + subs.iter().flatten().map(|s| s.nodes.len()).sum::<usize>();
-    let mut nodes = Vec::with_capacity(total);
-    nodes.push(super::bvh4::empty_node());
     let mut child = [u32::MAX; 4];
     let mut deepest = depth;
+    let mut kept = Vec::new();
     for (slot, (k, sub)) in kids.iter().zip(subs).enumerate() {
         child[slot] = match sub {
-            None => leaf_ref(k),
+            None => leaf_ref(k, base),
             Some(s) => {
-                let off = nodes.len() as u32;
                 deepest = deepest.max(s.depth);
-                nodes.extend(s.nodes.into_iter().map(|mut n| {
-                    for c in &mut n.child {
-                        if *c & LEAF == 0 && *c != u32::MAX {
-                            *c += off;
-                        }
-                    }
-                    n
-                }));
-                off
+                kept.push(s);
+                SUB | (kept.len() - 1) as u32
             }
         };
     }
-    nodes[0] = make_node(&kids, child);
     Subtree {
-        nodes,
+        nodes: vec![make_node(&kids, child)],
+        subs: kept,
         depth: deepest,
     }
 }
 
-/// `build_par` on a slice that holds exactly `range` (its indices are
-/// absolute: they are shifted to the slice and back).
-fn build_par_at(part: &mut [Ref], range: Range, depth: usize, sah_depth: usize) -> Subtree {
-    let shift = range.start;
-    let local = Range {
-        start: 0,
-        end: range.len(),
-        ..range
-    };
-    let mut s = build_par(part, local, depth, sah_depth);
-    for n in &mut s.nodes {
-        for c in &mut n.child {
-            if *c != u32::MAX && *c & LEAF != 0 {
-                *c += (shift as u32) << 2;
-            }
+/// The subtrees joined into one node array, in pre-order (the root first),
+/// copied in parallel with their child references made global.
+fn flatten(root: Subtree) -> Vec<Node> {
+    // Pre-order list of the subtrees, each with its first node and the
+    // list positions of its own subtrees.
+    let mut list: Vec<(&Subtree, usize, Vec<usize>)> = Vec::new();
+    let mut stack = vec![(&root, usize::MAX)];
+    let mut total = 0usize;
+    while let Some((t, parent)) = stack.pop() {
+        let me = list.len();
+        if parent != usize::MAX {
+            list[parent].2.push(me);
+        }
+        list.push((t, total, Vec::new()));
+        total += t.nodes.len();
+        // Reversed, so that subs[0] comes out first (its index in the
+        // parent's list is then its slot number).
+        for s in t.subs.iter().rev() {
+            stack.push((s, me));
         }
     }
-    s
+    // (A subtree's own subtrees are popped in order, each after the whole
+    // of the one before it, so `list[i].2[k]` is the position of subs[k].)
+    let mut out = vec![super::bvh4::empty_node(); total];
+    let mut slices = Vec::with_capacity(list.len());
+    let mut rest = &mut out[..];
+    for (t, _, _) in &list {
+        let (head, tail) = rest.split_at_mut(t.nodes.len());
+        slices.push(head);
+        rest = tail;
+    }
+    let firsts: Vec<usize> = list.iter().map(|l| l.1).collect();
+    slices
+        .into_par_iter()
+        .zip(list.par_iter())
+        .for_each(|(dst, (t, first, subs))| {
+            for (d, n) in dst.iter_mut().zip(&t.nodes) {
+                *d = *n;
+                for c in &mut d.child {
+                    if *c == u32::MAX || *c & LEAF != 0 {
+                        continue;
+                    }
+                    *c = if *c & SUB != 0 {
+                        firsts[subs[(*c & !SUB) as usize]] as u32
+                    } else {
+                        *c + *first as u32
+                    };
+                }
+            }
+        });
+    out
+}
+
+/// Hands the heap's free pages back to the system. The subtrees' small
+/// node arrays come from malloc's heap, and once joined their pages would
+/// stay resident under the leaves allocated next (about 20 bytes per
+/// triangle of peak memory).
+fn release_free_heap() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        extern "C" {
+            fn malloc_trim(pad: usize) -> std::ffi::c_int;
+        }
+        // SAFETY: glibc's malloc_trim has no preconditions.
+        unsafe {
+            malloc_trim(0);
+        }
+    }
 }
 
 /// The built tree: four-wide nodes (the root first), the leaves, the
@@ -589,16 +647,25 @@ pub(super) fn build(
     assert!(n > 0 && n < 1 << 29);
     let root = range_of(&refs, 0);
     let sah_depth = 2 * (usize::BITS - n.leading_zeros()) as usize + 16;
-    let (nodes, depth) = if is_leaf(&root) {
+    let (tree, depth) = if is_leaf(&root) {
         let mut child = [u32::MAX; 4];
-        child[0] = leaf_ref(&root);
-        (vec![make_node(&[root], child)], 1)
+        child[0] = leaf_ref(&root, 0);
+        let nodes = vec![make_node(&[root], child)];
+        let tree = Subtree {
+            nodes,
+            subs: Vec::new(),
+            depth: 1,
+        };
+        (tree, 1)
     } else {
-        let s = build_par(&mut refs, root, 1, sah_depth);
-        (s.nodes, s.depth)
+        let s = build_par(&mut refs, 0, root, 1, sah_depth);
+        let depth = s.depth;
+        (s, depth)
     };
     let order: Vec<u32> = refs.par_iter().map(Ref::prim).collect();
     drop(refs);
+    let nodes = flatten(tree);
+    release_free_heap();
     // Leaves in node order, numbered by a prefix count.
     let mut nodes = nodes;
     let mut next = 0u32;
