@@ -463,6 +463,10 @@ pub const BVH_BYTES_PER_TRIANGLE: u64 = 80;
 /// reinsertion and the collapse plan live next to the result).
 const PLOC_BYTES_PER_PRIMITIVE: u64 = 320;
 
+/// Most primitives one BVH level can hold (the binned builder packs a
+/// leaf's first primitive and count into 31 bits).
+pub const MAX_LEVEL_PRIMITIVES: u64 = (1 << 29) - 1;
+
 /// The bytes a level's BVH over `primitives` will need at most (see
 /// [`BVH_BYTES_PER_TRIANGLE`]), for the loader's memory check.
 pub fn bvh_memory_estimate(primitives: u64) -> u64 {

@@ -170,6 +170,19 @@ impl<'s, 'c> Builder<'s, 'c> {
         };
         self.scene_triangles += triangles;
         self.render_bytes += copies;
+        if self.scene_triangles > crate::accel::MAX_LEVEL_PRIMITIVES {
+            self.ctx.error(
+                loc,
+                format!(
+                    "the scene's meshes have {} triangles so far, more than the {} one BVH holds",
+                    self.scene_triangles,
+                    crate::accel::MAX_LEVEL_PRIMITIVES
+                ),
+                "this mesh brings the scene past the BVH's limit",
+                None,
+            );
+            return false;
+        }
         let bvh = crate::accel::bvh_memory_estimate(self.scene_triangles);
         let what = format!(
             "rendering the scene's {} triangles so far (BVH and world-space copies, estimated)",
