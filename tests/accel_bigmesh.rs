@@ -84,3 +84,52 @@ fn big_level_is_deterministic_and_within_its_estimate() {
         actual as f64 / triangles as f64
     );
 }
+
+/// A scene whose meshes cannot fit (one 300,000-triangle PLY placed 1,800
+/// times: 540 million triangles, past the BVH's limit and, on most
+/// machines, its memory estimate first) is refused while loading, with an
+/// error at the `Shape` line, before anything is built.
+#[test]
+fn too_many_triangles_is_a_located_error() {
+    let dir = std::env::temp_dir().join(format!("pbrs-accel-bigmesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = grid(388);
+    let mut ply = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        mesh.p.len(),
+        mesh.triangle_count()
+    )
+    .into_bytes();
+    for v in mesh.p.iter() {
+        for c in v.to_array() {
+            ply.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for t in mesh.indices.chunks_exact(3) {
+        ply.push(3);
+        for &i in t {
+            ply.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+    }
+    std::fs::write(dir.join("m.ply"), ply).unwrap();
+    let shapes = "Shape \"plymesh\" \"string filename\" \"m.ply\"\n".repeat(1800);
+    std::fs::write(
+        dir.join("scene.pbrt"),
+        format!(
+            "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nFilm \"image\" \"integer xresolution\" 8 \"integer yresolution\" 8 \"string filename\" \"out.png\"\nWorldBegin\n{shapes}WorldEnd\n"
+        ),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pbrs"))
+        .arg("scene.pbrt")
+        .current_dir(&dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.matches("triangles so far").count(), 1, "{stderr}");
+    assert!(stderr.contains("scene.pbrt:"), "{stderr}");
+    assert!(!dir.join("out.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -118,6 +118,9 @@ pub struct Builder<'s, 'c> {
     /// machine's memory at each mesh.
     scene_triangles: u64,
     render_bytes: u64,
+    /// A mesh was refused for the scene's size (reported once; the later
+    /// ones are refused without another error).
+    too_big: bool,
     /// Shared MIP maps and texture counts.
     pub texture_state: TextureState,
     after_warned: bool,
@@ -188,6 +191,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             meshes: HashMap::new(),
             scene_triangles: 0,
             render_bytes: 0,
+            too_big: false,
             texture_state: TextureState::default(),
             after_warned: false,
             world_seen: false,

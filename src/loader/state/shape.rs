@@ -170,7 +170,11 @@ impl<'s, 'c> Builder<'s, 'c> {
         };
         self.scene_triangles += triangles;
         self.render_bytes += copies;
+        if self.too_big {
+            return false;
+        }
         if self.scene_triangles > crate::accel::MAX_LEVEL_PRIMITIVES {
+            self.too_big = true;
             self.ctx.error(
                 loc,
                 format!(
@@ -191,12 +195,13 @@ impl<'s, 'c> Builder<'s, 'c> {
         match crate::scene::memory::check_budget(&what, bvh + self.render_bytes) {
             Ok(()) => true,
             Err(why) => {
+                self.too_big = true;
                 self.ctx.error(
                     loc,
                     why,
                     "this mesh brings the scene past the memory available",
                     Some(format!(
-                        "the BVH takes about {} bytes per triangle; render fewer or smaller meshes, or on a machine with more memory",
+                        "the BVH takes about {} bytes per triangle; render fewer or smaller meshes, or on a machine with more memory (later meshes are refused too)",
                         crate::accel::BVH_BYTES_PER_TRIANGLE
                     )),
                 );
