@@ -35,10 +35,10 @@ fn grid(n: u32) -> TriangleMesh {
         }
     }
     TriangleMesh {
-        p,
+        p: p.into(),
         n: None,
         uv: None,
-        indices,
+        indices: indices.into(),
         face_indices: None,
         flip_normal: false,
         reverse_orientation: false,

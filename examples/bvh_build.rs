@@ -11,10 +11,10 @@ use std::time::Instant;
 
 fn mesh(p: Vec<Vec3>, indices: Vec<u32>) -> TriangleMesh {
     TriangleMesh {
-        p,
+        p: p.into(),
         n: None,
         uv: None,
-        indices,
+        indices: indices.into(),
         face_indices: None,
         flip_normal: false,
         reverse_orientation: false,

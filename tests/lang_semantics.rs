@@ -482,7 +482,7 @@ fn triangle_mesh_details() {
         Surface::TriangleMesh(m) => m.clone(),
         g => panic!("{g:?}"),
     };
-    assert_eq!(mesh(0).indices, vec![0, 1, 2]);
+    assert_eq!(*mesh(0).indices, vec![0, 1, 2]);
     assert_eq!(mesh(0).uvs.as_ref().unwrap()[1], Vec2::new(1.0, 0.0));
     assert!(mesh(1).normals.is_none());
     assert!(mesh(1).uvs.is_some());

@@ -31,7 +31,7 @@ fn ascii_ply(m: &MeshData) -> Vec<u8> {
         m.triangle_count()
     );
     // `{}` prints the shortest decimal that reads back as the same f32.
-    for p in &m.positions {
+    for p in m.positions.iter() {
         writeln!(s, "{} {} {}", p.x, p.y, p.z).unwrap();
     }
     for t in m.indices.chunks_exact(3) {
@@ -47,7 +47,7 @@ fn big_endian_ply(m: &MeshData) -> Vec<u8> {
         m.triangle_count()
     )
     .into_bytes();
-    for p in &m.positions {
+    for p in m.positions.iter() {
         for c in p.to_array() {
             d.extend_from_slice(&c.to_be_bytes());
         }
@@ -63,7 +63,7 @@ fn big_endian_ply(m: &MeshData) -> Vec<u8> {
 
 fn obj(m: &MeshData) -> Vec<u8> {
     let mut s = String::from("# converted by tests/mesh_formats.rs\no dragon\n");
-    for p in &m.positions {
+    for p in m.positions.iter() {
         writeln!(s, "v {} {} {}", p.x, p.y, p.z).unwrap();
     }
     for t in m.indices.chunks_exact(3) {
@@ -75,17 +75,17 @@ fn obj(m: &MeshData) -> Vec<u8> {
 /// (JSON, binary buffer) of a one-mesh glTF; `uri` names an external buffer.
 fn gltf_parts(m: &MeshData, uri: Option<&str>) -> (String, Vec<u8>) {
     let mut bin = Vec::new();
-    for p in &m.positions {
+    for p in m.positions.iter() {
         for c in p.to_array() {
             bin.extend_from_slice(&c.to_le_bytes());
         }
     }
     let pos_len = bin.len();
-    for &i in &m.indices {
+    for &i in m.indices.iter() {
         bin.extend_from_slice(&i.to_le_bytes());
     }
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for p in &m.positions {
+    for p in m.positions.iter() {
         for k in 0..3 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);

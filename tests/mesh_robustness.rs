@@ -82,7 +82,7 @@ fn ply_survives_damage() {
     ] {
         let valid = ply(format, be);
         let m = read_ply(&valid).unwrap().mesh;
-        assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 1], "{format}");
+        assert_eq!(*m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 1], "{format}");
         assert_eq!(m.uvs.as_ref().map(Vec::len), Some(4));
         damage(&valid, &|b| read_ply(b).is_ok());
     }
@@ -98,7 +98,7 @@ fn obj_survives_damage() {
 #[test]
 fn gltf_node_transforms_and_damage() {
     let m = gltf(GLTF.as_bytes()).unwrap();
-    assert_eq!(m.indices, vec![0, 1, 2]);
+    assert_eq!(*m.indices, vec![0, 1, 2]);
     // Node (translate 1 2 3) → child (scale 2): (1,0,0) ↦ (3,2,3).
     assert_eq!(m.positions[1], glam::Vec3::new(3.0, 2.0, 3.0));
     damage(GLTF.as_bytes(), &|b| gltf(b).is_ok());

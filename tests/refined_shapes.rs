@@ -581,7 +581,7 @@ fn heightfield_vertices_uv_and_triangles() {
         assert_eq!(*p, want);
         assert_eq!(uv[k], want.truncate());
     }
-    assert_eq!(m.indices, vec![0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4]);
+    assert_eq!(*m.indices, vec![0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4]);
     assert!(m.normals.is_none());
 }
 

@@ -30,7 +30,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::ploc::PlocBuilder;
 use obvhs::BvhBuildParams;
 
-use super::split;
+use super::{binned, split};
 
 /// Above this many primitives with one box, PLOC's cost grows as n times
 /// that count (see [`split`]); such levels use the bounded builder. Runs of
@@ -47,12 +47,14 @@ pub struct BuildWork {
     /// Primitive touches counted: the coincidence check and the bounded
     /// builder's passes (PLOC is not instrumented), and one per node made.
     pub work: u64,
+    /// Built by the parallel binned-SAH builder (a big level).
+    pub binned: bool,
 }
 
 /// A child reference with this bit set is a leaf.
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 /// Most primitives in a leaf (one SIMD pack).
-const LEAF_SIZE: usize = 4;
+pub(super) const LEAF_SIZE: usize = 4;
 /// Traversal stack sizes (entries): a tiny one for small trees, kept in the
 /// caller's frame (zeroing it is part of every ray's cost), and larger ones
 /// in frames of their own.
@@ -65,16 +67,16 @@ const LARGE_STACK: usize = 512;
 /// used slots (an unused one has an empty box, +∞ to −∞).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node {
-    b: [Vec4; 6],
-    child: [u32; 4],
-    valid: BVec4A,
+pub(super) struct Node {
+    pub(super) b: [Vec4; 6],
+    pub(super) child: [u32; 4],
+    pub(super) valid: BVec4A,
 }
 
 /// Up to four primitives at BVH positions `first .. first + count`;
 /// `triangles` marks the lanes that are triangles (their vertices in `v`).
 #[derive(Clone, Copy, Debug)]
-struct Leaf {
+pub(super) struct Leaf {
     v: TrianglePack,
     first: u32,
     count: u32,
@@ -190,8 +192,43 @@ impl Bvh4 {
                 bounded,
                 largest_coincident: run,
                 work,
+                binned: false,
             },
         )
+    }
+
+    /// Builds with the parallel binned-SAH builder of [`binned`] over
+    /// `refs` (primitive `i` is a triangle with vertices `triangle(i)` or
+    /// something else for `None`); returns the BVH, the primitives in BVH
+    /// order and the bounds of everything.
+    pub(super) fn build_binned(
+        refs: Vec<binned::Ref>,
+        triangle: impl Fn(usize) -> Option<[Vec3; 3]> + Sync,
+    ) -> (Bvh4, Vec<u32>, (Vec3, Vec3)) {
+        let b = binned::build(refs, triangle);
+        (
+            Bvh4 {
+                nodes: b.nodes,
+                leaves: b.leaves,
+                stack_need: 3 * b.depth + 4,
+            },
+            b.order,
+            b.bounds,
+        )
+    }
+
+    /// Bytes held by the nodes and leaves.
+    pub(super) fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node>()
+            + self.leaves.capacity() * std::mem::size_of::<Leaf>()
+    }
+
+    pub(super) fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub(super) fn leaf_count(&self) -> usize {
+        self.leaves.len()
     }
 
     fn from_bvh2(bvh2: &Bvh2, triangle: impl Fn(usize) -> Option<[Vec3; 3]>) -> (Bvh4, Vec<u32>) {
@@ -220,7 +257,7 @@ impl Bvh4 {
         let mut leaves: Vec<Leaf> = Vec::new();
         let mut max_depth = 0usize;
 
-        let mut make_leaf = |root: usize, order: &mut Vec<u32>| -> u32 {
+        let mut leaf_of = |root: usize, order: &mut Vec<u32>| -> u32 {
             let first = order.len() as u32;
             // The subtree's primitives, left to right.
             let mut stack = vec![root];
@@ -234,22 +271,8 @@ impl Bvh4 {
                     order.extend_from_slice(&bvh2.primitive_indices[s..s + n.prim_count as usize]);
                 }
             }
-            let prims = &order[first as usize..];
-            debug_assert!(prims.len() <= LEAF_SIZE);
-            let mut tris = [[Vec3::ZERO; 3]; LEAF_SIZE];
-            let mut mask = 0;
-            for (lane, &p) in prims.iter().enumerate() {
-                if let Some(t) = triangle(p as usize) {
-                    tris[lane] = t;
-                    mask |= 1 << lane;
-                }
-            }
-            leaves.push(Leaf {
-                v: pack_triangles(&tris),
-                first,
-                count: prims.len() as u32,
-                triangles: mask,
-            });
+            let count = order.len() as u32 - first;
+            leaves.push(make_leaf(order, first, count, &triangle));
             (leaves.len() - 1) as u32 | LEAF
         };
 
@@ -273,7 +296,7 @@ impl Bvh4 {
                     node.b[3 + axis][slot] = a.max[axis];
                 }
                 node.child[slot] = if plan.is_leaf(k) {
-                    make_leaf(k, &mut order)
+                    leaf_of(k, &mut order)
                 } else {
                     nodes.push(empty_node());
                     work.push((k, nodes.len() - 1, depth + 1));
@@ -521,7 +544,33 @@ impl Bvh4 {
     }
 }
 
-fn empty_node() -> Node {
+/// The leaf of BVH positions `first .. first + count` (`order` maps them to
+/// primitives, `triangle` gives a primitive's vertices if it is one).
+pub(super) fn make_leaf(
+    order: &[u32],
+    first: u32,
+    count: u32,
+    triangle: &impl Fn(usize) -> Option<[Vec3; 3]>,
+) -> Leaf {
+    let prims = &order[first as usize..(first + count) as usize];
+    debug_assert!(prims.len() <= LEAF_SIZE);
+    let mut tris = [[Vec3::ZERO; 3]; LEAF_SIZE];
+    let mut mask = 0;
+    for (lane, &p) in prims.iter().enumerate() {
+        if let Some(t) = triangle(p as usize) {
+            tris[lane] = t;
+            mask |= 1 << lane;
+        }
+    }
+    Leaf {
+        v: pack_triangles(&tris),
+        first,
+        count,
+        triangles: mask,
+    }
+}
+
+pub(super) fn empty_node() -> Node {
     let mut b = [Vec4::splat(f32::INFINITY); 6];
     for m in &mut b[3..] {
         *m = Vec4::splat(f32::NEG_INFINITY);
@@ -733,6 +782,87 @@ mod tests {
             (i < n).then(|| tris[i])
         });
         (bvh, order)
+    }
+
+    fn build_binned(tris: &[[Vec3; 3]], others: &[Aabb]) -> (Bvh4, Vec<u32>) {
+        let n = tris.len();
+        let mut refs: Vec<binned::Ref> = tris
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+                binned::Ref::new(lo, hi, i as u32, true)
+            })
+            .collect();
+        for (i, a) in others.iter().enumerate() {
+            refs.push(binned::Ref::new(
+                a.min.into(),
+                a.max.into(),
+                (n + i) as u32,
+                false,
+            ));
+        }
+        let (bvh, order, _) = Bvh4::build_binned(refs, |i| (i < n).then(|| tris[i]));
+        (bvh, order)
+    }
+
+    /// The binned builder: right hits (as `check` for PLOC), other
+    /// primitives in leaves of their own, and the same tree for one thread
+    /// and two (big enough that the partition and the subtrees run in
+    /// parallel).
+    #[test]
+    fn binned_builder_finds_the_hits_and_is_deterministic() {
+        let mut rng = Pcg32::with_sequence(21);
+        for (n, size) in [(1, 0.8), (5, 0.5), (37, 0.3), (3000, 0.08)] {
+            let tris = random_triangles(&mut rng, n, 1.0, size);
+            let (bvh, order) = build_binned(&tris, &[]);
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            assert!(sorted.iter().copied().eq(0..n as u32));
+            let mut hits = 0;
+            for _ in 0..2000 {
+                let ray = random_ray(&mut rng, 1.0);
+                let expect = brute(&tris, &ray).map(|h| h.0);
+                let got = match bvh.closest(&ray, ray.t_max, |_, _| None) {
+                    Closest::Triangle { t, .. } => Some(t),
+                    _ => None,
+                };
+                assert_eq!(expect, got, "{n} triangles, ray {ray:?}");
+                assert_eq!(bvh.any(&ray, ray.t_max, |_| false), expect.is_some());
+                hits += got.is_some() as usize;
+            }
+            assert!(hits > 30, "{n} triangles: {hits} hits");
+        }
+        let tris = random_triangles(&mut rng, 20, 1.0, 0.3);
+        let others = [Aabb::new(Vec3::splat(-0.1).into(), Vec3::splat(0.1).into())];
+        let (bvh, order) = build_binned(&tris, &others);
+        let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        let mut seen = Vec::new();
+        bvh.closest(&ray, f32::INFINITY, |pos, _| {
+            seen.push(order[pos as usize]);
+            None
+        });
+        assert_eq!(seen, vec![20]);
+        // Determinism across thread counts.
+        let tris = random_triangles(&mut rng, 150_000, 1.0, 0.01);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (bvh, order) = pool.install(|| build_binned(&tris, &[]));
+            let boxes: Vec<u32> = bvh
+                .nodes
+                .iter()
+                .flat_map(|n| n.b.iter().flat_map(|v| v.to_array().map(f32::to_bits)))
+                .chain(bvh.nodes.iter().flat_map(|n| n.child))
+                .collect();
+            (boxes, order, bvh.leaves.len(), bvh.stack_need)
+        };
+        let one = run(1);
+        assert!(one.0.len() > 10_000, "{} node words", one.0.len());
+        assert!(one == run(2), "the tree differs between 1 and 2 threads");
+        assert!(one == run(3), "the tree differs between 1 and 3 threads");
     }
 
     /// Brute-force closest hit: (t, primitive).

@@ -48,7 +48,7 @@ pub fn read_obj(bytes: &[u8]) -> Result<MeshData, String> {
         if base + nv > u32::MAX as usize {
             return Err("more than 2^32 vertices".into());
         }
-        out.positions.extend(
+        std::sync::Arc::make_mut(&mut out.positions).extend(
             m.positions
                 .chunks_exact(3)
                 .map(|c| Vec3::new(c[0], c[1], c[2])),
@@ -70,7 +70,7 @@ pub fn read_obj(bytes: &[u8]) -> Result<MeshData, String> {
                     i as u64 + 1
                 ));
             }
-            out.indices.push(base as u32 + i);
+            std::sync::Arc::make_mut(&mut out.indices).push(base as u32 + i);
         }
     }
     if out.positions.is_empty() {
@@ -164,7 +164,7 @@ pub fn read_gltf(
                     return Err("more than 2^32 vertices".into());
                 }
                 let identity = xf == DMat4::IDENTITY;
-                out.positions.extend(p.iter().map(|&v| {
+                std::sync::Arc::make_mut(&mut out.positions).extend(p.iter().map(|&v| {
                     let v = Vec3::from(v);
                     if identity {
                         v
@@ -206,7 +206,7 @@ pub fn read_gltf(
                             p.len()
                         ));
                     }
-                    out.indices.push(base as u32 + i);
+                    std::sync::Arc::make_mut(&mut out.indices).push(base as u32 + i);
                 }
             }
         }

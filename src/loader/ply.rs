@@ -319,16 +319,53 @@ fn read_vertices(r: &mut Reader, el: &Element, mesh: &mut MeshData) -> Result<()
         &format!("the mesh's {} vertices", el.count),
         (el.count as u64).saturating_mul(per),
     )?;
-    mesh.positions.reserve(el.count);
+    let positions = std::sync::Arc::make_mut(&mut mesh.positions);
+    positions.reserve(el.count);
     let mut normals = Vec::with_capacity(if normal.is_some() { el.count } else { 0 });
     let mut uvs = Vec::with_capacity(if uv.is_some() { el.count } else { 0 });
+    if r.format != Format::Ascii && el.props.iter().all(|p| p.list.is_none()) {
+        // Binary records of a fixed size (the common case): decoded in
+        // place, without the per-scalar reader.
+        let offsets: Vec<usize> = el
+            .props
+            .iter()
+            .scan(0, |at, p| {
+                let o = *at;
+                *at += p.ty.size();
+                Some(o)
+            })
+            .collect();
+        let stride: usize = el.props.iter().map(|p| p.ty.size()).sum();
+        let bytes = el.count * stride;
+        if r.left() < bytes {
+            return Err("the file ends before all elements were read (truncated)".into());
+        }
+        let le = r.format == Format::BinaryLe;
+        let field = |rec: &[u8], k: usize| scalar(el.props[k].ty, &rec[offsets[k]..], le) as f32;
+        for rec in r.data[r.pos..r.pos + bytes].chunks_exact(stride.max(1)) {
+            positions.push(Vec3::new(field(rec, x), field(rec, y), field(rec, z)));
+            if let Some([a, b, c]) = normal {
+                normals.push(Vec3::new(field(rec, a), field(rec, b), field(rec, c)));
+            }
+            if let Some([a, b]) = uv {
+                uvs.push(Vec2::new(field(rec, a), field(rec, b)));
+            }
+        }
+        r.pos += bytes;
+        if normal.is_some() {
+            mesh.normals = Some(normals);
+        }
+        if uv.is_some() {
+            mesh.uvs = Some(uvs);
+        }
+        return Ok(());
+    }
     let mut vals = vec![0.0f64; el.props.len()];
     for _ in 0..el.count {
         for (k, p) in el.props.iter().enumerate() {
             vals[k] = read_prop(r, p)?.unwrap_or(0.0);
         }
-        mesh.positions
-            .push(Vec3::new(vals[x] as f32, vals[y] as f32, vals[z] as f32));
+        positions.push(Vec3::new(vals[x] as f32, vals[y] as f32, vals[z] as f32));
         if let Some([a, b, c]) = normal {
             normals.push(Vec3::new(vals[a] as f32, vals[b] as f32, vals[c] as f32));
         }
@@ -364,9 +401,9 @@ fn read_faces(
     if li.is_some_and(|i| !el.props[i].ty.is_integer()) {
         return Err("`vertex_indices` is not a list of integers".into());
     }
-    mesh.indices
-        .reserve(el.count.saturating_mul(3).min(r.left()));
     let nverts = mesh.positions.len();
+    let indices = std::sync::Arc::make_mut(&mut mesh.indices);
+    indices.reserve(el.count.saturating_mul(3).min(r.left()));
     // pbrt-v3's `face_indices`: a Ptex face per face (both triangles of a
     // quad get it).
     let fi = el
@@ -374,6 +411,51 @@ fn read_faces(
         .iter()
         .position(|p| p.list.is_none() && p.name == "face_indices" && p.ty.is_integer());
     let mut face_indices: Vec<i32> = Vec::new();
+    if r.format != Format::Ascii && el.props.len() == 1 && have_vertices {
+        // Binary faces with nothing but the index list (the common case).
+        let p = &el.props[0];
+        let (ct, it) = (p.list.expect("the index list"), p.ty);
+        let (cs, is) = (ct.size(), it.size());
+        let le = r.format == Format::BinaryLe;
+        for f in 0..el.count {
+            if r.left() < cs {
+                return Err("the file ends before all elements were read (truncated)".into());
+            }
+            let n = scalar(ct, &r.data[r.pos..], le);
+            r.pos += cs;
+            if n < 0.0 {
+                return Err(format!("face {f} has a bad vertex count {n}"));
+            }
+            if n * is as f64 > r.left() as f64 {
+                return Err("the file ends before all elements were read (truncated)".into());
+            }
+            if n == 0.0 {
+                return Err(format!("face {f} has no vertex indices"));
+            }
+            let n = n as usize;
+            let mut poly = [0u32; 4];
+            let list = &r.data[r.pos..r.pos + n * is];
+            for (k, b) in list.chunks_exact(is).enumerate() {
+                let v = scalar(it, b, le);
+                if v < 0.0 || v >= nverts as f64 {
+                    return Err(format!(
+                        "face {f} has vertex index {v}, out of range (the file has {nverts} vertices)"
+                    ));
+                }
+                if let Some(slot) = poly.get_mut(k) {
+                    *slot = v as u32;
+                }
+            }
+            r.pos += n * is;
+            match n {
+                3 => indices.extend_from_slice(&poly[..3]),
+                4 => indices
+                    .extend_from_slice(&[poly[0], poly[1], poly[2], poly[0], poly[2], poly[3]]),
+                _ => skipped += 1,
+            }
+        }
+        return Ok(skipped);
+    }
     let mut face_index = 0;
     let mut poly: Vec<f64> = Vec::with_capacity(8);
     for f in 0..el.count {
@@ -408,15 +490,14 @@ fn read_faces(
                 ));
             }
         }
-        let p: Vec<u32> = poly.iter().map(|&v| v as u32).collect();
-        match p.len() {
+        let p = |k: usize| poly[k] as u32;
+        match poly.len() {
             3 => {
-                mesh.indices.extend_from_slice(&p);
+                indices.extend_from_slice(&[p(0), p(1), p(2)]);
                 face_indices.push(face_index);
             }
             4 => {
-                mesh.indices
-                    .extend_from_slice(&[p[0], p[1], p[2], p[0], p[2], p[3]]);
+                indices.extend_from_slice(&[p(0), p(1), p(2), p(0), p(2), p(3)]);
                 face_indices.extend_from_slice(&[face_index, face_index]);
             }
             _ => skipped += 1,
@@ -426,6 +507,33 @@ fn read_faces(
         mesh.face_indices = Some(face_indices);
     }
     Ok(skipped)
+}
+
+/// A binary scalar at the start of `b` (which holds at least its size).
+#[inline(always)]
+fn scalar(ty: Scalar, b: &[u8], le: bool) -> f64 {
+    macro_rules! get {
+        ($t:ty) => {{
+            let arr: [u8; std::mem::size_of::<$t>()] = b[..std::mem::size_of::<$t>()]
+                .try_into()
+                .expect("size checked");
+            if le {
+                <$t>::from_le_bytes(arr)
+            } else {
+                <$t>::from_be_bytes(arr)
+            }
+        }};
+    }
+    match ty {
+        Scalar::I8 => b[0] as i8 as f64,
+        Scalar::U8 => b[0] as f64,
+        Scalar::I16 => get!(i16) as f64,
+        Scalar::U16 => get!(u16) as f64,
+        Scalar::I32 => get!(i32) as f64,
+        Scalar::U32 => get!(u32) as f64,
+        Scalar::F32 => get!(f32) as f64,
+        Scalar::F64 => get!(f64),
+    }
 }
 
 /// Reads one property (a scalar, or a list whose values are discarded).
@@ -471,7 +579,7 @@ mod tests {
     fn face_indices_per_triangle() {
         let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar uint vertex_indices\nproperty int face_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 7\n3 0 2 3 -2\n";
         let m = read_ply(text.as_bytes()).unwrap().mesh;
-        assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 3]);
+        assert_eq!(*m.indices, vec![0, 1, 2, 0, 2, 3, 0, 2, 3]);
         assert_eq!(m.face_indices, Some(vec![7, 7, -2]));
         let plain = read_ply(
             text.replace("property int face_indices\n", "")
@@ -484,11 +592,71 @@ mod tests {
         assert_eq!(plain.face_indices, None);
     }
 
+    /// Binary records (decoded in place) read as the same file in ascii
+    /// (read scalar by scalar): doubles, big endian, normals, uv, a quad, a
+    /// pentagon skipped, a `face_indices` property (the general path).
+    #[test]
+    fn binary_records_match_ascii() {
+        let verts = [
+            [0.5f64, -1.25, 2.0, 0.0, 0.0, 1.0, 0.25, 0.75],
+            [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0],
+            [1.0, 1.0, 3.5, 1.0, 0.0, 0.0, 1.0, 1.0],
+            [0.0, 1.0, -7.0, 0.0, 0.0, -1.0, 0.0, 1.0],
+            [0.1, 0.2, 0.3, 0.0, 1.0, 0.0, 0.5, 0.5],
+        ];
+        let faces: [&[u16]; 3] = [&[0, 1, 2, 3], &[4, 2, 1], &[0, 1, 2, 3, 4]];
+        let header = |fmt: &str, extra: &str| {
+            format!(
+                "ply\nformat {fmt} 1.0\nelement vertex 5\nproperty double x\nproperty double y\nproperty double z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty double u\nproperty float v\nelement face 3\nproperty list uchar ushort vertex_indices\n{extra}end_header\n"
+            )
+        };
+        let mut text = header("ascii", "");
+        for v in &verts {
+            let line: Vec<String> = v.iter().map(|x| x.to_string()).collect();
+            text += &(line.join(" ") + "\n");
+        }
+        for f in faces {
+            let line: Vec<String> = f.iter().map(|x| x.to_string()).collect();
+            text += &format!("{} {}\n", f.len(), line.join(" "));
+        }
+        let ascii = read_ply(text.as_bytes()).unwrap();
+        for extra in ["", "property int face_indices\n"] {
+            let mut bin = header("binary_big_endian", extra).into_bytes();
+            for v in &verts {
+                for (k, x) in v.iter().enumerate() {
+                    if k == 0 || k == 1 || k == 2 || k == 6 {
+                        bin.extend_from_slice(&x.to_be_bytes());
+                    } else {
+                        bin.extend_from_slice(&(*x as f32).to_be_bytes());
+                    }
+                }
+            }
+            for f in faces {
+                bin.push(f.len() as u8);
+                for i in f {
+                    bin.extend_from_slice(&i.to_be_bytes());
+                }
+                if !extra.is_empty() {
+                    bin.extend_from_slice(&5i32.to_be_bytes());
+                }
+            }
+            let b = read_ply(&bin).unwrap();
+            assert_eq!(b.mesh.positions, ascii.mesh.positions);
+            assert_eq!(b.mesh.normals, ascii.mesh.normals);
+            assert_eq!(b.mesh.uvs, ascii.mesh.uvs);
+            assert_eq!(*b.mesh.indices, vec![0, 1, 2, 0, 2, 3, 4, 2, 1]);
+            assert_eq!(b.notes, ascii.notes);
+            assert!(read_ply(&bin[..bin.len() - 1])
+                .unwrap_err()
+                .contains("truncated"));
+        }
+    }
+
     #[test]
     fn ascii_quad() {
         let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n";
         let m = read_ply(text.as_bytes()).unwrap().mesh;
-        assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3]);
+        assert_eq!(*m.indices, vec![0, 1, 2, 0, 2, 3]);
         assert_eq!(m.uvs.unwrap()[2], Vec2::new(1.0, 1.0));
     }
 

@@ -113,6 +113,14 @@ pub struct Builder<'s, 'c> {
     area_lights: HashMap<usize, Option<DiffuseEmission>>,
     named_material_defs: Vec<(String, Rc<MaterialSpec>)>,
     pub meshes: HashMap<std::path::PathBuf, Option<Arc<MeshData>>>,
+    /// Triangles of the mesh shapes so far, and the bytes the render will
+    /// add for them (world-space copies and the BVH): checked against the
+    /// machine's memory at each mesh.
+    scene_triangles: u64,
+    render_bytes: u64,
+    /// A mesh was refused for the scene's size (reported once; the later
+    /// ones are refused without another error).
+    too_big: bool,
     /// Shared MIP maps and texture counts.
     pub texture_state: TextureState,
     after_warned: bool,
@@ -181,6 +189,9 @@ impl<'s, 'c> Builder<'s, 'c> {
             area_lights: HashMap::new(),
             named_material_defs: Vec::new(),
             meshes: HashMap::new(),
+            scene_triangles: 0,
+            render_bytes: 0,
+            too_big: false,
             texture_state: TextureState::default(),
             after_warned: false,
             world_seen: false,

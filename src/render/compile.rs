@@ -83,12 +83,20 @@ impl RenderScene {
             notes.push(format!("{zero} lights of zero power are never sampled"));
         }
         notes.push(format!(
-            "built: {} triangles in {} meshes, {} quadrics, BVH over {} primitives in {:.1} ms; {} lights ({} area lights from {} emissive shapes)",
+            "built: {} triangles in {} meshes, {} quadrics, BVH over {} primitives in {:.1} ms ({}, {:.1} MiB in {} nodes and {} leaves); {} lights ({} area lights from {} emissive shapes)",
             aggregate.meshes.iter().map(|m| m.triangle_count() as u64).sum::<u64>(),
             aggregate.meshes.len(),
             aggregate.quadrics.len(),
             aggregate.primitive_count(),
             aggregate.build_time.as_secs_f64() * 1e3,
+            if aggregate.build_work.binned {
+                "parallel binned SAH"
+            } else {
+                "PLOC"
+            },
+            aggregate.bvh_bytes() as f64 / (1024.0 * 1024.0),
+            aggregate.bvh_counts().0,
+            aggregate.bvh_counts().1,
             lights.len(),
             area.len(),
             emissive_shapes
@@ -376,11 +384,18 @@ fn placed_analytic(
 /// orientation and alpha masks.
 fn world_mesh(m: &scene::MeshData, to_world: DMat4, s: &ShapeDesc, material: u32) -> TriangleMesh {
     let reverse = s.reverse_orientation;
-    let p = m
-        .positions
-        .iter()
-        .map(|v| to_world.transform_point3(v.as_dvec3()).as_vec3())
-        .collect();
+    // An identity transform maps every position to itself exactly: the
+    // scene's positions are shared, not copied.
+    let p = if to_world == DMat4::IDENTITY {
+        m.positions.clone()
+    } else {
+        Arc::new(
+            m.positions
+                .iter()
+                .map(|v| to_world.transform_point3(v.as_dvec3()).as_vec3())
+                .collect(),
+        )
+    };
     let lin = DMat3::from_mat4(to_world);
     let nm = lin.inverse().transpose();
     let n = m.normals.as_ref().map(|ns| {

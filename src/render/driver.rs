@@ -33,6 +33,8 @@ pub struct RenderOptions {
 #[derive(Clone, Debug, Default)]
 pub struct RenderStats {
     pub build_time: Duration,
+    /// The part of `build_time` spent on the BVHs.
+    pub bvh_time: Duration,
     pub render_time: Duration,
     pub rays: RayCounts,
     pub samples: u64,
@@ -95,16 +97,17 @@ impl Renderer {
     pub fn new(desc: &SceneDescription, opts: &RenderOptions) -> Result<Renderer, String> {
         let t0 = Instant::now();
         check_film_memory(desc)?;
-        let scene = RenderScene::new(desc);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(opts.threads.unwrap_or(0))
+            .build()
+            .map_err(|e| format!("cannot start worker threads: {e}"))?;
+        // The BVH is built on the render's threads (as many as it has).
+        let scene = pool.install(|| RenderScene::new(desc));
         let mut integrator = Integrator::new(&desc.integrator, &scene, opts.scalar);
         let film = Film::new(&desc.film, &desc.filter);
         integrator.prepare_film(&scene, film.sample_bounds())?;
         let mut sampler = Sampler::new(&desc.sampler, film.sample_bounds(), opts.seed);
         integrator.prepare_sampler(&scene, &mut sampler);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(opts.threads.unwrap_or(0))
-            .build()
-            .map_err(|e| format!("cannot start worker threads: {e}"))?;
         let batch = if opts.scalar || !sampler.batches_well() {
             1
         } else {
@@ -112,6 +115,7 @@ impl Renderer {
         };
         let stats = RenderStats {
             build_time: t0.elapsed(),
+            bvh_time: scene.aggregate.build_time,
             threads: pool.current_num_threads(),
             ..Default::default()
         };

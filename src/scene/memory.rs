@@ -32,11 +32,12 @@ fn gib(b: u64) -> f64 {
 }
 
 /// Ok if `need` bytes fit in 90% of the available memory (or it is not
-/// known); else "WHAT needs N GiB, more than the M GiB of memory available".
+/// known); else "WHAT needs N GiB, more than 90% of the M GiB of memory
+/// available".
 pub fn check_budget(what: &str, need: u64) -> Result<(), String> {
     match available_memory_bytes() {
         Some(avail) if need > avail / 10 * 9 => Err(format!(
-            "{what} needs {:.1} GiB, more than the {:.1} GiB of memory available",
+            "{what} needs {:.1} GiB, more than 90% of the {:.1} GiB of memory available",
             gib(need),
             gib(avail)
         )),

@@ -269,9 +269,11 @@ pub struct CurveData {
 /// Triangle mesh data in object space, shared between shapes and instances.
 #[derive(Clone, Debug, Default)]
 pub struct MeshData {
-    pub positions: Vec<Vec3>,
+    /// Shared with the render's world-space mesh (positions too when the
+    /// shape's transform is the identity), so a big mesh is held once.
+    pub positions: std::sync::Arc<Vec<Vec3>>,
     /// Three per triangle, every index < positions.len().
-    pub indices: Vec<u32>,
+    pub indices: std::sync::Arc<Vec<u32>>,
     /// Per-vertex normals (same length as positions) if given.
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex uv (same length as positions) if given.

@@ -11,11 +11,14 @@ use std::sync::Arc;
 /// all triangles (32-bit indices).
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
-    pub p: Vec<Vec3>,
+    /// Vertex positions (shared with the scene's mesh data when its
+    /// transform is the identity).
+    pub p: Arc<Vec<Vec3>>,
     /// Per-vertex normals in world space (unnormalised allowed).
     pub n: Option<Vec<Vec3>>,
     pub uv: Option<Vec<Vec2>>,
-    pub indices: Vec<u32>,
+    /// Three per triangle (shared with the scene's mesh data).
+    pub indices: Arc<Vec<u32>>,
     /// Per-triangle Ptex face ids (pbrt-v3's `faceIndices`).
     pub face_indices: Option<Vec<i32>>,
     /// ReverseOrientation XOR the transform swaps handedness.

@@ -130,8 +130,8 @@ fn mesh(p: &ParamValues, r: &mut dyn ShapeInput) -> Option<MeshData> {
         None
     };
     Some(MeshData {
-        positions,
-        indices,
+        positions: positions.into(),
+        indices: indices.into(),
         normals,
         uvs,
         face_indices,

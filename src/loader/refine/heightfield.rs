@@ -97,8 +97,8 @@ impl Heightfield {
             }
         }
         finished(MeshData {
-            positions,
-            indices,
+            positions: positions.into(),
+            indices: indices.into(),
             normals: None,
             uvs: Some(uvs),
             face_indices: None,

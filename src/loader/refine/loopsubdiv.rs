@@ -596,10 +596,10 @@ fn limit_mesh(mut lim: Level, ring: &mut Vec<DVec3>) -> Result<MeshData, Problem
             }
         });
     }
-    let indices = lim.fv.iter().flatten().copied().collect();
+    let indices: Vec<u32> = lim.fv.iter().flatten().copied().collect();
     finished(MeshData {
-        positions: lim.p.iter().map(|p| p.as_vec3()).collect(),
-        indices,
+        positions: std::sync::Arc::new(lim.p.iter().map(|p| p.as_vec3()).collect()),
+        indices: indices.into(),
         normals: Some(normals),
         uvs: None,
         face_indices: None,

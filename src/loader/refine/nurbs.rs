@@ -355,8 +355,8 @@ impl Nurbs {
             .map(|n| if n.is_finite() { n } else { Vec3::ZERO })
             .collect();
         finished(MeshData {
-            positions,
-            indices,
+            positions: positions.into(),
+            indices: indices.into(),
             normals: Some(normals),
             uvs: Some(uvs),
             face_indices: None,

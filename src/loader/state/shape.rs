@@ -106,6 +106,12 @@ impl<'s, 'c> Builder<'s, 'c> {
             params.mark_all_used();
             return None;
         };
+        if let Surface::TriangleMesh(m) = &surface {
+            if !self.memory_fits(m, ctm, stmts[i].loc) {
+                params.mark_all_used();
+                return None;
+            }
+        }
         // pbrt-v3 reads alpha textures for triangle meshes only (and passes
         // none to the meshes it refines from other shapes).
         let refined = crate::loader::refine::REFINED_SHAPES.contains(&name.value.as_str());
@@ -147,6 +153,61 @@ impl<'s, 'c> Builder<'s, 'c> {
             shadow_alpha,
             medium_interface,
         })
+    }
+
+    /// The memory estimate of the render's side of the meshes so far (with
+    /// `m`): a copy of positions and normals for a mesh that is not in
+    /// world space already, and the BVH ([`crate::accel::bvh_memory_estimate`]),
+    /// checked against the machine's memory before anything is built. Too
+    /// much: an error at this `Shape` (instead of the system's OOM kill
+    /// during the build).
+    fn memory_fits(&mut self, m: &crate::scene::MeshData, ctm: DMat4, loc: Loc) -> bool {
+        let triangles = m.triangle_count() as u64;
+        let copies = if ctm == DMat4::IDENTITY {
+            0
+        } else {
+            12 * (m.positions.len() + m.normals.as_ref().map_or(0, Vec::len)) as u64
+        };
+        self.scene_triangles += triangles;
+        self.render_bytes += copies;
+        if self.too_big {
+            return false;
+        }
+        if self.scene_triangles > crate::accel::MAX_LEVEL_PRIMITIVES {
+            self.too_big = true;
+            self.ctx.error(
+                loc,
+                format!(
+                    "the scene's meshes have {} triangles so far, more than the {} one BVH holds",
+                    self.scene_triangles,
+                    crate::accel::MAX_LEVEL_PRIMITIVES
+                ),
+                "this mesh brings the scene past the BVH's limit",
+                None,
+            );
+            return false;
+        }
+        let bvh = crate::accel::bvh_memory_estimate(self.scene_triangles);
+        let what = format!(
+            "rendering the scene's {} triangles so far (BVH and world-space copies, estimated)",
+            self.scene_triangles
+        );
+        match crate::scene::memory::check_budget(&what, bvh + self.render_bytes) {
+            Ok(()) => true,
+            Err(why) => {
+                self.too_big = true;
+                self.ctx.error(
+                    loc,
+                    why,
+                    "this mesh brings the scene past the memory available",
+                    Some(format!(
+                        "the BVH takes about {} bytes per triangle; render fewer or smaller meshes, or on a machine with more memory (later meshes are refused too)",
+                        crate::accel::BVH_BYTES_PER_TRIANGLE
+                    )),
+                );
+                false
+            }
+        }
     }
 
     /// pbrt-v3's `CreateMediumInterface`: the current inside and outside
