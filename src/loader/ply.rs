@@ -423,7 +423,10 @@ fn read_faces(
             }
             let n = scalar(ct, &r.data[r.pos..], le);
             r.pos += cs;
-            if n < 0.0 {
+            // The general path's checks and messages: more indices than
+            // bytes left is a bad count, fewer bytes than they need a
+            // truncated file.
+            if n < 0.0 || n > r.left() as f64 {
                 return Err(format!("face {f} has a bad vertex count {n}"));
             }
             if n * is as f64 > r.left() as f64 {
