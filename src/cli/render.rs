@@ -515,11 +515,12 @@ fn render_one(
     if args.stats {
         eprintln!("statistics:");
         eprintln!(
-            "  times: load {:.3} s (scene text and the files it names), build {:.3} s (BVH {:.3} s on {} threads; lights, film), render {:.3} s",
+            "  times: load {:.3} s (scene text and the files it names), build {:.3} s (BVH {:.3} s on {} thread{}; lights, film), render {:.3} s",
             load_time.as_secs_f64(),
             stats.build_time.as_secs_f64(),
             stats.bvh_time.as_secs_f64(),
             stats.threads,
+            if stats.threads == 1 { "" } else { "s" },
             stats.render_time.as_secs_f64()
         );
         for n in desc
