@@ -9,24 +9,9 @@ use pbrs::accel::Aggregate;
 use pbrs::shapes::TriangleMesh;
 use std::time::Instant;
 
-fn mesh(p: Vec<Vec3>, indices: Vec<u32>) -> TriangleMesh {
-    TriangleMesh {
-        p: p.into(),
-        n: None,
-        uv: None,
-        indices: indices.into(),
-        face_indices: None,
-        flip_normal: false,
-        reverse_orientation: false,
-        material: 0,
-        first_light: None,
-        alpha: None,
-    }
-}
-
 fn coincident(n: usize) -> TriangleMesh {
     let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
-    mesh(p, [0, 1, 2].repeat(n))
+    TriangleMesh::plain(p, [0, 1, 2].repeat(n))
 }
 
 fn random(n: usize) -> TriangleMesh {
@@ -44,7 +29,7 @@ fn random(n: usize) -> TriangleMesh {
             p.push(c + Vec3::new(rnd(), rnd(), rnd()) * 0.05);
         }
     }
-    mesh(p, (0..3 * n as u32).collect())
+    TriangleMesh::plain(p, (0..3 * n as u32).collect())
 }
 
 fn main() {

@@ -27,18 +27,7 @@ fn grid(n: u32) -> TriangleMesh {
             indices.extend_from_slice(&[a, a + 1, a + n + 2, a, a + n + 2, a + n + 1]);
         }
     }
-    TriangleMesh {
-        p: p.into(),
-        n: None,
-        uv: None,
-        indices: indices.into(),
-        face_indices: None,
-        flip_normal: false,
-        reverse_orientation: false,
-        material: 0,
-        first_light: None,
-        alpha: None,
-    }
+    TriangleMesh::plain(p, indices)
 }
 
 #[test]

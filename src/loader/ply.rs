@@ -122,29 +122,9 @@ impl Reader<'_> {
         if self.left() < n {
             return Err("the file ends before all elements were read (truncated)".into());
         }
-        let b = &self.data[self.pos..self.pos + n];
+        let v = scalar(ty, &self.data[self.pos..], self.format == Format::BinaryLe);
         self.pos += n;
-        let le = self.format == Format::BinaryLe;
-        macro_rules! get {
-            ($t:ty) => {{
-                let arr: [u8; std::mem::size_of::<$t>()] = b.try_into().expect("size checked");
-                if le {
-                    <$t>::from_le_bytes(arr)
-                } else {
-                    <$t>::from_be_bytes(arr)
-                }
-            }};
-        }
-        Ok(match ty {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => get!(i16) as f64,
-            Scalar::U16 => get!(u16) as f64,
-            Scalar::I32 => get!(i32) as f64,
-            Scalar::U32 => get!(u32) as f64,
-            Scalar::F32 => get!(f32) as f64,
-            Scalar::F64 => get!(f64),
-        })
+        Ok(v)
     }
 }
 

@@ -46,6 +46,23 @@ pub struct AlphaMask {
 }
 
 impl TriangleMesh {
+    /// Positions and indices alone (no normals, uv, alpha or light;
+    /// material 0): the meshes that benchmarks and tests generate.
+    pub fn plain(p: Vec<Vec3>, indices: Vec<u32>) -> TriangleMesh {
+        TriangleMesh {
+            p: p.into(),
+            n: None,
+            uv: None,
+            indices: indices.into(),
+            face_indices: None,
+            flip_normal: false,
+            reverse_orientation: false,
+            material: 0,
+            first_light: None,
+            alpha: None,
+        }
+    }
+
     /// pbrt-v3's alpha test of a hit at barycentrics `b`: false if the hit
     /// is to be ignored (`alpha` is 0 there, or for a shadow ray
     /// `shadowalpha` is). The textures see the hit's point, uv and
