@@ -423,15 +423,8 @@ impl Level {
         let bvh = if prims.is_empty() {
             None
         } else {
-            // Triangles of meshes with alpha masks are left to the
-            // callbacks (like quadrics), so that only they pay for the test.
             let (bvh, order, work) = Bvh4::build_counted(&aabbs, build_params(aabbs.len()), |i| {
-                let p = prims[i];
-                (p.mesh != QUADRIC_TAG
-                    && p.mesh != INSTANCE_TAG
-                    && p.mesh != MOVING_TAG
-                    && meshes[p.mesh as usize].alpha.is_none())
-                .then(|| meshes[p.mesh as usize].vertices(p.index))
+                packed_vertices(meshes, prims[i])
             });
             prims = order.iter().map(|&i| prims[i as usize]).collect();
             build = work;
@@ -445,6 +438,16 @@ impl Level {
             build,
         }
     }
+}
+
+/// The vertices of `p` if a leaf tests it in its triangle pack: a triangle
+/// of a mesh without alpha masks. Those with masks are left to the leaf's
+/// callbacks (like quadrics and instances), so that only they pay for the
+/// test.
+fn packed_vertices(meshes: &[TriangleMesh], p: PrimRef) -> Option<[Vec3; 3]> {
+    let tagged = matches!(p.mesh, QUADRIC_TAG | INSTANCE_TAG | MOVING_TAG);
+    (!tagged && meshes[p.mesh as usize].alpha.is_none())
+        .then(|| meshes[p.mesh as usize].vertices(p.index))
 }
 
 /// Levels with more primitives than this are built by the parallel
@@ -576,14 +579,8 @@ impl Level {
                 build: BuildWork::default(),
             };
         }
-        let (bvh, order, (lo, hi)) = Bvh4::build_binned(refs, |g| {
-            let p = num.prim(g as u32);
-            (p.mesh != QUADRIC_TAG
-                && p.mesh != INSTANCE_TAG
-                && p.mesh != MOVING_TAG
-                && meshes[p.mesh as usize].alpha.is_none())
-            .then(|| meshes[p.mesh as usize].vertices(p.index))
-        });
+        let (bvh, order, (lo, hi)) =
+            Bvh4::build_binned(refs, |g| packed_vertices(meshes, num.prim(g as u32)));
         let prims: Vec<PrimRef> = order.par_iter().map(|&g| num.prim(g)).collect();
         let build = BuildWork {
             binned: true,

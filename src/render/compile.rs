@@ -82,6 +82,7 @@ impl RenderScene {
         if zero > 0 {
             notes.push(format!("{zero} lights of zero power are never sampled"));
         }
+        let (bvh_nodes, bvh_leaves) = aggregate.bvh_counts();
         notes.push(format!(
             "built: {} triangles in {} meshes, {} quadrics, BVH over {} primitives in {:.1} ms ({}, {:.1} MiB in {} nodes and {} leaves); {} lights ({} area lights from {} emissive shapes)",
             aggregate.meshes.iter().map(|m| m.triangle_count() as u64).sum::<u64>(),
@@ -95,8 +96,8 @@ impl RenderScene {
                 "PLOC"
             },
             aggregate.bvh_bytes() as f64 / (1024.0 * 1024.0),
-            aggregate.bvh_counts().0,
-            aggregate.bvh_counts().1,
+            bvh_nodes,
+            bvh_leaves,
             lights.len(),
             area.len(),
             emissive_shapes
