@@ -41,7 +41,7 @@ use crate::geometry::{luminance, spawn_ray, Bounds2i, Bounds3, Ray, RayDiff};
 use crate::integrators::RenderScene;
 use crate::lights::LightSampler;
 use crate::materials::{Bsdf, BxdfFlags};
-use crate::samplers::lowdiscrepancy::{radical_inverse, DigitBase, PRIMES};
+use crate::samplers::lowdiscrepancy::{RadicalTable, PRIMES};
 use crate::samplers::{CameraSample, Sampler};
 use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues, SamplerDesc, SamplerKind};
@@ -331,12 +331,13 @@ impl Sppm {
             sample_pixel_center: false,
         };
         let sampler = Sampler::new(&desc, pb, run.seed);
-        let bases: Vec<DigitBase> = PRIMES.iter().map(|&p| DigitBase::new(p)).collect();
+        let bases: Vec<RadicalTable> = PRIMES.iter().map(|&p| RadicalTable::new(p)).collect();
         let mut counts = RayCounts::default();
         let mut image = vec![Vec3::ZERO; n_pixels];
+        let mut grid = Grid::default();
         for iter in 0..s.iterations {
             counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
-            let grid = run.pool.install(|| Grid::new(&pixels, &vps));
+            run.pool.install(|| grid.rebuild(&pixels, &vps));
             let (acc, c) = self.photon_pass(run, &grid, &vps, &bases, iter, photons);
             counts.add(&c);
             let k = iter + 1;
@@ -482,7 +483,7 @@ impl Sppm {
         run: &SppmRun,
         grid: &Grid,
         vps: &[VisiblePoint],
-        bases: &[DigitBase],
+        bases: &[RadicalTable],
         iter: u32,
         photons: u32,
     ) -> (Vec<(DVec3, u32)>, RayCounts) {
@@ -548,7 +549,7 @@ fn update_pixel(p: &mut Pixel, vp: &mut VisiblePoint, phi: DVec3, m: u32) {
 
 /// The radical inverses of one photon's index, dimension by dimension.
 struct Halton<'b> {
-    bases: &'b [DigitBase],
+    bases: &'b [RadicalTable],
     index: u64,
     dim: usize,
 }
@@ -556,9 +557,13 @@ struct Halton<'b> {
 impl Halton<'_> {
     #[inline]
     fn next(&mut self) -> f32 {
-        let b = &self.bases[self.dim % self.bases.len()];
+        // Dimensions past the last base start again at the first.
+        let b = &self.bases[self.dim];
         self.dim += 1;
-        radical_inverse(b, self.index)
+        if self.dim == self.bases.len() {
+            self.dim = 0;
+        }
+        b.radical_inverse(self.index)
     }
     #[inline]
     fn next_2d(&mut self) -> Vec2 {
@@ -576,7 +581,7 @@ impl Sppm {
         scene: &RenderScene,
         grid: &Grid,
         vps: &[VisiblePoint],
-        bases: &[DigitBase],
+        bases: &[RadicalTable],
         index: u64,
         recs: &mut Vec<(u32, Vec3)>,
         counts: &mut RayCounts,
@@ -672,28 +677,35 @@ pub(super) fn importance(bsdf: &Bsdf, bs: &crate::materials::BsdfSample, wo: Vec
 /// largest radius over the visible points' bounds, hashed into as many
 /// buckets as pixels; each bucket lists, in pixel order, the pixels whose
 /// search disc reaches one of its cells.
+#[derive(Default)]
 struct Grid {
     bounds: Bounds3,
     res: IVec3,
+    buckets: Buckets,
     /// Bucket b lists `entries[starts[b]..starts[b + 1]]`.
     starts: Vec<u32>,
     entries: Vec<u32>,
     /// Each pixel's visible point and search radius, by pixel index (none
     /// where the pixel has no visible point that carries light).
     points: Vec<Option<(Vec3, f32)>>,
+    /// Work space of the build, kept for the next iteration: each pixel's
+    /// first key, and the buckets of every pixel's cells in pixel order.
+    key_starts: Vec<u32>,
+    keys: Vec<u32>,
 }
 
 impl Grid {
-    /// Builds the grid on the current thread pool; the same grid for any
-    /// number of threads.
-    fn new(pixels: &[Pixel], vps: &[VisiblePoint]) -> Grid {
-        let points: Vec<Option<(Vec3, f32)>> = pixels
+    /// Builds the grid on the current thread pool, in the buffers of the
+    /// last iteration's grid; the same grid for any number of threads.
+    fn rebuild(&mut self, pixels: &[Pixel], vps: &[VisiblePoint]) {
+        pixels
             .par_iter()
             .zip(vps)
             .map(|(p, vp)| (vp.beta != Vec3::ZERO).then_some((vp.p, p.radius)))
-            .collect();
+            .collect_into_vec(&mut self.points);
         // Minima and maxima: exact, so in any order.
-        let (bounds, max_radius) = points
+        let (bounds, max_radius) = self
+            .points
             .par_iter()
             .flatten()
             .fold(
@@ -710,61 +722,91 @@ impl Grid {
                 |(a, ma), (b, mb)| (a.union(&b), ma.max(mb)),
             );
         let size = pixels.len().max(1);
-        let mut grid = Grid {
-            bounds,
-            res: IVec3::ONE,
-            starts: vec![0; size + 1],
-            entries: Vec::new(),
-            points,
-        };
+        self.bounds = bounds;
+        self.res = IVec3::ONE;
+        self.buckets = Buckets::new(size);
+        self.starts.clear();
+        self.starts.resize(size + 1, 0);
+        self.entries.clear();
         if max_radius <= 0.0 {
-            return grid;
+            return;
         }
         let diag = bounds.max - bounds.min;
         let max_diag = diag.max_element();
         let base = (max_diag / max_radius) as i32;
-        grid.res = IVec3::new(
+        self.res = IVec3::new(
             ((base as f32 * diag.x / max_diag) as i32).max(1),
             ((base as f32 * diag.y / max_diag) as i32).max(1),
             ((base as f32 * diag.z / max_diag) as i32).max(1),
         );
-        // Every (bucket, pixel) pair in pixel order, made in parallel; then
-        // counted and filled so that buckets list pixels in pixel order.
-        let g = &grid;
-        let pairs: Vec<(u32, u32)> = g
-            .points
+        let mut key_starts = std::mem::take(&mut self.key_starts);
+        let mut keys = std::mem::take(&mut self.keys);
+        // The cells a pixel's disc reaches (an empty range for none).
+        let cells = |pt: &Option<(Vec3, f32)>| match pt {
+            Some((p, radius)) => {
+                let r = Vec3::splat(*radius);
+                (self.cell(*p - r).0, self.cell(*p + r).0)
+            }
+            None => (IVec3::ONE, IVec3::ZERO),
+        };
+        // Each pixel's number of cells, then their buckets in pixel order,
+        // written in parallel (each chunk of pixels owns its run of keys).
+        self.points
             .par_iter()
-            .enumerate()
-            .flat_map_iter(|(i, pt)| {
-                let (lo, hi) = match pt {
-                    Some((p, radius)) => {
-                        let r = Vec3::splat(*radius);
-                        (g.cell(*p - r).0, g.cell(*p + r).0)
-                    }
-                    // An empty range.
-                    None => (IVec3::ONE, IVec3::ZERO),
-                };
-                (lo.z..=hi.z).flat_map(move |z| {
-                    (lo.y..=hi.y).flat_map(move |y| {
-                        (lo.x..=hi.x)
-                            .map(move |x| (hash(IVec3::new(x, y, z), size) as u32, i as u32))
-                    })
-                })
+            .map(|pt| {
+                let (lo, hi) = cells(pt);
+                let n = (hi - lo + IVec3::ONE).max(IVec3::ZERO);
+                (n.x * n.y * n.z) as u32
             })
-            .collect();
-        for &(b, _) in &pairs {
-            grid.starts[b as usize + 1] += 1;
+            .collect_into_vec(&mut key_starts);
+        let mut total = 0u32;
+        for k in key_starts.iter_mut() {
+            let n = *k;
+            *k = total;
+            total += n;
+        }
+        key_starts.push(total);
+        keys.clear();
+        keys.resize(total as usize, 0);
+        let mut runs = Vec::new();
+        let mut rest = &mut keys[..];
+        for first in (0..self.points.len()).step_by(GRID_CHUNK) {
+            let last = (first + GRID_CHUNK).min(self.points.len());
+            let (run, tail) = rest.split_at_mut((key_starts[last] - key_starts[first]) as usize);
+            runs.push((first..last, run));
+            rest = tail;
+        }
+        runs.into_par_iter().for_each(|(range, run)| {
+            let mut k = 0;
+            for pt in &self.points[range] {
+                let (lo, hi) = cells(pt);
+                for z in lo.z..=hi.z {
+                    for y in lo.y..=hi.y {
+                        for x in lo.x..=hi.x {
+                            run[k] = self.buckets.of(IVec3::new(x, y, z)) as u32;
+                            k += 1;
+                        }
+                    }
+                }
+            }
+        });
+        // Counted and filled so that buckets list pixels in pixel order.
+        for &b in &keys {
+            self.starts[b as usize + 1] += 1;
         }
         for b in 0..size {
-            grid.starts[b + 1] += grid.starts[b];
+            self.starts[b + 1] += self.starts[b];
         }
-        grid.entries = vec![0; pairs.len()];
-        let mut fill = grid.starts.clone();
-        for &(b, i) in &pairs {
-            grid.entries[fill[b as usize] as usize] = i;
-            fill[b as usize] += 1;
+        self.entries.resize(total as usize, 0);
+        let mut fill = self.starts.clone();
+        for (i, w) in key_starts.windows(2).enumerate() {
+            for &b in &keys[w[0] as usize..w[1] as usize] {
+                self.entries[fill[b as usize] as usize] = i as u32;
+                fill[b as usize] += 1;
+            }
         }
-        grid
+        self.key_starts = key_starts;
+        self.keys = keys;
     }
 
     fn is_empty(&self) -> bool {
@@ -806,7 +848,7 @@ impl Grid {
         if !inside {
             return;
         }
-        let b = hash(c, self.starts.len() - 1);
+        let b = self.buckets.of(c);
         let (lo, hi) = (self.starts[b] as usize, self.starts[b + 1] as usize);
         for &i in &self.entries[lo..hi] {
             // Only pixels with a visible point are listed.
@@ -823,9 +865,68 @@ impl Grid {
     }
 }
 
-/// pbrt-v3's grid hash.
-#[inline]
+/// Pixels per task of the grid's parallel key pass.
+const GRID_CHUNK: usize = 4096;
+
+/// pbrt-v3's grid hash as it writes it ([`Buckets::of`] computes it).
+#[cfg(test)]
 fn hash(p: IVec3, size: usize) -> usize {
     let h = (p.x.wrapping_mul(73856093)) ^ (p.y.wrapping_mul(19349663)) ^ (p.z.wrapping_mul(83492791));
     (h as u32 as usize) % size
+}
+
+/// [`hash`] into a fixed number of buckets, the remainder taken with a
+/// multiply instead of a division (Lemire, Kaser and Kurz 2019, "Faster
+/// remainder by direct computation"): exact for every 32-bit hash and
+/// bucket count.
+#[derive(Clone, Copy, Debug, Default)]
+struct Buckets {
+    size: u64,
+    /// `⌈2^64 / size⌉` (0 where `size` does not fit 32 bits, or is 1).
+    magic: u64,
+}
+
+impl Buckets {
+    fn new(size: usize) -> Buckets {
+        let size = size.max(1) as u64;
+        let magic = if size > 1 && size <= u32::MAX as u64 {
+            u64::MAX / size + 1
+        } else {
+            0
+        };
+        Buckets { size, magic }
+    }
+
+    #[inline(always)]
+    fn of(&self, p: IVec3) -> usize {
+        let h = ((p.x.wrapping_mul(73856093)) ^ (p.y.wrapping_mul(19349663)) ^ (p.z.wrapping_mul(83492791))) as u32;
+        if self.magic != 0 {
+            let low = self.magic.wrapping_mul(h as u64);
+            ((low as u128 * self.size as u128) >> 64) as usize
+        } else {
+            (h as u64 % self.size) as usize
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::rng::Pcg32;
+
+    #[test]
+    fn buckets_are_pbrt_v3_hash() {
+        let mut r = Pcg32::with_sequence(3);
+        for size in [1usize, 2, 3, 7, 160 * 229, 1 << 20, (1 << 31) - 1, u32::MAX as usize, 1 << 33] {
+            let b = Buckets::new(size);
+            for _ in 0..20_000 {
+                let c = IVec3::new(
+                    r.uniform_u32() as i32,
+                    (r.uniform_u32() % 1000) as i32,
+                    r.uniform_u32() as i32 >> 7,
+                );
+                assert_eq!(b.of(c), hash(c, size), "size {size} cell {c}");
+            }
+        }
+    }
 }

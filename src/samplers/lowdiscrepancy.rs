@@ -182,6 +182,107 @@ pub fn radical_inverse_base3(mut a: u64) -> f32 {
     ((reversed as f64 * INV3_POWERS[n]) as f32).min(ONE_MINUS_EPSILON)
 }
 
+/// Largest chunk of digits [`RadicalTable`] looks up at once.
+const RADICAL_CHUNK_MAX: u64 = 4096;
+
+/// The unscrambled radical inverse in one base, several digits per step
+/// from a table (`radical_inverse` bit for bit): a chunk of `k` digits,
+/// `base^k ≤ 4096`, costs one multiply-high and one load where the plain
+/// loop pays `k` dependent multiply-highs. Base 2 reverses the bits (below
+/// 2^53, where that is exact); bases above 64 (one digit per chunk) use the
+/// plain loop.
+pub struct RadicalTable {
+    base: DigitBase,
+    /// `base^k`, the chunk, and its magic number (as [`DigitBase`]'s).
+    chunk: u64,
+    chunk_magic: u64,
+    k: usize,
+    /// For `v < chunk`: its `k` digits reversed (`.0`), its significant
+    /// digits reversed (`.1`), and how many those are (`.2`). Empty where
+    /// the table is not used (base 2 below 2^53, whose bits are reversed,
+    /// and bases above 64).
+    entries: Box<[(u16, u16, u16)]>,
+    /// `base^n` for `n ≤ k`.
+    pow: [u64; 13],
+    /// 1/base multiplied into 1.0 `n` times in f64, one step at a time (the
+    /// rounding of `radical_inverse`'s loop).
+    inv_powers: [f64; 65],
+}
+
+impl RadicalTable {
+    pub fn new(base: u32) -> RadicalTable {
+        let b = DigitBase::new(base);
+        let (mut chunk, mut k) = (1u64, 0usize);
+        while chunk * base as u64 <= RADICAL_CHUNK_MAX {
+            chunk *= base as u64;
+            k += 1;
+        }
+        let mut pow = [1u64; 13];
+        for n in 1..=k {
+            pow[n] = pow[n - 1] * base as u64;
+        }
+        let mut inv_powers = [1.0f64; 65];
+        for n in 1..65 {
+            inv_powers[n] = inv_powers[n - 1] * b.inv_base;
+        }
+        let entries = if k < 2 {
+            Box::default()
+        } else {
+            (0..chunk)
+                .map(|v| {
+                    let (mut a, mut rev, mut n) = (v, 0u64, 0usize);
+                    while a != 0 {
+                        rev = rev * base as u64 + a % base as u64;
+                        a /= base as u64;
+                        n += 1;
+                    }
+                    ((rev * pow[k - n]) as u16, rev as u16, n as u16)
+                })
+                .collect()
+        };
+        RadicalTable {
+            base: b,
+            chunk,
+            // (Unused where the chunk is a single digit or less.)
+            chunk_magic: (u64::MAX / chunk).wrapping_add(1),
+            k,
+            entries,
+            pow,
+            inv_powers,
+        }
+    }
+
+    /// `radical_inverse(&DigitBase::new(base), a)`, bit for bit.
+    #[inline]
+    pub fn radical_inverse(&self, mut a: u64) -> f32 {
+        if self.base.base == 2 && a < 1 << 53 {
+            return radical_inverse_base2(a);
+        }
+        if self.entries.is_empty() {
+            return radical_inverse(&self.base, a);
+        }
+        let mut reversed: u64 = 0;
+        let mut n = 0usize;
+        while a >= self.chunk {
+            let next = if a <= u32::MAX as u64 {
+                ((a as u128 * self.chunk_magic as u128) >> 64) as u64
+            } else {
+                a / self.chunk
+            };
+            let e = self.entries[(a - next * self.chunk) as usize];
+            reversed = reversed.wrapping_mul(self.chunk).wrapping_add(e.0 as u64);
+            n += self.k;
+            a = next;
+        }
+        let e = self.entries[a as usize];
+        reversed = reversed
+            .wrapping_mul(self.pow[e.2 as usize])
+            .wrapping_add(e.1 as u64);
+        n += e.2 as usize;
+        ((reversed as f64 * self.inv_powers[n]) as f32).min(ONE_MINUS_EPSILON)
+    }
+}
+
 /// Radical inverse with every digit (including the infinitely many leading
 /// zeros) mapped through `perm` (pbrt-v3's `ScrambledRadicalInverse`).
 #[inline]
@@ -785,6 +886,44 @@ mod tests {
                     scrambled_radical_inverse(b, perm, tail, a).to_bits(),
                     "dim {dim} a {a}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn radical_tables_are_bit_identical() {
+        let mut r = Pcg32::with_sequence(11);
+        for &p in PRIMES
+            .iter()
+            .take(80)
+            .chain(&PRIMES[PRIME_TABLE_SIZE - 3..])
+        {
+            let b = DigitBase::new(p);
+            let t = RadicalTable::new(p);
+            let check = |a: u64| {
+                assert_eq!(
+                    t.radical_inverse(a).to_bits(),
+                    radical_inverse(&b, a).to_bits(),
+                    "base {p} a {a}"
+                );
+            };
+            for a in 0..5_000u64 {
+                check(a);
+            }
+            for _ in 0..5_000 {
+                check(r.uniform_u32() as u64);
+                check(((r.uniform_u32() as u64) << 32) | r.uniform_u32() as u64);
+            }
+            // Around powers of the base and the chunk, and the extremes.
+            let mut q = 1u64;
+            while let Some(n) = q.checked_mul(p as u64) {
+                for a in [q - 1, q, q + 1, n - 1] {
+                    check(a);
+                }
+                q = n;
+            }
+            for a in [u32::MAX as u64, u32::MAX as u64 + 1, u64::MAX - 1, u64::MAX] {
+                check(a);
             }
         }
     }
