@@ -335,19 +335,23 @@ impl Sppm {
         let mut counts = RayCounts::default();
         let mut image = vec![Vec3::ZERO; n_pixels];
         let mut grid = Grid::default();
+        // Each pixel's photons of the iteration (flux and count), zeroed
+        // again as the pixels are updated.
+        let mut acc = vec![(DVec3::ZERO, 0u32); n_pixels];
         for iter in 0..s.iterations {
             counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
             run.pool.install(|| grid.rebuild(&pixels, &vps));
-            let (acc, c) = self.photon_pass(run, &grid, &vps, &bases, iter, photons);
+            let c = self.photon_pass(run, &grid, &vps, &bases, iter, photons, &mut acc);
             counts.add(&c);
             let k = iter + 1;
             let write = k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
             let np = k as u64 * photons as u64;
             // Each pixel on its own: in parallel, the same values.
             run.pool.install(|| {
-                (pixels.par_iter_mut(), vps.par_iter_mut(), acc.into_par_iter(), image.par_iter_mut())
+                (pixels.par_iter_mut(), vps.par_iter_mut(), acc.par_iter_mut(), image.par_iter_mut())
                     .into_par_iter()
-                    .for_each(|(p, vp, (phi, m), l)| {
+                    .for_each(|(p, vp, a, l)| {
+                        let (phi, m) = std::mem::take(a);
                         update_pixel(p, vp, phi, m);
                         *l = p.ld / k as f32;
                         if np > 0 && p.radius > 0.0 {
@@ -477,7 +481,9 @@ impl Sppm {
 
     /// Step (3): photons in fixed chunks traced in parallel, each chunk's
     /// contributions (pixel, flux) recorded in photon order and added
-    /// chunk by chunk in order: each pixel's flux and photon count.
+    /// chunk by chunk in order into `acc` (zero on entry): each pixel's
+    /// flux and photon count.
+    #[allow(clippy::too_many_arguments)]
     fn photon_pass(
         &self,
         run: &SppmRun,
@@ -486,11 +492,11 @@ impl Sppm {
         bases: &[RadicalTable],
         iter: u32,
         photons: u32,
-    ) -> (Vec<(DVec3, u32)>, RayCounts) {
+        acc: &mut [(DVec3, u32)],
+    ) -> RayCounts {
         let mut counts = RayCounts::default();
-        let mut acc = vec![(DVec3::ZERO, 0u32); vps.len()];
         if grid.is_empty() || run.scene.lights.is_empty() {
-            return (acc, counts);
+            return counts;
         }
         let chunks = photons.div_ceil(PHOTON_CHUNK);
         // Chunks in flight at once: enough for every thread, few enough
@@ -527,7 +533,7 @@ impl Sppm {
             }
             first = last;
         }
-        (acc, counts)
+        counts
     }
 }
 
