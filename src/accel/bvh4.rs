@@ -217,6 +217,35 @@ impl Bvh4 {
         )
     }
 
+    /// The tree's cost by the surface area heuristic (the weights of
+    /// [`CollapsePlan`]): each child box's half area times the cost of
+    /// testing what it holds, summed; proportional to the expected cost of
+    /// a random ray through the root's box.
+    pub(super) fn sah_cost(&self) -> f64 {
+        let mut cost = 0.0f64;
+        for n in &self.nodes {
+            for slot in 0..4 {
+                if !n.valid.test(slot) {
+                    continue;
+                }
+                let d = Vec3::new(
+                    n.b[3][slot] - n.b[0][slot],
+                    n.b[4][slot] - n.b[1][slot],
+                    n.b[5][slot] - n.b[2][slot],
+                )
+                .max(Vec3::ZERO);
+                let area = (d.x * d.y + d.y * d.z + d.z * d.x) as f64;
+                let weight = if n.child[slot] & LEAF != 0 {
+                    COST_LEAF
+                } else {
+                    COST_NODE
+                };
+                cost += area * weight as f64;
+            }
+        }
+        cost
+    }
+
     /// Bytes held by the nodes and leaves.
     pub(super) fn heap_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>()

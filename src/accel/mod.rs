@@ -367,9 +367,11 @@ impl MovingInstance {
 }
 
 impl Level {
-    /// Builds the BVH (in parallel, with obvhs's PLOC builder) over the shapes
-    /// and the given extra boxes (instances). Zero-area triangles are left
-    /// out; an empty level builds no BVH at all.
+    /// Builds the BVH over the shapes and the given extra boxes
+    /// (instances): by obvhs's PLOC for small levels, by the binned builder
+    /// for big ones, and by whichever gives the cheaper tree in between.
+    /// Zero-area triangles are left out; an empty level builds no BVH at
+    /// all.
     fn build(
         meshes: &[TriangleMesh],
         quadrics: &[AnalyticShape],
@@ -377,9 +379,34 @@ impl Level {
         moving: &[Bounds3],
     ) -> Level {
         let triangles: usize = meshes.iter().map(|m| m.triangle_count() as usize).sum();
-        if triangles + quadrics.len() + extra.len() + moving.len() > BINNED_MIN {
+        let count = triangles + quadrics.len() + extra.len() + moving.len();
+        if count > BINNED_MIN {
             return Level::build_binned(meshes, quadrics, extra, moving);
         }
+        let ploc = Level::build_ploc(meshes, quadrics, extra, moving);
+        if count <= COMPARE_MIN {
+            return ploc;
+        }
+        // Neither builder makes the better tree everywhere (the f16 of
+        // pbrt-v3's caustic-glass scenes traces faster with the binned one,
+        // the Stanford dragon with PLOC's): both are built and the one the
+        // surface area heuristic rates cheaper is kept.
+        let binned = Level::build_binned(meshes, quadrics, extra, moving);
+        let cost = |l: &Level| l.bvh.as_ref().map_or(f64::INFINITY, |b| b.sah_cost());
+        if cost(&binned) < cost(&ploc) {
+            binned
+        } else {
+            ploc
+        }
+    }
+
+    /// [`Level::build`] by obvhs's PLOC and the SAH collapse.
+    fn build_ploc(
+        meshes: &[TriangleMesh],
+        quadrics: &[AnalyticShape],
+        extra: &[Bounds3],
+        moving: &[Bounds3],
+    ) -> Level {
         let mut prims = Vec::new();
         let mut aabbs = Vec::new();
         let mut bounds = Bounds3::EMPTY;
@@ -455,6 +482,10 @@ fn packed_vertices(meshes: &[TriangleMesh], p: PrimRef) -> Option<[Vec3; 3]> {
 /// in a fraction of PLOC's memory; smaller ones by obvhs's PLOC and the SAH
 /// collapse.
 const BINNED_MIN: usize = 262_144;
+
+/// Levels with more primitives than this (and at most [`BINNED_MIN`]) are
+/// built by both builders, and keep the tree with the lower SAH cost.
+const COMPARE_MIN: usize = 4096;
 
 /// Bytes per primitive a big level's BVH holds at its peak: about 67
 /// measured (10 M triangles: 64 in leaves of 3.8 triangles with their
@@ -1019,5 +1050,46 @@ fn build_params(n: usize) -> BvhBuildParams {
         BvhBuildParams::slow_build()
     } else {
         BvhBuildParams::medium_build()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::rng::Pcg32;
+
+    /// A mesh of `n` random small triangles in clusters (`clusters` of
+    /// them), so that the two builders make different trees.
+    fn clustered(n: usize, clusters: usize, seed: u64) -> TriangleMesh {
+        let mut r = Pcg32::with_sequence(seed);
+        let mut v = || Vec3::new(r.uniform_f32(), r.uniform_f32(), r.uniform_f32());
+        let centres: Vec<Vec3> = (0..clusters).map(|_| v() * 100.0).collect();
+        let mut p = Vec::with_capacity(3 * n);
+        for i in 0..n {
+            let c = centres[i % clusters] + v() * 4.0;
+            p.extend([c, c + v() * 0.5, c + v() * 0.5]);
+        }
+        TriangleMesh::plain(p, (0..3 * n as u32).collect())
+    }
+
+    #[test]
+    fn mid_sized_levels_keep_the_cheaper_tree() {
+        let cost = |l: &Level| l.bvh.as_ref().unwrap().sah_cost();
+        let mut picked = [0, 0];
+        for (seed, clusters) in [(1, 1), (2, 7), (3, 60), (4, 400)] {
+            let meshes = [clustered(COMPARE_MIN + 1000, clusters, seed)];
+            let level = Level::build(&meshes, &[], &[], &[]);
+            let ploc = Level::build_ploc(&meshes, &[], &[], &[]);
+            let binned = Level::build_binned(&meshes, &[], &[], &[]);
+            let best = cost(&ploc).min(cost(&binned));
+            assert_eq!(cost(&level), best, "seed {seed}");
+            assert_eq!(level.build.binned, cost(&binned) < cost(&ploc));
+            picked[level.build.binned as usize] += 1;
+            assert_eq!(level.prims.len(), meshes[0].triangle_count() as usize);
+        }
+        // Small levels are PLOC's alone.
+        let meshes = [clustered(COMPARE_MIN, 7, 5)];
+        assert!(!Level::build(&meshes, &[], &[], &[]).build.binned);
+        eprintln!("levels that kept PLOC's tree, the binned one: {picked:?}");
     }
 }
