@@ -228,13 +228,9 @@ impl Bvh4 {
                 if !n.valid.test(slot) {
                     continue;
                 }
-                let d = Vec3::new(
-                    n.b[3][slot] - n.b[0][slot],
-                    n.b[4][slot] - n.b[1][slot],
-                    n.b[5][slot] - n.b[2][slot],
-                )
-                .max(Vec3::ZERO);
-                let area = (d.x * d.y + d.y * d.z + d.z * d.x) as f64;
+                let lo = Vec3::new(n.b[0][slot], n.b[1][slot], n.b[2][slot]);
+                let hi = Vec3::new(n.b[3][slot], n.b[4][slot], n.b[5][slot]);
+                let area = Aabb::new(lo.into(), hi.into()).half_area().max(0.0) as f64;
                 let weight = if n.child[slot] & LEAF != 0 {
                     COST_LEAF
                 } else {
@@ -865,13 +861,7 @@ mod tests {
         let tris = random_triangles(&mut rng, 20, 1.0, 0.3);
         let others = [Aabb::new(Vec3::splat(-0.1).into(), Vec3::splat(0.1).into())];
         let (bvh, order) = build_binned(&tris, &others);
-        let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
-        let mut seen = Vec::new();
-        bvh.closest(&ray, f32::INFINITY, |pos, _| {
-            seen.push(order[pos as usize]);
-            None
-        });
-        assert_eq!(seen, vec![20]);
+        assert_eq!(others_on_axis(&bvh, &order), vec![20]);
         // Determinism across thread counts.
         let tris = random_triangles(&mut rng, 150_000, 1.0, 0.01);
         let run = |threads: usize| {
@@ -1104,6 +1094,18 @@ mod tests {
         }
     }
 
+    /// The primitives other than triangles that a closest-hit query along
+    /// the z axis hands to its callback (rejecting each).
+    fn others_on_axis(bvh: &Bvh4, order: &[u32]) -> Vec<u32> {
+        let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        let mut seen = Vec::new();
+        bvh.closest(&ray, f32::INFINITY, |pos, _| {
+            seen.push(order[pos as usize]);
+            None
+        });
+        seen
+    }
+
     #[test]
     fn other_primitives_are_handed_out() {
         let mut rng = Pcg32::with_sequence(3);
@@ -1114,13 +1116,7 @@ mod tests {
             Aabb::new(Vec3::splat(0.3).into(), Vec3::splat(0.4).into()),
         ];
         let (bvh, order) = build(&tris, &others);
-        let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
-        let mut seen = Vec::new();
-        bvh.closest(&ray, f32::INFINITY, |pos, _| {
-            seen.push(order[pos as usize]);
-            None
-        });
-        assert_eq!(seen, vec![20]);
+        assert_eq!(others_on_axis(&bvh, &order), vec![20]);
         let ray = Ray::new(Vec3::new(0.35, 0.35, -5.0), Vec3::Z);
         assert!(bvh.any(&ray, f32::INFINITY, |pos| order[pos as usize] == 21));
     }

@@ -874,11 +874,17 @@ impl Grid {
 /// Pixels per task of the grid's parallel key pass.
 const GRID_CHUNK: usize = 4096;
 
-/// pbrt-v3's grid hash as it writes it ([`Buckets::of`] computes it).
+/// pbrt-v3's grid hash of a cell, before the remainder by the bucket count.
+#[inline(always)]
+fn cell_hash(p: IVec3) -> u32 {
+    ((p.x.wrapping_mul(73856093)) ^ (p.y.wrapping_mul(19349663)) ^ (p.z.wrapping_mul(83492791))) as u32
+}
+
+/// pbrt-v3's bucket of a cell, with its division ([`Buckets::of`] computes
+/// it).
 #[cfg(test)]
 fn hash(p: IVec3, size: usize) -> usize {
-    let h = (p.x.wrapping_mul(73856093)) ^ (p.y.wrapping_mul(19349663)) ^ (p.z.wrapping_mul(83492791));
-    (h as u32 as usize) % size
+    cell_hash(p) as usize % size
 }
 
 /// [`hash`] into a fixed number of buckets, the remainder taken with a
@@ -905,7 +911,7 @@ impl Buckets {
 
     #[inline(always)]
     fn of(&self, p: IVec3) -> usize {
-        let h = ((p.x.wrapping_mul(73856093)) ^ (p.y.wrapping_mul(19349663)) ^ (p.z.wrapping_mul(83492791))) as u32;
+        let h = cell_hash(p);
         if self.magic != 0 {
             let low = self.magic.wrapping_mul(h as u64);
             ((low as u128 * self.size as u128) >> 64) as usize
