@@ -23,6 +23,7 @@ use super::random::stream_rng;
 use super::sobolmatrices::{sobol_matrices, to_unit, SOBOL_MATRIX_SIZE};
 use super::ArrayStore;
 use crate::geometry::Bounds2i;
+use crate::sampling::bounded_fast::BoundedDraws;
 use crate::sampling::rng::{mix64, Pcg32};
 use glam::{IVec2, Vec2};
 
@@ -63,10 +64,15 @@ pub struct PixelSampler {
     dim_2d: usize,
     /// Values past the tables.
     extra: Pcg32,
+    /// The shuffles' draws below every count up to the largest of `spp`
+    /// and the arrays' sizes.
+    draws: BoundedDraws,
 }
 
-/// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values.
-fn shuffle<T>(s: &mut [T], count: usize, n: usize, rng: &mut Pcg32) {
+/// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values
+/// (the plain method, which [`shuffle`] equals).
+#[cfg(test)]
+fn shuffle_plain<T>(s: &mut [T], count: usize, n: usize, rng: &mut Pcg32) {
     for i in 0..count {
         let other = i + rng.uniform_u32_below((count - i) as u32) as usize;
         for j in 0..n {
@@ -75,24 +81,78 @@ fn shuffle<T>(s: &mut [T], count: usize, n: usize, rng: &mut Pcg32) {
     }
 }
 
+/// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values,
+/// with the draws of `draws` (the same values and RNG state as
+/// [`Pcg32::uniform_u32_below`]).
+#[inline]
+fn shuffle<T>(s: &mut [T], count: usize, n: usize, rng: &mut Pcg32, draws: &BoundedDraws) {
+    if n == 1 {
+        let s = &mut s[..count];
+        for i in 0..count {
+            let other = i + draws.below(rng, (count - i) as u32) as usize;
+            s.swap(i, other);
+        }
+        return;
+    }
+    for i in 0..count {
+        let other = i + draws.below(rng, (count - i) as u32) as usize;
+        if other != i {
+            let (a, b) = s.split_at_mut(n * other);
+            a[n * i..n * i + n].swap_with_slice(&mut b[..n]);
+        }
+    }
+}
+
+/// pbrt-v3's shuffle of each of a pixel's `spp` runs of `per_sample` values
+/// within itself. A run of one value stays as it is after one draw below 1,
+/// so the RNG skips those draws in one step.
+#[inline]
+fn shuffle_within<T>(
+    out: &mut [T],
+    per_sample: usize,
+    spp: usize,
+    rng: &mut Pcg32,
+    draws: &BoundedDraws,
+) {
+    if per_sample == 1 {
+        rng.advance(spp as i64);
+        return;
+    }
+    for i in 0..spp {
+        shuffle(&mut out[i * per_sample..], per_sample, 1, rng, draws);
+    }
+}
+
 /// pbrt-v3's `GrayCodeSample` (one dimension) and `VanDerCorput`: the
 /// scrambled van der Corput values in Gray-code order, shuffled within each
 /// pixel sample's `per_sample` values, then the pixel samples shuffled.
-fn van_der_corput(per_sample: usize, spp: usize, out: &mut [f32], c: &[u32], rng: &mut Pcg32) {
+fn van_der_corput(
+    per_sample: usize,
+    spp: usize,
+    out: &mut [f32],
+    c: &[u32],
+    rng: &mut Pcg32,
+    draws: &BoundedDraws,
+) {
     let mut v = rng.uniform_u32();
     for (i, o) in out.iter_mut().enumerate().take(per_sample * spp) {
         *o = to_unit(v);
         v ^= c[(i as u32 + 1).trailing_zeros() as usize];
     }
-    for i in 0..spp {
-        shuffle(&mut out[i * per_sample..], per_sample, 1, rng);
-    }
-    shuffle(out, spp, per_sample, rng);
+    shuffle_within(out, per_sample, spp, rng, draws);
+    shuffle(out, spp, per_sample, rng, draws);
 }
 
 /// pbrt-v3's `Sobol2D`: the scrambled (0,2)-sequence in Gray-code order,
 /// shuffled as [`van_der_corput`].
-fn sobol_2d(per_sample: usize, spp: usize, out: &mut [Vec2], c: [&[u32]; 2], rng: &mut Pcg32) {
+fn sobol_2d(
+    per_sample: usize,
+    spp: usize,
+    out: &mut [Vec2],
+    c: [&[u32]; 2],
+    rng: &mut Pcg32,
+    draws: &BoundedDraws,
+) {
     let mut v = [rng.uniform_u32(), rng.uniform_u32()];
     for (i, o) in out.iter_mut().enumerate().take(per_sample * spp) {
         *o = Vec2::new(to_unit(v[0]), to_unit(v[1]));
@@ -100,10 +160,8 @@ fn sobol_2d(per_sample: usize, spp: usize, out: &mut [Vec2], c: [&[u32]; 2], rng
         v[0] ^= c[0][k];
         v[1] ^= c[1][k];
     }
-    for i in 0..spp {
-        shuffle(&mut out[i * per_sample..], per_sample, 1, rng);
-    }
-    shuffle(out, spp, per_sample, rng);
+    shuffle_within(out, per_sample, spp, rng, draws);
+    shuffle(out, spp, per_sample, rng, draws);
 }
 
 /// pbrt-v3's `MultiplyGenerator`.
@@ -156,6 +214,14 @@ impl PixelSampler {
             dim_1d: 0,
             dim_2d: 0,
             extra: Pcg32::new(),
+            draws: BoundedDraws::new(spp),
+        }
+    }
+
+    /// Covers the arrays' sizes in the shuffles' draws.
+    fn cover(&mut self, n: u32) {
+        if n > self.draws.max() {
+            self.draws = BoundedDraws::new(n);
         }
     }
 
@@ -175,11 +241,13 @@ impl PixelSampler {
     }
 
     pub fn request_1d_array(&mut self, n: u32) {
+        self.cover(n);
         self.arrays.request_1d(n, self.spp);
         self.generated = None;
     }
 
     pub fn request_2d_array(&mut self, n: u32) {
+        self.cover(n);
         self.arrays.request_2d(n, self.spp);
         self.generated = None;
     }
@@ -189,6 +257,7 @@ impl PixelSampler {
     fn generate(&mut self) {
         let spp = self.spp as usize;
         let rng = &mut self.rng;
+        let draws = &self.draws;
         let (c0, c1) = (self.c0, self.c1);
         let mut rest_2d = &mut self.samples_2d[..];
         if let Pattern::MaxMinDist(c) = self.pattern {
@@ -197,22 +266,22 @@ impl PixelSampler {
                 for (i, v) in first.iter_mut().enumerate() {
                     *v = Vec2::new(i as f32 * inv, to_unit(multiply_generator(c, i as u32)));
                 }
-                shuffle(first, spp, 1, rng);
+                shuffle(first, spp, 1, rng, draws);
                 rest_2d = rest;
             }
         }
         for s in &mut self.samples_1d {
-            van_der_corput(1, spp, s, c0, rng);
+            van_der_corput(1, spp, s, c0, rng, draws);
         }
         for s in rest_2d {
-            sobol_2d(1, spp, s, [c0, c1], rng);
+            sobol_2d(1, spp, s, [c0, c1], rng, draws);
         }
         let a = &mut self.arrays;
         for (&n, data) in a.sizes_1d.iter().zip(a.data_1d.iter_mut()) {
-            van_der_corput(n as usize, spp, data, c0, rng);
+            van_der_corput(n as usize, spp, data, c0, rng, draws);
         }
         for (&n, data) in a.sizes_2d.iter().zip(a.data_2d.iter_mut()) {
-            sobol_2d(n as usize, spp, data, [c0, c1], rng);
+            sobol_2d(n as usize, spp, data, [c0, c1], rng, draws);
         }
     }
 
@@ -309,5 +378,43 @@ impl PixelSampler {
             return None;
         }
         self.arrays.get_2d(n, self.sample_index as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shuffles_equal_pbrt_v3s() {
+        let draws = BoundedDraws::new(64);
+        let cases = [
+            (1usize, 1usize),
+            (2, 1),
+            (64, 1),
+            (64, 3),
+            (16, 8),
+            (7, 2),
+            (100, 1),
+        ];
+        for &(count, n) in &cases {
+            let mut a: Vec<u32> = (0..(count * n) as u32).collect();
+            let mut b = a.clone();
+            let mut ra = Pcg32::new();
+            ra.set_sequence(count as u64 * 31 + n as u64);
+            let mut rb = ra;
+            shuffle(&mut a, count, n, &mut ra, &draws);
+            shuffle_plain(&mut b, count, n, &mut rb);
+            assert_eq!(a, b, "count {count} n {n}");
+            assert_eq!(ra.uniform_u32(), rb.uniform_u32());
+            // The runs of one pixel sample each, shuffled within themselves.
+            let (spp, per) = (count, n);
+            shuffle_within(&mut a, per, spp, &mut ra, &draws);
+            for i in 0..spp {
+                shuffle_plain(&mut b[i * per..], per, 1, &mut rb);
+            }
+            assert_eq!(a, b, "within: spp {spp} per sample {per}");
+            assert_eq!(ra.uniform_u32(), rb.uniform_u32());
+        }
     }
 }

@@ -3,6 +3,7 @@
 //! reusable chi-square harness ([`chi2`]) to test any of them.
 
 pub mod alias;
+pub mod bounded_fast;
 pub mod chi2;
 pub mod distribution;
 pub mod interpolation;

@@ -1,0 +1,125 @@
+//! Speed only: pbrt-v3's `RNG::UniformUInt32(b)` ([`Pcg32::uniform_u32_below`])
+//! for the many draws below small bounds that shuffles make, with both of
+//! its remainders (the rejection threshold and the result) taken by
+//! multiplication (Lemire, Kaser and Kurz, "Faster remainder by direct
+//! computation", 2019) from constants made once per bound, in place of two
+//! integer divisions per draw. The draws and the RNG's state afterwards are
+//! the plain method's, bit for bit (`tests::equals_plain`).
+
+use super::rng::Pcg32;
+
+/// `a % d` for any `a` and `d >= 1` from `m = ⌊(2^64 − 1) / d⌋ + 1`
+/// (wrapping: 0 for `d = 1`).
+#[inline(always)]
+fn fastmod(a: u32, m: u64, d: u32) -> u32 {
+    ((m.wrapping_mul(a as u64) as u128 * d as u128) >> 64) as u32
+}
+
+/// The constants of every bound from 1 to `max`.
+#[derive(Clone, Debug, Default)]
+pub struct BoundedDraws {
+    /// `(m, threshold)` of bound `b` at index `b` (index 0 unused).
+    consts: Vec<(u64, u32)>,
+}
+
+impl BoundedDraws {
+    /// Constants for the bounds `1..=max`.
+    pub fn new(max: u32) -> Self {
+        let consts = (0..=max.max(1))
+            .map(|b| {
+                if b == 0 {
+                    return (0, 0);
+                }
+                let m = (u64::MAX / b as u64).wrapping_add(1);
+                (m, fastmod(b.wrapping_neg(), m, b))
+            })
+            .collect();
+        Self { consts }
+    }
+
+    /// Largest bound covered.
+    #[inline]
+    pub fn max(&self) -> u32 {
+        self.consts.len() as u32 - 1
+    }
+
+    /// `rng.uniform_u32_below(b)` for `1 <= b <= max()` (larger bounds take
+    /// the plain method).
+    #[inline]
+    pub fn below(&self, rng: &mut Pcg32, b: u32) -> u32 {
+        let Some(&(m, threshold)) = self.consts.get(b as usize) else {
+            return rng.uniform_u32_below(b);
+        };
+        loop {
+            let r = rng.uniform_u32();
+            if r >= threshold {
+                return fastmod(r, m, b);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fastmod_is_the_remainder() {
+        let ds = [
+            1u32,
+            2,
+            3,
+            5,
+            7,
+            10,
+            63,
+            64,
+            65,
+            1000,
+            4095,
+            4096,
+            65537,
+            u32::MAX - 1,
+            u32::MAX,
+        ];
+        let mut rng = Pcg32::new();
+        for &d in &ds {
+            let m = (u64::MAX / d as u64).wrapping_add(1);
+            let mut aa = vec![
+                0u32,
+                1,
+                d - 1,
+                d,
+                d.wrapping_add(1),
+                u32::MAX,
+                u32::MAX - 1,
+                d.wrapping_neg(),
+            ];
+            aa.extend((0..2000).map(|_| rng.uniform_u32()));
+            for a in aa {
+                assert_eq!(fastmod(a, m, d), a % d, "{a} % {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn equals_plain() {
+        let draws = BoundedDraws::new(300);
+        assert_eq!(draws.max(), 300);
+        let mut fast = Pcg32::new();
+        fast.set_sequence(17);
+        let mut plain = fast.clone();
+        // Every covered bound, and bounds past the table.
+        for round in 0..40u32 {
+            for b in 1..=310u32 {
+                let b = if round % 7 == 3 { b * 1_000_003 } else { b };
+                assert_eq!(
+                    draws.below(&mut fast, b),
+                    plain.uniform_u32_below(b),
+                    "bound {b}"
+                );
+            }
+        }
+        assert_eq!(fast.uniform_u32(), plain.uniform_u32());
+    }
+}
