@@ -108,7 +108,7 @@ mod tests {
         assert_eq!(draws.max(), 300);
         let mut fast = Pcg32::new();
         fast.set_sequence(17);
-        let mut plain = fast.clone();
+        let mut plain = fast;
         // Every covered bound, and bounds past the table.
         for round in 0..40u32 {
             for b in 1..=310u32 {
