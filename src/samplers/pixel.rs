@@ -23,7 +23,7 @@ use super::random::stream_rng;
 use super::sobolmatrices::{sobol_matrices, to_unit, SOBOL_MATRIX_SIZE};
 use super::ArrayStore;
 use crate::geometry::Bounds2i;
-use crate::sampling::bounded_fast::BoundedDraws;
+use crate::sampling::bounded_fast::{BoundedDraws, Jumps};
 use crate::sampling::rng::{mix64, Pcg32};
 use glam::{IVec2, Vec2};
 
@@ -67,6 +67,12 @@ pub struct PixelSampler {
     /// The shuffles' draws below every count up to the largest of `spp`
     /// and the arrays' sizes.
     draws: BoundedDraws,
+    /// For each array of the current pixel not made yet: the RNG as
+    /// pbrt-v3's `StartPixel` has it where that array begins. An array is
+    /// made when a sample first asks for it (most of directlighting's
+    /// arrays, one per light and bounce, are never read).
+    pending_1d: Vec<Option<Pcg32>>,
+    pending_2d: Vec<Option<Pcg32>>,
 }
 
 /// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values
@@ -121,6 +127,27 @@ fn shuffle_within<T>(
     for i in 0..spp {
         shuffle(&mut out[i * per_sample..], per_sample, 1, rng, draws);
     }
+}
+
+/// The RNG stepped past the draws that [`van_der_corput`] (`scrambles` 1)
+/// or [`sobol_2d`] (`scrambles` 2) make, without the values or the swaps.
+fn skip_table(
+    scrambles: i64,
+    per_sample: usize,
+    spp: usize,
+    rng: &mut Pcg32,
+    draws: &BoundedDraws,
+) {
+    rng.advance(scrambles);
+    let jumps = Jumps::of(rng);
+    if per_sample == 1 {
+        rng.advance(spp as i64);
+    } else {
+        for _ in 0..spp {
+            draws.skip(rng, &jumps, per_sample);
+        }
+    }
+    draws.skip(rng, &jumps, spp);
 }
 
 /// pbrt-v3's `GrayCodeSample` (one dimension) and `VanDerCorput`: the
@@ -215,6 +242,8 @@ impl PixelSampler {
             dim_2d: 0,
             extra: Pcg32::new(),
             draws: BoundedDraws::new(spp),
+            pending_1d: Vec::new(),
+            pending_2d: Vec::new(),
         }
     }
 
@@ -243,18 +272,26 @@ impl PixelSampler {
     pub fn request_1d_array(&mut self, n: u32) {
         self.cover(n);
         self.arrays.request_1d(n, self.spp);
+        self.pending_1d.push(None);
         self.generated = None;
     }
 
     pub fn request_2d_array(&mut self, n: u32) {
         self.cover(n);
         self.arrays.request_2d(n, self.spp);
+        self.pending_2d.push(None);
         self.generated = None;
     }
 
     /// The tables of the current pixel made by pbrt-v3's `StartPixel` with
     /// the RNG as it is.
     fn generate(&mut self) {
+        self.generate_with(false);
+    }
+
+    /// [`PixelSampler::generate`], with the arrays made now if `eager` (the
+    /// tests' reference), else when first read.
+    fn generate_with(&mut self, eager: bool) {
         let spp = self.spp as usize;
         let rng = &mut self.rng;
         let draws = &self.draws;
@@ -276,12 +313,28 @@ impl PixelSampler {
         for s in rest_2d {
             sobol_2d(1, spp, s, [c0, c1], rng, draws);
         }
-        let a = &mut self.arrays;
-        for (&n, data) in a.sizes_1d.iter().zip(a.data_1d.iter_mut()) {
-            van_der_corput(n as usize, spp, data, c0, rng, draws);
+        if eager {
+            let a = &mut self.arrays;
+            for (&n, data) in a.sizes_1d.iter().zip(a.data_1d.iter_mut()) {
+                van_der_corput(n as usize, spp, data, c0, rng, draws);
+            }
+            for (&n, data) in a.sizes_2d.iter().zip(a.data_2d.iter_mut()) {
+                sobol_2d(n as usize, spp, data, [c0, c1], rng, draws);
+            }
+            self.pending_1d.iter_mut().for_each(|p| *p = None);
+            self.pending_2d.iter_mut().for_each(|p| *p = None);
+            return;
         }
-        for (&n, data) in a.sizes_2d.iter().zip(a.data_2d.iter_mut()) {
-            sobol_2d(n as usize, spp, data, [c0, c1], rng, draws);
+        // The arrays are made when first read: here the RNG only steps
+        // past their draws.
+        let a = &self.arrays;
+        for (&n, pending) in a.sizes_1d.iter().zip(self.pending_1d.iter_mut()) {
+            *pending = Some(*rng);
+            skip_table(1, n as usize, spp, rng, draws);
+        }
+        for (&n, pending) in a.sizes_2d.iter().zip(self.pending_2d.iter_mut()) {
+            *pending = Some(*rng);
+            skip_table(2, n as usize, spp, rng, draws);
         }
     }
 
@@ -369,6 +422,20 @@ impl PixelSampler {
         if !self.in_table() {
             return None;
         }
+        let i = self.arrays.next_1d;
+        if self.arrays.sizes_1d.get(i) == Some(&n) {
+            if let Some(mut rng) = self.pending_1d[i].take() {
+                let data = &mut self.arrays.data_1d[i];
+                van_der_corput(
+                    n as usize,
+                    self.spp as usize,
+                    data,
+                    self.c0,
+                    &mut rng,
+                    &self.draws,
+                );
+            }
+        }
         self.arrays.get_1d(n, self.sample_index as usize)
     }
 
@@ -376,6 +443,21 @@ impl PixelSampler {
     pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
         if !self.in_table() {
             return None;
+        }
+        let i = self.arrays.next_2d;
+        if self.arrays.sizes_2d.get(i) == Some(&n) {
+            if let Some(mut rng) = self.pending_2d[i].take() {
+                let data = &mut self.arrays.data_2d[i];
+                let c = [self.c0, self.c1];
+                sobol_2d(
+                    n as usize,
+                    self.spp as usize,
+                    data,
+                    c,
+                    &mut rng,
+                    &self.draws,
+                );
+            }
         }
         self.arrays.get_2d(n, self.sample_index as usize)
     }
@@ -415,6 +497,55 @@ mod tests {
             }
             assert_eq!(a, b, "within: spp {spp} per sample {per}");
             assert_eq!(ra.uniform_u32(), rb.uniform_u32());
+        }
+    }
+
+    /// Arrays left unread at some pixels (stepped past, not made) leave the
+    /// RNG where making them does: a pixel's arrays read lazily, after
+    /// earlier pixels of its tile left theirs unread, equal the arrays made
+    /// at once at every pixel from the tile's start.
+    #[test]
+    fn unread_arrays_step_the_rng_as_made_ones() {
+        let bounds = Bounds2i::new(IVec2::new(-2, -2), IVec2::new(30, 20));
+        let make = || {
+            let mut s = PixelSampler::new(Pattern::ZeroTwo, 8, 2, bounds, 0);
+            s.request_1d_array(3);
+            s.request_2d_array(16);
+            s.request_2d_array(1);
+            s.request_1d_array(1);
+            s
+        };
+        let mut lazy = make();
+        let mut eager = make();
+        let mut k = 0;
+        for y in -2..20 {
+            for x in -2..30 {
+                k += 1;
+                if k % 5 != 0 {
+                    continue;
+                }
+                let p = IVec2::new(x, y);
+                // The reference: every pixel of the tile up to p made at once.
+                let (tile, index) = eager.tile_of(p).unwrap();
+                eager.rng.set_sequence(tile.wrapping_add(eager.seed_offset));
+                for _ in 0..=index {
+                    eager.generate_with(true);
+                }
+                let sample = (k % 8) as u32;
+                lazy.start_pixel_sample(p, sample);
+                let i = sample as usize;
+                let a = &eager.arrays;
+                assert_eq!(
+                    lazy.get_1d_array(3).unwrap(),
+                    &a.data_1d[0][3 * i..3 * i + 3]
+                );
+                assert_eq!(
+                    lazy.get_2d_array(16).unwrap(),
+                    &a.data_2d[0][16 * i..16 * i + 16]
+                );
+                assert_eq!(lazy.get_2d_array(1).unwrap(), &a.data_2d[1][i..i + 1]);
+                assert_eq!(lazy.get_1d_array(1).unwrap(), &a.data_1d[1][i..i + 1]);
+            }
         }
     }
 }

@@ -59,6 +59,60 @@ impl BoundedDraws {
     }
 }
 
+/// The states `k = 0..=LANES` steps after a state `s`, as `a[k]·s + c[k]`
+/// (mod 2^64) on one stream.
+const LANES: usize = 8;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Jumps {
+    a: [u64; LANES + 1],
+    c: [u64; LANES + 1],
+}
+
+impl Jumps {
+    /// The jumps of `rng`'s stream.
+    pub fn of(rng: &Pcg32) -> Self {
+        let inc = rng.parts().1;
+        let (mut a, mut c) = ([1u64; LANES + 1], [0u64; LANES + 1]);
+        for k in 1..=LANES {
+            a[k] = a[k - 1].wrapping_mul(Pcg32::MULT);
+            c[k] = c[k - 1].wrapping_mul(Pcg32::MULT).wrapping_add(inc);
+        }
+        Self { a, c }
+    }
+}
+
+impl BoundedDraws {
+    /// Steps `rng` (whose stream `jumps` describes) past the draws of
+    /// `below(rng, count - i)` for `i` in `0..count` (a shuffle of `count`
+    /// values) without making them: eight draws at a time, computed side by
+    /// side from the state, are one step each when none of them is rejected,
+    /// which holds when none is below `count` (every threshold is below its
+    /// bound, at most `count`); a block where one is goes draw by draw.
+    pub fn skip(&self, rng: &mut Pcg32, jumps: &Jumps, count: usize) {
+        let mut i = 0;
+        while i + LANES <= count {
+            let s = rng.parts().0;
+            let mut least = u32::MAX;
+            for k in 0..LANES {
+                let sk = jumps.a[k].wrapping_mul(s).wrapping_add(jumps.c[k]);
+                least = least.min(Pcg32::output(sk));
+            }
+            if least as usize >= count {
+                rng.set_state(jumps.a[LANES].wrapping_mul(s).wrapping_add(jumps.c[LANES]));
+            } else {
+                for k in 0..LANES {
+                    self.below(rng, (count - i - k) as u32);
+                }
+            }
+            i += LANES;
+        }
+        for k in i..count {
+            self.below(rng, (count - k) as u32);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -121,5 +175,35 @@ mod tests {
             }
         }
         assert_eq!(fast.uniform_u32(), plain.uniform_u32());
+    }
+
+    #[test]
+    fn skip_equals_plain_draws() {
+        let draws = BoundedDraws::new(4096);
+        for seq in 0..200u64 {
+            let mut fast = Pcg32::with_sequence(seq);
+            let jumps = Jumps::of(&fast);
+            let mut plain = fast;
+            for count in [1usize, 2, 7, 8, 9, 16, 63, 64, 65, 1000, 4096] {
+                draws.skip(&mut fast, &jumps, count);
+                for i in 0..count {
+                    plain.uniform_u32_below((count - i) as u32);
+                }
+                assert_eq!(fast, plain, "sequence {seq} count {count}");
+            }
+        }
+        // State 0 draws 0 first: rejected below 9 (2^32 mod 9 = 4), taken
+        // below 16 (no threshold) yet under the block test's bound.
+        for count in [9usize, 16, 24, 100] {
+            let mut fast = Pcg32::with_sequence(3);
+            fast.set_state(0);
+            let jumps = Jumps::of(&fast);
+            let mut plain = fast;
+            draws.skip(&mut fast, &jumps, count);
+            for i in 0..count {
+                plain.uniform_u32_below((count - i) as u32);
+            }
+            assert_eq!(fast, plain, "from state 0, count {count}");
+        }
     }
 }

@@ -57,10 +57,31 @@ impl Pcg32 {
     pub fn uniform_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(PCG32_MULT).wrapping_add(self.inc);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        let rot = (old >> 59) as u32;
+        Self::output(old)
+    }
+
+    /// The value drawn from `state` (PCG's XSH RR output).
+    #[inline(always)]
+    pub(crate) fn output(state: u64) -> u32 {
+        let xorshifted = (((state >> 18) ^ state) >> 27) as u32;
+        let rot = (state >> 59) as u32;
         xorshifted.rotate_right(rot)
     }
+
+    /// The state and increment.
+    #[inline(always)]
+    pub(crate) fn parts(&self) -> (u64, u64) {
+        (self.state, self.inc)
+    }
+
+    /// Moves to `state` on the same stream.
+    #[inline(always)]
+    pub(crate) fn set_state(&mut self, state: u64) {
+        self.state = state;
+    }
+
+    /// The multiplier of one step.
+    pub(crate) const MULT: u64 = PCG32_MULT;
 
     /// Uniform in `[0, b)` without modulo bias (pbrt-v3's `UniformUInt32(b)`).
     #[inline]
