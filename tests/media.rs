@@ -285,6 +285,7 @@ fn grid_density_is_trilinear_between_voxel_centres() {
         [2, 2, 2],
         Arc::new(density),
         DMat4::IDENTITY.as_mat4(),
+        16,
     );
     let m = Medium::new("g", c, Density::Grid(grid));
     let Density::Grid(grid) = &m.density else {
@@ -518,6 +519,11 @@ fn bad_media_are_located_diagnostics() {
     );
     let e = errors("MakeNamedMedium \"g\" \"string type\" \"heterogeneous\" \"integer nz\" 0 \"float density\" []\nWorldBegin\nWorldEnd");
     assert!(e.contains("\"nz\" is 0"), "{e}");
+    let e = errors("MakeNamedMedium \"g\" \"string type\" \"heterogeneous\" \"integer majorantgrid\" 0 \"float density\" [1]\nWorldBegin\nWorldEnd");
+    assert!(
+        e.contains("mem.pbrt:1:") && e.contains("\"majorantgrid\" is 0"),
+        "{e}"
+    );
     let e = errors("MakeNamedMedium \"g\" \"string type\" \"heterogeneous\" \"point3 p1\" [1 0 1] \"float density\" [1]\nWorldBegin\nWorldEnd");
     assert!(
         e.contains("p0…p1 in the current transform is degenerate"),
@@ -590,4 +596,105 @@ WorldEnd",
     // "c" (unknown type) was not defined: naming it is an error.
     let e = errors("MakeNamedMedium \"c\" \"string type\" \"homogenous\"\nWorldBegin\nMediumInterface \"c\" \"\"\nShape \"sphere\"\nWorldEnd");
     assert!(e.contains("named medium \"c\" undefined"), "{e}");
+}
+
+/// Ratio tracking's mean transmittance and delta tracking's chance of
+/// crossing without scattering, through an uneven grid (empty regions and
+/// a dense blob), equal exp(−optical depth) by quadrature, both stepping
+/// cell by cell through the majorant grid (the default) and by the largest
+/// density alone (`majorantgrid` 1, pbrt-v3's tracking).
+#[test]
+fn majorant_grid_tracking_is_unbiased() {
+    let n = [12u32, 9, 7];
+    let mut density = Vec::new();
+    for z in 0..n[2] {
+        for y in 0..n[1] {
+            for x in 0..n[0] {
+                let p = Vec3::new(
+                    (x as f32 + 0.5) / n[0] as f32,
+                    (y as f32 + 0.5) / n[1] as f32,
+                    (z as f32 + 0.5) / n[2] as f32,
+                );
+                let blob = (2.5 - 16.0 * (p - Vec3::new(0.7, 0.4, 0.5)).length_squared()).max(0.0);
+                let haze = if p.x < 0.3 { 0.3 } else { 0.0 };
+                density.push(blob + haze);
+            }
+        }
+    }
+    let density = Arc::new(density);
+    let (sigma_a, sigma_s) = (Vec3::splat(0.5), Vec3::splat(1.0));
+    let c = Coefficients {
+        sigma_a,
+        sigma_s,
+        g: 0.0,
+    };
+    let rays = [
+        (Vec3::new(-0.5, 0.4, 0.5), Vec3::new(1.0, 0.0, 0.0)),
+        (
+            Vec3::new(-0.2, -0.3, 0.1),
+            Vec3::new(1.0, 0.8, 0.45).normalize(),
+        ),
+        (
+            Vec3::new(1.4, 1.2, 0.9),
+            Vec3::new(-0.8, -0.9, -0.4).normalize(),
+        ),
+        (Vec3::new(0.1, 0.9, -0.5), Vec3::new(0.0, 0.0, 1.0)),
+    ];
+    for cells in [16, 1] {
+        let grid = Grid::new(
+            sigma_a,
+            sigma_s,
+            n,
+            density.clone(),
+            DMat4::IDENTITY.as_mat4(),
+            cells,
+        );
+        let m = Medium::new("g", c, Density::Grid(grid.clone()));
+        let mut s = sampler();
+        for (o, d) in rays {
+            let ray = Ray { o, d, t_max: 3.0 };
+            // Optical depth by the midpoint rule.
+            let steps = 30000;
+            let dt = 3.0 / steps as f64;
+            let depth: f64 = (0..steps)
+                .map(|i| {
+                    let p = o + d * ((i as f64 + 0.5) * dt) as f32;
+                    let inside = p.cmpge(Vec3::ZERO).all() && p.cmple(Vec3::ONE).all();
+                    if inside {
+                        grid.density_at(p) as f64 * dt
+                    } else {
+                        0.0
+                    }
+                })
+                .sum::<f64>()
+                * 1.5;
+            let expected = (-depth).exp();
+            let runs = 40000;
+            let (mut sum, mut sum2, mut crossed) = (0.0f64, 0.0f64, 0u32);
+            for _ in 0..runs {
+                let tr = m.tr(&ray, &mut s).x as f64;
+                sum += tr;
+                sum2 += tr * tr;
+                if m.sample(&ray, &mut s).1.is_none() {
+                    crossed += 1;
+                }
+            }
+            let mean = sum / runs as f64;
+            let se = ((sum2 / runs as f64 - mean * mean).max(0.0) / runs as f64).sqrt();
+            assert!(
+                (mean - expected).abs() < 4.0 * se + 2e-3,
+                "cells {cells}, ray {o} {d}: ratio tracking {mean} ± {se} against {expected}"
+            );
+            let frac = crossed as f64 / runs as f64;
+            let se = (expected * (1.0 - expected) / runs as f64).sqrt();
+            assert!(
+                (frac - expected).abs() < 4.0 * se + 2e-3,
+                "cells {cells}, ray {o} {d}: delta tracking crossed {frac} against {expected}"
+            );
+            assert!(
+                expected > 0.02 && expected < 0.98,
+                "a ray that tests little: {expected}"
+            );
+        }
+    }
 }

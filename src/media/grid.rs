@@ -13,10 +13,14 @@
 //!
 //! σt = σa + σs must be the same in every channel (pbrt-v3 reports an
 //! error and uses the first channel's; pbrs warns and does the same).
-//! Scattering is sampled by delta tracking against the grid's largest
-//! density, transmittance estimated by ratio tracking with pbrt-v3's
-//! Russian roulette below 0.1, each drawing from the sampler as pbrt-v3.
+//! Scattering is sampled by delta tracking, transmittance estimated by
+//! ratio tracking with pbrt-v3's Russian roulette below 0.1, each drawing
+//! from the sampler as pbrt-v3. Both step cell by cell through a majorant
+//! grid ([`super::majorant`], as pbrt-v4) by each cell's largest density;
+//! `"integer majorantgrid" 1` (a pbrs extension) tracks against the whole
+//! grid's largest density alone, as pbrt-v3 does.
 
+use super::majorant::Majorants;
 use super::{fix, Coefficients, Density, Medium, MediumInput, MediumType, Support, COMMON};
 use crate::geometry::{gamma, Ray};
 use crate::samplers::Sampler;
@@ -44,6 +48,11 @@ pub const KIND: MediumType = MediumType {
         ParamSpec::int("nz", 1, "grid resolution in z"),
         ParamSpec::point3("p0", [0.0; 3], "the grid box's first corner"),
         ParamSpec::point3("p1", [1.0; 3], "the grid box's opposite corner"),
+        ParamSpec::int(
+            "majorantgrid",
+            16,
+            "pbrs extension: cells per axis (at most the grid's voxels) of the grid of local largest densities that tracking steps by; 1 steps by the largest density alone, as pbrt-v3",
+        ),
     ],
     doc: "a density grid scaling the coefficients, trilinearly interpolated (pbrt-v3's GridDensityMedium)",
     build,
@@ -131,6 +140,15 @@ fn build(p: &ParamValues, input: &MediumInput, r: &mut dyn Report) -> Option<Med
             "spectrally varying attenuation",
         );
     }
+    let cells = p.int("majorantgrid");
+    if cells < 1 {
+        r.error(
+            Some("majorantgrid"),
+            format!("{what}: \"majorantgrid\" is {cells}: the majorant grid needs at least one cell per axis"),
+            "must be ≥ 1",
+        );
+        return None;
+    }
     let (p0, p1) = (p.point("p0"), p.point("p1"));
     let data_to_medium = DMat4::from_translation(p0) * DMat4::from_scale(p1 - p0);
     let medium_to_world = input.ctm * data_to_medium;
@@ -148,6 +166,7 @@ fn build(p: &ParamValues, input: &MediumInput, r: &mut dyn Report) -> Option<Med
         [n[0] as u32, n[1] as u32, n[2] as u32],
         Arc::new(density),
         medium_to_world.inverse().as_mat4(),
+        cells,
     );
     Some(Medium::new(input.name, c, Density::Grid(grid)))
 }
@@ -162,6 +181,7 @@ pub struct Grid {
     pub world_to_medium: Mat4,
     /// 1 / the largest density (∞ for an empty grid).
     pub inv_max_density: f32,
+    majorants: Arc<Majorants>,
 }
 
 impl Grid {
@@ -171,16 +191,25 @@ impl Grid {
         n: [u32; 3],
         density: std::sync::Arc<Vec<f32>>,
         world_to_medium: Mat4,
+        majorant_cells: i32,
     ) -> Grid {
         let max = density.iter().copied().fold(0.0f32, f32::max);
+        let n = n.map(|v| v as i32);
+        let majorants = Arc::new(Majorants::new(n, &density, majorant_cells));
         Grid {
+            majorants,
             sigma_s,
             sigma_t: sigma_a.x + sigma_s.x,
-            n: n.map(|v| v as i32),
+            n,
             density,
             world_to_medium,
             inv_max_density: 1.0 / max,
         }
+    }
+
+    /// The majorant grid.
+    pub fn majorants(&self) -> &Majorants {
+        &self.majorants
     }
 
     #[inline]
@@ -254,19 +283,32 @@ impl Grid {
         let Some((o, d, t_min, t_max, len)) = self.overlap(ray) else {
             return (Vec3::ONE, None);
         };
-        let step = self.inv_max_density / self.sigma_t;
-        let mut t = t_min;
-        for _ in 0..MAX_TRACKING_STEPS {
-            t -= (1.0 - sampler.get_1d()).ln() * step;
-            if t.is_nan() || t >= t_max {
-                return (Vec3::ONE, None);
+        let mut steps = 0u32;
+        for (t0, t1, inv_maj) in self.segments(o, d, t_min, t_max) {
+            if !inv_maj.is_finite() {
+                continue;
             }
-            if self.density_at(o + d * t) * self.inv_max_density > sampler.get_1d() {
-                return (self.sigma_s / self.sigma_t, Some(t / len));
+            let step = inv_maj / self.sigma_t;
+            let mut t = t0;
+            loop {
+                steps += 1;
+                if steps > MAX_TRACKING_STEPS {
+                    note_cut(Cut::Tracking);
+                    return (Vec3::ZERO, None);
+                }
+                t -= (1.0 - sampler.get_1d()).ln() * step;
+                if t.is_nan() {
+                    return (Vec3::ONE, None);
+                }
+                if t >= t1 {
+                    break;
+                }
+                if self.density_at(o + d * t) * inv_maj > sampler.get_1d() {
+                    return (self.sigma_s / self.sigma_t, Some(t / len));
+                }
             }
         }
-        note_cut(Cut::Tracking);
-        (Vec3::ZERO, None)
+        (Vec3::ONE, None)
     }
 
     /// Ratio tracking with pbrt-v3's Russian roulette; 0 past
@@ -275,25 +317,61 @@ impl Grid {
         let Some((o, d, t_min, t_max, _)) = self.overlap(ray) else {
             return Vec3::ONE;
         };
-        let step = self.inv_max_density / self.sigma_t;
-        let (mut tr, mut t) = (1.0f32, t_min);
-        for _ in 0..MAX_TRACKING_STEPS {
-            t -= (1.0 - sampler.get_1d()).ln() * step;
-            if t.is_nan() || t >= t_max {
-                return Vec3::splat(tr);
+        let mut tr = 1.0f32;
+        let mut steps = 0u32;
+        for (t0, t1, inv_maj) in self.segments(o, d, t_min, t_max) {
+            if !inv_maj.is_finite() {
+                continue;
             }
-            let density = self.density_at(o + d * t);
-            tr *= 1.0 - (density * self.inv_max_density).max(0.0);
-            const RR_THRESHOLD: f32 = 0.1;
-            if tr < RR_THRESHOLD {
-                let q = (1.0 - tr).max(0.05);
-                if sampler.get_1d() < q {
+            let step = inv_maj / self.sigma_t;
+            let mut t = t0;
+            loop {
+                steps += 1;
+                if steps > MAX_TRACKING_STEPS {
+                    note_cut(Cut::Tracking);
                     return Vec3::ZERO;
                 }
-                tr /= 1.0 - q;
+                t -= (1.0 - sampler.get_1d()).ln() * step;
+                if t.is_nan() {
+                    return Vec3::splat(tr);
+                }
+                if t >= t1 {
+                    break;
+                }
+                let density = self.density_at(o + d * t);
+                tr *= 1.0 - (density * inv_maj).max(0.0);
+                const RR_THRESHOLD: f32 = 0.1;
+                if tr < RR_THRESHOLD {
+                    let q = (1.0 - tr).max(0.05);
+                    if sampler.get_1d() < q {
+                        return Vec3::ZERO;
+                    }
+                    tr /= 1.0 - q;
+                }
             }
         }
-        note_cut(Cut::Tracking);
-        Vec3::ZERO
+        Vec3::splat(tr)
+    }
+
+    /// The ray's pieces `[t0, t1)` with 1 / the largest density over each
+    /// (∞ where the medium is empty): one piece, `[t_min, t_max)` with the
+    /// grid's largest density, for a majorant grid of one cell (pbrt-v3's
+    /// tracking).
+    #[inline]
+    fn segments(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> impl Iterator<Item = (f32, f32, f32)> + '_ {
+        let single = self.majorants.is_single();
+        let one = single.then_some((t_min, t_max, self.inv_max_density));
+        let walk = (!single).then(|| self.majorants.walk(o, d, t_min, t_max));
+        one.into_iter().chain(
+            walk.into_iter()
+                .flatten()
+                .map(|(t0, t1, maj)| (t0, t1, 1.0 / maj)),
+        )
     }
 }

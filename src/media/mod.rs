@@ -13,6 +13,7 @@
 pub mod grid;
 pub mod hg;
 pub mod homogeneous;
+pub mod majorant;
 pub mod presets;
 
 pub use grid::Grid;
