@@ -111,7 +111,8 @@ impl Iterator for Dda<'_> {
 
     #[inline]
     fn next(&mut self) -> Option<(f32, f32, f32)> {
-        if !(self.t < self.t_max) {
+        // (Also ends a walk whose end is NaN.)
+        if self.t.partial_cmp(&self.t_max) != Some(std::cmp::Ordering::Less) {
             return None;
         }
         let [cx, cy, cz] = self.cell;
@@ -150,7 +151,6 @@ impl Iterator for Dda<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::media::Grid;
     use crate::sampling::rng::Pcg32;
     use glam::Vec3;
