@@ -232,10 +232,39 @@ impl Grid {
         let (x, y, z) = (f.x as i32, f.y as i32, f.z as i32);
         let d = s - f;
         let lerp = |t: f32, a: f32, b: f32| (1.0 - t) * a + t * b;
-        let d00 = lerp(d.x, self.d(x, y, z), self.d(x + 1, y, z));
-        let d10 = lerp(d.x, self.d(x, y + 1, z), self.d(x + 1, y + 1, z));
-        let d01 = lerp(d.x, self.d(x, y, z + 1), self.d(x + 1, y, z + 1));
-        let d11 = lerp(d.x, self.d(x, y + 1, z + 1), self.d(x + 1, y + 1, z + 1));
+        let [nx, ny, nz] = self.n;
+        // The eight voxels: read from one base index when they are all
+        // inside the grid (the usual case), else one by one with 0 outside.
+        let v = if x >= 0 && y >= 0 && z >= 0 && x + 1 < nx && y + 1 < ny && z + 1 < nz {
+            let (row, slab) = (nx as usize, (nx * ny) as usize);
+            let i = ((z * ny + y) * nx + x) as usize;
+            let g = &self.density[i..i + slab + row + 2];
+            [
+                g[0],
+                g[1],
+                g[row],
+                g[row + 1],
+                g[slab],
+                g[slab + 1],
+                g[slab + row],
+                g[slab + row + 1],
+            ]
+        } else {
+            [
+                self.d(x, y, z),
+                self.d(x + 1, y, z),
+                self.d(x, y + 1, z),
+                self.d(x + 1, y + 1, z),
+                self.d(x, y, z + 1),
+                self.d(x + 1, y, z + 1),
+                self.d(x, y + 1, z + 1),
+                self.d(x + 1, y + 1, z + 1),
+            ]
+        };
+        let d00 = lerp(d.x, v[0], v[1]);
+        let d10 = lerp(d.x, v[2], v[3]);
+        let d01 = lerp(d.x, v[4], v[5]);
+        let d11 = lerp(d.x, v[6], v[7]);
         let d0 = lerp(d.y, d00, d10);
         let d1 = lerp(d.y, d01, d11);
         lerp(d.z, d0, d1)
@@ -373,5 +402,50 @@ impl Grid {
                 .flatten()
                 .map(|(t0, t1, maj)| (t0, t1, 1.0 / maj)),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::rng::Pcg32;
+
+    /// pbrt-v3's `Density` as written there: every voxel through `D`.
+    fn density_plain(g: &Grid, p: Vec3) -> f32 {
+        let s = Vec3::new(
+            p.x * g.n[0] as f32 - 0.5,
+            p.y * g.n[1] as f32 - 0.5,
+            p.z * g.n[2] as f32 - 0.5,
+        );
+        let f = s.floor();
+        let (x, y, z) = (f.x as i32, f.y as i32, f.z as i32);
+        let d = s - f;
+        let lerp = |t: f32, a: f32, b: f32| (1.0 - t) * a + t * b;
+        let d00 = lerp(d.x, g.d(x, y, z), g.d(x + 1, y, z));
+        let d10 = lerp(d.x, g.d(x, y + 1, z), g.d(x + 1, y + 1, z));
+        let d01 = lerp(d.x, g.d(x, y, z + 1), g.d(x + 1, y, z + 1));
+        let d11 = lerp(d.x, g.d(x, y + 1, z + 1), g.d(x + 1, y + 1, z + 1));
+        let d0 = lerp(d.y, d00, d10);
+        let d1 = lerp(d.y, d01, d11);
+        lerp(d.z, d0, d1)
+    }
+
+    #[test]
+    fn density_equals_the_plain_lookup() {
+        let mut rng = Pcg32::with_sequence(4);
+        for n in [[1u32, 1, 1], [2, 1, 3], [7, 5, 4], [16, 16, 16]] {
+            let count = (n[0] * n[1] * n[2]) as usize;
+            let d: Vec<f32> = (0..count).map(|_| rng.uniform_f32() * 3.0).collect();
+            let g = Grid::new(Vec3::ONE, Vec3::ONE, n, Arc::new(d), Mat4::IDENTITY, 16);
+            for _ in 0..20000 {
+                let p = Vec3::new(rng.uniform_f32(), rng.uniform_f32(), rng.uniform_f32()) * 1.2
+                    - Vec3::splat(0.1);
+                assert_eq!(
+                    g.density_at(p).to_bits(),
+                    density_plain(&g, p).to_bits(),
+                    "{n:?} at {p}"
+                );
+            }
+        }
     }
 }
