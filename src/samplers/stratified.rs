@@ -2,10 +2,12 @@
 //! strata for the first few 1D and 2D dimensions, shuffled independently per
 //! dimension; array samples stratified (1D) or Latin hypercube (2D); then
 //! independent uniform values. Tables are regenerated whenever the pixel
-//! changes, from a stream seeded by (pixel, seed).
+//! changes, from a stream seeded by (pixel, seed); a pixel's arrays are made
+//! when a sample first reads them (the stream steps past the unread ones).
 
 use super::random::stream_rng;
 use super::{count, ArrayStore, SamplerKindEntry, DIMENSIONS, MAX_SAMPLES};
+use crate::sampling::bounded_fast::{BoundedDraws, Jumps};
 use crate::sampling::rng::{Pcg32, ONE_MINUS_EPSILON};
 use crate::scene::{ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind, Support};
 use glam::{IVec2, Vec2};
@@ -74,13 +76,42 @@ pub struct StratifiedSampler {
     dim_1d: usize,
     dim_2d: usize,
     rng: Pcg32,
+    /// The shuffles' draws below every count up to the largest table.
+    draws: BoundedDraws,
+    /// For each array of the current pixel not made yet: the pixel's stream
+    /// where that array begins.
+    pending_1d: Vec<Option<Pcg32>>,
+    pending_2d: Vec<Option<Pcg32>>,
 }
 
-fn shuffle<T>(s: &mut [T], rng: &mut Pcg32) {
+fn shuffle<T>(s: &mut [T], rng: &mut Pcg32, draws: &BoundedDraws) {
     let n = s.len();
     for i in 0..n {
-        let other = i + rng.uniform_u32_below((n - i) as u32) as usize;
+        let other = i + draws.below(rng, (n - i) as u32) as usize;
         s.swap(i, other);
+    }
+}
+
+/// The stream stepped past a 1D array's draws ([`stratified_1d`] and
+/// [`shuffle`], `copies` times `n` values).
+fn skip_1d(n: usize, copies: usize, rng: &mut Pcg32, jitter: bool, draws: &BoundedDraws) {
+    let jumps = Jumps::of(rng);
+    for _ in 0..copies {
+        if jitter {
+            rng.advance(n as i64);
+        }
+        draws.skip(rng, &jumps, n);
+    }
+}
+
+/// The stream stepped past a 2D array's draws ([`latin_hypercube_2d`],
+/// `copies` times `n` values).
+fn skip_2d(n: usize, copies: usize, rng: &mut Pcg32, draws: &BoundedDraws) {
+    let jumps = Jumps::of(rng);
+    for _ in 0..copies {
+        rng.advance(2 * n as i64);
+        draws.skip(rng, &jumps, n);
+        draws.skip(rng, &jumps, n);
     }
 }
 
@@ -108,7 +139,7 @@ fn stratified_2d(s: &mut [Vec2], nx: u32, ny: u32, rng: &mut Pcg32, jitter: bool
     }
 }
 
-fn latin_hypercube_2d(s: &mut [Vec2], rng: &mut Pcg32) {
+fn latin_hypercube_2d(s: &mut [Vec2], rng: &mut Pcg32, draws: &BoundedDraws) {
     let n = s.len();
     let inv = 1.0 / n as f32;
     for (i, v) in s.iter_mut().enumerate() {
@@ -118,16 +149,31 @@ fn latin_hypercube_2d(s: &mut [Vec2], rng: &mut Pcg32) {
     }
     // Shuffle each axis independently (pbrt-v3's LatinHypercube).
     for j in 0..n {
-        let other = j + rng.uniform_u32_below((n - j) as u32) as usize;
+        let other = j + draws.below(rng, (n - j) as u32) as usize;
         let (a, b) = (s[j].x, s[other].x);
         s[j].x = b;
         s[other].x = a;
     }
     for j in 0..n {
-        let other = j + rng.uniform_u32_below((n - j) as u32) as usize;
+        let other = j + draws.below(rng, (n - j) as u32) as usize;
         let (a, b) = (s[j].y, s[other].y);
         s[j].y = b;
         s[other].y = a;
+    }
+}
+
+/// A pixel's 1D array of `n` values per sample: stratified and shuffled.
+fn make_1d(data: &mut [f32], n: u32, rng: &mut Pcg32, jitter: bool, draws: &BoundedDraws) {
+    for chunk in data.chunks_exact_mut(n.max(1) as usize) {
+        stratified_1d(chunk, rng, jitter);
+        shuffle(chunk, rng, draws);
+    }
+}
+
+/// A pixel's 2D array of `n` values per sample: Latin hypercubes.
+fn make_2d(data: &mut [Vec2], n: u32, rng: &mut Pcg32, draws: &BoundedDraws) {
+    for chunk in data.chunks_exact_mut(n.max(1) as usize) {
+        latin_hypercube_2d(chunk, rng, draws);
     }
 }
 
@@ -160,6 +206,16 @@ impl StratifiedSampler {
             dim_1d: 0,
             dim_2d: 0,
             rng: Pcg32::new(),
+            draws: BoundedDraws::new(n as u32),
+            pending_1d: Vec::new(),
+            pending_2d: Vec::new(),
+        }
+    }
+
+    /// Covers an array's size in the shuffles' draws.
+    fn cover(&mut self, n: u32) {
+        if n > self.draws.max() {
+            self.draws = BoundedDraws::new(n);
         }
     }
 
@@ -168,45 +224,55 @@ impl StratifiedSampler {
     }
 
     pub fn request_1d_array(&mut self, n: u32) {
+        self.cover(n);
         self.arrays.request_1d(n, self.samples_per_pixel());
+        self.pending_1d.push(None);
         self.pixel = None;
     }
 
     pub fn request_2d_array(&mut self, n: u32) {
+        self.cover(n);
         self.arrays.request_2d(n, self.samples_per_pixel());
+        self.pending_2d.push(None);
         self.pixel = None;
     }
 
     fn generate_pixel(&mut self, pixel: IVec2) {
+        self.generate_pixel_with(pixel, false);
+    }
+
+    /// The tables of `pixel`; its arrays made now if `eager` (the tests'
+    /// reference), else when a sample first reads them.
+    fn generate_pixel_with(&mut self, pixel: IVec2, eager: bool) {
         let mut rng = stream_rng(pixel, u32::MAX, self.seed, 2);
         let (xs, ys, jitter) = (self.xs, self.ys, self.jitter);
+        let draws = &self.draws;
         for s in &mut self.samples_1d {
             stratified_1d(s, &mut rng, jitter);
-            shuffle(s, &mut rng);
+            shuffle(s, &mut rng, draws);
         }
         for s in &mut self.samples_2d {
             stratified_2d(s, xs, ys, &mut rng, jitter);
-            shuffle(s, &mut rng);
+            shuffle(s, &mut rng, draws);
         }
-        for (&n, data) in self
-            .arrays
-            .sizes_1d
-            .iter()
-            .zip(self.arrays.data_1d.iter_mut())
-        {
-            for chunk in data.chunks_exact_mut(n.max(1) as usize) {
-                stratified_1d(chunk, &mut rng, jitter);
-                shuffle(chunk, &mut rng);
+        let copies = (xs * ys) as usize;
+        let a = &mut self.arrays;
+        for (i, &n) in a.sizes_1d.iter().enumerate() {
+            if eager {
+                make_1d(&mut a.data_1d[i], n, &mut rng, jitter, draws);
+                self.pending_1d[i] = None;
+            } else {
+                self.pending_1d[i] = Some(rng);
+                skip_1d(n.max(1) as usize, copies, &mut rng, jitter, draws);
             }
         }
-        for (&n, data) in self
-            .arrays
-            .sizes_2d
-            .iter()
-            .zip(self.arrays.data_2d.iter_mut())
-        {
-            for chunk in data.chunks_exact_mut(n.max(1) as usize) {
-                latin_hypercube_2d(chunk, &mut rng);
+        for (i, &n) in a.sizes_2d.iter().enumerate() {
+            if eager {
+                make_2d(&mut a.data_2d[i], n, &mut rng, draws);
+                self.pending_2d[i] = None;
+            } else {
+                self.pending_2d[i] = Some(rng);
+                skip_2d(n.max(1) as usize, copies, &mut rng, draws);
             }
         }
         self.pixel = Some(pixel);
@@ -256,6 +322,18 @@ impl StratifiedSampler {
         if !self.in_table() {
             return None;
         }
+        let i = self.arrays.next_1d;
+        if self.arrays.sizes_1d.get(i) == Some(&n) {
+            if let Some(mut rng) = self.pending_1d[i].take() {
+                make_1d(
+                    &mut self.arrays.data_1d[i],
+                    n,
+                    &mut rng,
+                    self.jitter,
+                    &self.draws,
+                );
+            }
+        }
         self.arrays.get_1d(n, self.sample_index as usize)
     }
 
@@ -264,6 +342,62 @@ impl StratifiedSampler {
         if !self.in_table() {
             return None;
         }
+        let i = self.arrays.next_2d;
+        if self.arrays.sizes_2d.get(i) == Some(&n) {
+            if let Some(mut rng) = self.pending_2d[i].take() {
+                make_2d(&mut self.arrays.data_2d[i], n, &mut rng, &self.draws);
+            }
+        }
         self.arrays.get_2d(n, self.sample_index as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Arrays read at some samples of some pixels only (the others stepped
+    /// past) equal the arrays made at once, and the tables are unchanged.
+    #[test]
+    fn lazy_arrays_equal_arrays_made_at_once() {
+        for jitter in [true, false] {
+            let make = || {
+                let mut s = StratifiedSampler::new(2, 3, 6, jitter, 7);
+                s.request_1d_array(5);
+                s.request_2d_array(9);
+                s.request_1d_array(1);
+                s.request_2d_array(64);
+                s
+            };
+            let (mut lazy, mut eager) = (make(), make());
+            for k in 0..40 {
+                let p = IVec2::new(k % 7, k / 7);
+                eager.generate_pixel_with(p, true);
+                let sample = (k % 6) as u32;
+                lazy.start_pixel_sample(p, sample);
+                let i = sample as usize;
+                let a = &eager.arrays;
+                // Every array at most pixels, the first two or none at others.
+                if k % 3 != 1 || k % 2 == 0 {
+                    assert_eq!(
+                        lazy.get_1d_array(5).unwrap(),
+                        &a.data_1d[0][5 * i..5 * i + 5]
+                    );
+                    assert_eq!(
+                        lazy.get_2d_array(9).unwrap(),
+                        &a.data_2d[0][9 * i..9 * i + 9]
+                    );
+                }
+                if k % 3 != 1 {
+                    assert_eq!(lazy.get_1d_array(1).unwrap(), &a.data_1d[1][i..i + 1]);
+                    assert_eq!(
+                        lazy.get_2d_array(64).unwrap(),
+                        &a.data_2d[1][64 * i..64 * i + 64]
+                    );
+                }
+                assert_eq!(lazy.samples_2d, eager.samples_2d);
+                assert_eq!(lazy.samples_1d, eager.samples_1d);
+            }
+        }
     }
 }
