@@ -171,6 +171,16 @@ fn build(p: &ParamValues, input: &MediumInput, r: &mut dyn Report) -> Option<Med
     Some(Medium::new(input.name, c, Density::Grid(grid)))
 }
 
+/// How tracking along a ray ended.
+enum Tracked<R> {
+    /// Where the callback stopped it, with what it said.
+    Stopped(R),
+    /// Past the ray's end.
+    Through,
+    /// Past [`MAX_TRACKING_STEPS`].
+    Cut,
+}
+
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub sigma_s: Vec3,
@@ -312,32 +322,14 @@ impl Grid {
         let Some((o, d, t_min, t_max, len)) = self.overlap(ray) else {
             return (Vec3::ONE, None);
         };
-        let mut steps = 0u32;
-        for (t0, t1, inv_maj) in self.segments(o, d, t_min, t_max) {
-            if !inv_maj.is_finite() {
-                continue;
-            }
-            let step = inv_maj / self.sigma_t;
-            let mut t = t0;
-            loop {
-                steps += 1;
-                if steps > MAX_TRACKING_STEPS {
-                    note_cut(Cut::Tracking);
-                    return (Vec3::ZERO, None);
-                }
-                t -= (1.0 - sampler.get_1d()).ln() * step;
-                if t.is_nan() {
-                    return (Vec3::ONE, None);
-                }
-                if t >= t1 {
-                    break;
-                }
-                if self.density_at(o + d * t) * inv_maj > sampler.get_1d() {
-                    return (self.sigma_s / self.sigma_t, Some(t / len));
-                }
-            }
+        let tracked = self.track(o, d, t_min, t_max, sampler, |t, ratio, sampler| {
+            (ratio > sampler.get_1d()).then_some(t)
+        });
+        match tracked {
+            Tracked::Stopped(t) => (self.sigma_s / self.sigma_t, Some(t / len)),
+            Tracked::Through => (Vec3::ONE, None),
+            Tracked::Cut => (Vec3::ZERO, None),
         }
-        (Vec3::ONE, None)
     }
 
     /// Ratio tracking with pbrt-v3's Russian roulette; 0 past
@@ -347,6 +339,40 @@ impl Grid {
             return Vec3::ONE;
         };
         let mut tr = 1.0f32;
+        let tracked = self.track(o, d, t_min, t_max, sampler, |_, ratio, sampler| {
+            tr *= 1.0 - ratio.max(0.0);
+            const RR_THRESHOLD: f32 = 0.1;
+            if tr < RR_THRESHOLD {
+                let q = (1.0 - tr).max(0.05);
+                if sampler.get_1d() < q {
+                    return Some(());
+                }
+                tr /= 1.0 - q;
+            }
+            None
+        });
+        match tracked {
+            Tracked::Through => Vec3::splat(tr),
+            Tracked::Stopped(()) | Tracked::Cut => Vec3::ZERO,
+        }
+    }
+
+    /// The tentative collisions of delta and ratio tracking along the ray
+    /// (pbrt-v3's steps by −ln(1 − u) / (σt · majorant), cell by cell): at
+    /// each, `at(t, density / majorant, sampler)` says whether tracking
+    /// stops there. A step to a NaN distance ends the ray as passed through
+    /// (as pbrt-v3's comparison does); more than [`MAX_TRACKING_STEPS`]
+    /// steps are counted and cut.
+    #[inline(always)]
+    fn track<R>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: f32,
+        sampler: &mut Sampler,
+        mut at: impl FnMut(f32, f32, &mut Sampler) -> Option<R>,
+    ) -> Tracked<R> {
         let mut steps = 0u32;
         for (t0, t1, inv_maj) in self.segments(o, d, t_min, t_max) {
             if !inv_maj.is_finite() {
@@ -358,28 +384,22 @@ impl Grid {
                 steps += 1;
                 if steps > MAX_TRACKING_STEPS {
                     note_cut(Cut::Tracking);
-                    return Vec3::ZERO;
+                    return Tracked::Cut;
                 }
                 t -= (1.0 - sampler.get_1d()).ln() * step;
                 if t.is_nan() {
-                    return Vec3::splat(tr);
+                    return Tracked::Through;
                 }
                 if t >= t1 {
                     break;
                 }
-                let density = self.density_at(o + d * t);
-                tr *= 1.0 - (density * inv_maj).max(0.0);
-                const RR_THRESHOLD: f32 = 0.1;
-                if tr < RR_THRESHOLD {
-                    let q = (1.0 - tr).max(0.05);
-                    if sampler.get_1d() < q {
-                        return Vec3::ZERO;
-                    }
-                    tr /= 1.0 - q;
+                let ratio = self.density_at(o + d * t) * inv_maj;
+                if let Some(r) = at(t, ratio, sampler) {
+                    return Tracked::Stopped(r);
                 }
             }
         }
-        Vec3::splat(tr)
+        Tracked::Through
     }
 
     /// The ray's pieces `[t0, t1)` with 1 / the largest density over each

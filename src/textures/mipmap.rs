@@ -131,6 +131,50 @@ fn round_up_pow2(v: i32) -> i32 {
     (v as u32).next_power_of_two() as i32
 }
 
+/// pbrt-v3's EWA footprint on a level: the texel-space centre, the
+/// ellipse's coefficients (r² = a·s² + b·s·t + c·t²) and the bounding box of
+/// texels to scan (`s0..=s1`, `t0..=t1`, as floats before the area check).
+struct Ellipse {
+    st: Vec2,
+    a: f32,
+    b: f32,
+    c: f32,
+    s0: f32,
+    s1: f32,
+    t0: f32,
+    t1: f32,
+}
+
+impl Ellipse {
+    fn new<T>(l: &Level<T>, st: Vec2, dst0: Vec2, dst1: Vec2) -> Ellipse {
+        let (w, h) = (l.w as f32, l.h as f32);
+        let st = Vec2::new(st.x * w - 0.5, st.y * h - 0.5);
+        let d0 = Vec2::new(dst0.x * w, dst0.y * h);
+        let d1 = Vec2::new(dst1.x * w, dst1.y * h);
+        let mut a = d0.y * d0.y + d1.y * d1.y + 1.0;
+        let mut b = -2.0 * (d0.x * d0.y + d1.x * d1.y);
+        let mut c = d0.x * d0.x + d1.x * d1.x + 1.0;
+        let inv_f = 1.0 / (a * c - b * b * 0.25);
+        a *= inv_f;
+        b *= inv_f;
+        c *= inv_f;
+        let det = -b * b + 4.0 * a * c;
+        let inv_det = 1.0 / det;
+        let u_sqrt = (det * c).sqrt();
+        let v_sqrt = (a * det).sqrt();
+        Ellipse {
+            st,
+            a,
+            b,
+            c,
+            s0: (st.x - 2.0 * inv_det * u_sqrt).ceil(),
+            s1: (st.x + 2.0 * inv_det * u_sqrt).floor(),
+            t0: (st.y - 2.0 * inv_det * v_sqrt).ceil(),
+            t1: (st.y + 2.0 * inv_det * v_sqrt).floor(),
+        }
+    }
+}
+
 impl<T: TexValue> MipMap<T> {
     /// Builds the pyramid of a `w`×`h` image (row `t` = 0 at the bottom, as
     /// texture space has it). `None` if the image is empty or its
@@ -284,33 +328,15 @@ impl<T: TexValue> MipMap<T> {
             return self.texel(self.levels.len() - 1, 0, 0);
         }
         let l = &self.levels[level];
-        let (w, h) = (l.w as f32, l.h as f32);
-        let st_in = st;
-        let st = Vec2::new(st.x * w - 0.5, st.y * h - 0.5);
-        let d0 = Vec2::new(dst0.x * w, dst0.y * h);
-        let d1 = Vec2::new(dst1.x * w, dst1.y * h);
-        let mut a = d0.y * d0.y + d1.y * d1.y + 1.0;
-        let mut b = -2.0 * (d0.x * d0.y + d1.x * d1.y);
-        let mut c = d0.x * d0.x + d1.x * d1.x + 1.0;
-        let inv_f = 1.0 / (a * c - b * b * 0.25);
-        a *= inv_f;
-        b *= inv_f;
-        c *= inv_f;
-        let det = -b * b + 4.0 * a * c;
-        let inv_det = 1.0 / det;
-        let u_sqrt = (det * c).sqrt();
-        let v_sqrt = (a * det).sqrt();
-        let s0 = (st.x - 2.0 * inv_det * u_sqrt).ceil();
-        let s1 = (st.x + 2.0 * inv_det * u_sqrt).floor();
-        let t0 = (st.y - 2.0 * inv_det * v_sqrt).ceil();
-        let t1 = (st.y + 2.0 * inv_det * v_sqrt).floor();
+        let e = Ellipse::new(l, st, dst0, dst1);
         // Non-finite differentials or an absurd `maxanisotropy` would make
         // the scan meaningless or endless: fall back to the bilinear value.
-        let area = (s1 - s0 + 1.0) * (t1 - t0 + 1.0);
+        let area = (e.s1 - e.s0 + 1.0) * (e.t1 - e.t0 + 1.0);
         if !(area.is_finite() && area <= (1 << 22) as f32) {
-            return self.bilerp(level, st_in);
+            return self.bilerp(level, st);
         }
-        let (s0, s1, t0, t1) = (s0 as i32, s1 as i32, t0 as i32, t1 as i32);
+        let Ellipse { st, a, b, c, .. } = e;
+        let (s0, s1, t0, t1) = (e.s0 as i32, e.s1 as i32, e.t0 as i32, e.t1 as i32);
         let mut sum = T::ZERO;
         let mut sum_w = 0.0f32;
         // The texels of one row in turn: for `repeat`, the wrapped column
@@ -424,25 +450,17 @@ mod tests {
     /// pbrt-v3's `EWA` scan as written there: every texel through `Texel`.
     fn ewa_plain<T: TexValue>(m: &MipMap<T>, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
         let l = &m.levels[level];
-        let (w, h) = (l.w as f32, l.h as f32);
-        let st = Vec2::new(st.x * w - 0.5, st.y * h - 0.5);
-        let d0 = Vec2::new(dst0.x * w, dst0.y * h);
-        let d1 = Vec2::new(dst1.x * w, dst1.y * h);
-        let mut a = d0.y * d0.y + d1.y * d1.y + 1.0;
-        let mut b = -2.0 * (d0.x * d0.y + d1.x * d1.y);
-        let mut c = d0.x * d0.x + d1.x * d1.x + 1.0;
-        let inv_f = 1.0 / (a * c - b * b * 0.25);
-        a *= inv_f;
-        b *= inv_f;
-        c *= inv_f;
-        let det = -b * b + 4.0 * a * c;
-        let inv_det = 1.0 / det;
-        let u_sqrt = (det * c).sqrt();
-        let v_sqrt = (a * det).sqrt();
-        let s0 = (st.x - 2.0 * inv_det * u_sqrt).ceil() as i32;
-        let s1 = (st.x + 2.0 * inv_det * u_sqrt).floor() as i32;
-        let t0 = (st.y - 2.0 * inv_det * v_sqrt).ceil() as i32;
-        let t1 = (st.y + 2.0 * inv_det * v_sqrt).floor() as i32;
+        let Ellipse {
+            st,
+            a,
+            b,
+            c,
+            s0,
+            s1,
+            t0,
+            t1,
+        } = Ellipse::new(l, st, dst0, dst1);
+        let (s0, s1, t0, t1) = (s0 as i32, s1 as i32, t0 as i32, t1 as i32);
         let mut sum = T::ZERO;
         let mut sum_w = 0.0f32;
         for it in t0..=t1 {
