@@ -62,8 +62,9 @@ pub struct PixelSampler {
     sample_index: u32,
     dim_1d: usize,
     dim_2d: usize,
-    /// Values past the tables.
+    /// Values past the tables; seeded when first needed (`extra_ready`).
     extra: Pcg32,
+    extra_ready: bool,
     /// The shuffles' draws below every count up to the largest of `spp`
     /// and the arrays' sizes.
     draws: BoundedDraws,
@@ -241,6 +242,7 @@ impl PixelSampler {
             dim_1d: 0,
             dim_2d: 0,
             extra: Pcg32::new(),
+            extra_ready: false,
             draws: BoundedDraws::new(spp),
             pending_1d: Vec::new(),
             pending_2d: Vec::new(),
@@ -385,13 +387,24 @@ impl PixelSampler {
         self.sample_index = sample_index;
         self.dim_1d = 0;
         self.dim_2d = 0;
-        self.extra = stream_rng(pixel, sample_index, self.seed, 4);
+        self.extra_ready = false;
         self.arrays.reset();
     }
 
     #[inline]
     fn in_table(&self) -> bool {
         self.sample_index < self.spp
+    }
+
+    /// The stream of values past the tables, seeded by (pixel, sample,
+    /// seed) when a sample first needs it.
+    #[inline]
+    fn extra(&mut self) -> &mut Pcg32 {
+        if !self.extra_ready {
+            self.extra = stream_rng(self.pixel, self.sample_index, self.seed, 4);
+            self.extra_ready = true;
+        }
+        &mut self.extra
     }
 
     #[inline]
@@ -401,7 +414,7 @@ impl PixelSampler {
             self.dim_1d += 1;
             v
         } else {
-            self.extra.uniform_f32()
+            self.extra().uniform_f32()
         }
     }
 
@@ -412,8 +425,9 @@ impl PixelSampler {
             self.dim_2d += 1;
             v
         } else {
-            let x = self.extra.uniform_f32();
-            Vec2::new(x, self.extra.uniform_f32())
+            let extra = self.extra();
+            let x = extra.uniform_f32();
+            Vec2::new(x, extra.uniform_f32())
         }
     }
 

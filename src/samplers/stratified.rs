@@ -72,10 +72,14 @@ pub struct StratifiedSampler {
     samples_2d: Vec<Vec<Vec2>>,
     pub(super) arrays: ArrayStore,
     pixel: Option<IVec2>,
+    /// The pixel of the current sample.
+    pixel_now: IVec2,
     sample_index: u32,
     dim_1d: usize,
     dim_2d: usize,
+    /// Values past the tables; seeded when first needed (`rng_ready`).
     rng: Pcg32,
+    rng_ready: bool,
     /// The shuffles' draws below every count up to the largest table.
     draws: BoundedDraws,
     /// For each array of the current pixel not made yet: the pixel's stream
@@ -202,10 +206,12 @@ impl StratifiedSampler {
             samples_2d: vec![vec![Vec2::ZERO; n]; SAMPLED_DIMENSIONS],
             arrays: ArrayStore::default(),
             pixel: None,
+            pixel_now: IVec2::ZERO,
             sample_index: 0,
             dim_1d: 0,
             dim_2d: 0,
             rng: Pcg32::new(),
+            rng_ready: false,
             draws: BoundedDraws::new(n as u32),
             pending_1d: Vec::new(),
             pending_2d: Vec::new(),
@@ -285,8 +291,20 @@ impl StratifiedSampler {
         self.sample_index = sample_index;
         self.dim_1d = 0;
         self.dim_2d = 0;
-        self.rng = stream_rng(pixel, sample_index, self.seed, 3);
+        self.pixel_now = pixel;
+        self.rng_ready = false;
         self.arrays.reset();
+    }
+
+    /// The stream of values past the tables, seeded by (pixel, sample,
+    /// seed) when a sample first needs it.
+    #[inline]
+    fn rng(&mut self) -> &mut Pcg32 {
+        if !self.rng_ready {
+            self.rng = stream_rng(self.pixel_now, self.sample_index, self.seed, 3);
+            self.rng_ready = true;
+        }
+        &mut self.rng
     }
 
     #[inline]
@@ -301,7 +319,7 @@ impl StratifiedSampler {
             self.dim_1d += 1;
             v
         } else {
-            self.rng.uniform_f32()
+            self.rng().uniform_f32()
         }
     }
 
@@ -312,8 +330,9 @@ impl StratifiedSampler {
             self.dim_2d += 1;
             v
         } else {
-            let x = self.rng.uniform_f32();
-            Vec2::new(x, self.rng.uniform_f32())
+            let rng = self.rng();
+            let x = rng.uniform_f32();
+            Vec2::new(x, rng.uniform_f32())
         }
     }
 
