@@ -403,9 +403,9 @@ impl Grid {
     }
 
     /// The ray's pieces `[t0, t1)` with 1 / the largest density over each
-    /// (∞ where the medium is empty): one piece, `[t_min, t_max)` with the
-    /// grid's largest density, for a majorant grid of one cell (pbrt-v3's
-    /// tracking).
+    /// (∞ where the medium is empty): for a majorant grid of one cell, one
+    /// piece `[t_min, t_max)` with 1 / the grid's largest density, pbrt-v3's
+    /// tracking.
     #[inline]
     fn segments(
         &self,
@@ -414,14 +414,9 @@ impl Grid {
         t_min: f32,
         t_max: f32,
     ) -> impl Iterator<Item = (f32, f32, f32)> + '_ {
-        let single = self.majorants.is_single();
-        let one = single.then_some((t_min, t_max, self.inv_max_density));
-        let walk = (!single).then(|| self.majorants.walk(o, d, t_min, t_max));
-        one.into_iter().chain(
-            walk.into_iter()
-                .flatten()
-                .map(|(t0, t1, maj)| (t0, t1, 1.0 / maj)),
-        )
+        self.majorants
+            .walk(o, d, t_min, t_max)
+            .map(|(t0, t1, maj)| (t0, t1, 1.0 / maj))
     }
 }
 

@@ -53,11 +53,6 @@ impl Majorants {
         Self { res, max }
     }
 
-    /// One cell.
-    pub fn is_single(&self) -> bool {
-        self.max.len() == 1
-    }
-
     /// The cells along the ray `o + t·d` (medium space) for `t` in
     /// `[t_min, t_max]`, the part of the ray inside the unit cube.
     #[inline]
@@ -89,13 +84,15 @@ impl Majorants {
             delta,
             t: t_min,
             t_max,
+            done: false,
         }
     }
 }
 
 /// A ray's walk through the cells of a [`Majorants`] grid (Amanatides and
 /// Woo's DDA): segments `[t0, t1)` in order, each with its cell's largest
-/// density.
+/// density, at least one (a ray of zero length has one, empty, as pbrt-v3's
+/// tracking takes one step along it).
 pub struct Dda<'a> {
     m: &'a Majorants,
     cell: [i32; 3],
@@ -104,6 +101,8 @@ pub struct Dda<'a> {
     delta: [f32; 3],
     t: f32,
     t_max: f32,
+    /// The ray's end was reached.
+    done: bool,
 }
 
 impl Iterator for Dda<'_> {
@@ -111,8 +110,7 @@ impl Iterator for Dda<'_> {
 
     #[inline]
     fn next(&mut self) -> Option<(f32, f32, f32)> {
-        // (Also ends a walk whose end is NaN.)
-        if self.t.partial_cmp(&self.t_max) != Some(std::cmp::Ordering::Less) {
+        if self.done {
             return None;
         }
         let [cx, cy, cz] = self.cell;
@@ -145,6 +143,8 @@ impl Iterator for Dda<'_> {
         self.t = t1;
         self.cell[a] = to;
         self.next[a] += self.delta[a];
+        // (A NaN end ends the walk too.)
+        self.done = last || t1.partial_cmp(&self.t_max) != Some(std::cmp::Ordering::Less);
         Some((t0, t1, maj))
     }
 }

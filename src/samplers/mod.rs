@@ -30,6 +30,7 @@ pub use sobol::SobolSampler;
 pub use stratified::StratifiedSampler;
 
 use crate::geometry::Bounds2i;
+use crate::sampling::rng::Pcg32;
 use crate::scene::{Kind, ParamSpec, ParamValues, Report, SamplerDesc, SamplerKind};
 use glam::{IVec2, Vec2};
 
@@ -450,6 +451,10 @@ pub(crate) struct ArrayStore {
     pub data_2d: Vec<Vec<Vec2>>,
     pub next_1d: usize,
     pub next_2d: usize,
+    /// For samplers that make a pixel's arrays when a sample first reads
+    /// them: each array's RNG where its values begin, while not made yet.
+    pub unmade_1d: Vec<Option<Pcg32>>,
+    pub unmade_2d: Vec<Option<Pcg32>>,
 }
 
 impl ArrayStore {
@@ -461,13 +466,38 @@ impl ArrayStore {
 
     pub fn request_1d(&mut self, n: u32, copies: u32) {
         self.sizes_1d.push(n);
+        self.unmade_1d.push(None);
         self.data_1d.push(vec![0.0; n as usize * copies as usize]);
     }
 
     pub fn request_2d(&mut self, n: u32, copies: u32) {
         self.sizes_2d.push(n);
+        self.unmade_2d.push(None);
         self.data_2d
             .push(vec![Vec2::ZERO; n as usize * copies as usize]);
+    }
+
+    /// The next 1D array, if it has `n` values and is not made yet: its
+    /// storage and the RNG to make it with.
+    #[inline]
+    pub fn unmade_1d(&mut self, n: u32) -> Option<(&mut [f32], Pcg32)> {
+        let i = self.next_1d;
+        if self.sizes_1d.get(i) != Some(&n) {
+            return None;
+        }
+        let rng = self.unmade_1d[i].take()?;
+        Some((&mut self.data_1d[i], rng))
+    }
+
+    /// The next 2D array, if it has `n` values and is not made yet.
+    #[inline]
+    pub fn unmade_2d(&mut self, n: u32) -> Option<(&mut [Vec2], Pcg32)> {
+        let i = self.next_2d;
+        if self.sizes_2d.get(i) != Some(&n) {
+            return None;
+        }
+        let rng = self.unmade_2d[i].take()?;
+        Some((&mut self.data_2d[i], rng))
     }
 
     #[inline]

@@ -19,7 +19,7 @@
 //! tile used) come from an independent stream seeded by (pixel, sample,
 //! seed), so that images do not depend on threads or tiling.
 
-use super::random::stream_rng;
+use super::random::{stream_rng, SampleStream};
 use super::sobolmatrices::{sobol_matrices, to_unit, SOBOL_MATRIX_SIZE};
 use super::ArrayStore;
 use crate::geometry::Bounds2i;
@@ -62,18 +62,11 @@ pub struct PixelSampler {
     sample_index: u32,
     dim_1d: usize,
     dim_2d: usize,
-    /// Values past the tables; seeded when first needed (`extra_ready`).
-    extra: Pcg32,
-    extra_ready: bool,
+    /// Values past the tables.
+    extra: SampleStream,
     /// The shuffles' draws below every count up to the largest of `spp`
     /// and the arrays' sizes.
     draws: BoundedDraws,
-    /// For each array of the current pixel not made yet: the RNG as
-    /// pbrt-v3's `StartPixel` has it where that array begins. An array is
-    /// made when a sample first asks for it (most of directlighting's
-    /// arrays, one per light and bounce, are never read).
-    pending_1d: Vec<Option<Pcg32>>,
-    pending_2d: Vec<Option<Pcg32>>,
 }
 
 /// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values
@@ -241,18 +234,8 @@ impl PixelSampler {
             sample_index: 0,
             dim_1d: 0,
             dim_2d: 0,
-            extra: Pcg32::new(),
-            extra_ready: false,
+            extra: SampleStream::new(),
             draws: BoundedDraws::new(spp),
-            pending_1d: Vec::new(),
-            pending_2d: Vec::new(),
-        }
-    }
-
-    /// Covers the arrays' sizes in the shuffles' draws.
-    fn cover(&mut self, n: u32) {
-        if n > self.draws.max() {
-            self.draws = BoundedDraws::new(n);
         }
     }
 
@@ -272,16 +255,14 @@ impl PixelSampler {
     }
 
     pub fn request_1d_array(&mut self, n: u32) {
-        self.cover(n);
+        self.draws.cover(n);
         self.arrays.request_1d(n, self.spp);
-        self.pending_1d.push(None);
         self.generated = None;
     }
 
     pub fn request_2d_array(&mut self, n: u32) {
-        self.cover(n);
+        self.draws.cover(n);
         self.arrays.request_2d(n, self.spp);
-        self.pending_2d.push(None);
         self.generated = None;
     }
 
@@ -323,19 +304,20 @@ impl PixelSampler {
             for (&n, data) in a.sizes_2d.iter().zip(a.data_2d.iter_mut()) {
                 sobol_2d(n as usize, spp, data, [c0, c1], rng, draws);
             }
-            self.pending_1d.iter_mut().for_each(|p| *p = None);
-            self.pending_2d.iter_mut().for_each(|p| *p = None);
+            a.unmade_1d.iter_mut().for_each(|u| *u = None);
+            a.unmade_2d.iter_mut().for_each(|u| *u = None);
             return;
         }
-        // The arrays are made when first read: here the RNG only steps
-        // past their draws.
-        let a = &self.arrays;
-        for (&n, pending) in a.sizes_1d.iter().zip(self.pending_1d.iter_mut()) {
-            *pending = Some(*rng);
+        // The arrays are made when a sample first reads them (most of
+        // directlighting's, one per light and bounce, never are): here the
+        // RNG only steps past their draws.
+        let a = &mut self.arrays;
+        for (&n, unmade) in a.sizes_1d.iter().zip(a.unmade_1d.iter_mut()) {
+            *unmade = Some(*rng);
             skip_table(1, n as usize, spp, rng, draws);
         }
-        for (&n, pending) in a.sizes_2d.iter().zip(self.pending_2d.iter_mut()) {
-            *pending = Some(*rng);
+        for (&n, unmade) in a.sizes_2d.iter().zip(a.unmade_2d.iter_mut()) {
+            *unmade = Some(*rng);
             skip_table(2, n as usize, spp, rng, draws);
         }
     }
@@ -387,7 +369,7 @@ impl PixelSampler {
         self.sample_index = sample_index;
         self.dim_1d = 0;
         self.dim_2d = 0;
-        self.extra_ready = false;
+        self.extra.start(pixel, sample_index);
         self.arrays.reset();
     }
 
@@ -396,15 +378,10 @@ impl PixelSampler {
         self.sample_index < self.spp
     }
 
-    /// The stream of values past the tables, seeded by (pixel, sample,
-    /// seed) when a sample first needs it.
+    /// The stream of values past the tables.
     #[inline]
     fn extra(&mut self) -> &mut Pcg32 {
-        if !self.extra_ready {
-            self.extra = stream_rng(self.pixel, self.sample_index, self.seed, 4);
-            self.extra_ready = true;
-        }
-        &mut self.extra
+        self.extra.rng(self.seed, 4)
     }
 
     #[inline]
@@ -436,19 +413,15 @@ impl PixelSampler {
         if !self.in_table() {
             return None;
         }
-        let i = self.arrays.next_1d;
-        if self.arrays.sizes_1d.get(i) == Some(&n) {
-            if let Some(mut rng) = self.pending_1d[i].take() {
-                let data = &mut self.arrays.data_1d[i];
-                van_der_corput(
-                    n as usize,
-                    self.spp as usize,
-                    data,
-                    self.c0,
-                    &mut rng,
-                    &self.draws,
-                );
-            }
+        if let Some((data, mut rng)) = self.arrays.unmade_1d(n) {
+            van_der_corput(
+                n as usize,
+                self.spp as usize,
+                data,
+                self.c0,
+                &mut rng,
+                &self.draws,
+            );
         }
         self.arrays.get_1d(n, self.sample_index as usize)
     }
@@ -458,20 +431,16 @@ impl PixelSampler {
         if !self.in_table() {
             return None;
         }
-        let i = self.arrays.next_2d;
-        if self.arrays.sizes_2d.get(i) == Some(&n) {
-            if let Some(mut rng) = self.pending_2d[i].take() {
-                let data = &mut self.arrays.data_2d[i];
-                let c = [self.c0, self.c1];
-                sobol_2d(
-                    n as usize,
-                    self.spp as usize,
-                    data,
-                    c,
-                    &mut rng,
-                    &self.draws,
-                );
-            }
+        if let Some((data, mut rng)) = self.arrays.unmade_2d(n) {
+            let c = [self.c0, self.c1];
+            sobol_2d(
+                n as usize,
+                self.spp as usize,
+                data,
+                c,
+                &mut rng,
+                &self.draws,
+            );
         }
         self.arrays.get_2d(n, self.sample_index as usize)
     }

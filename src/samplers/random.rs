@@ -44,6 +44,46 @@ pub(crate) fn stream_rng(pixel: IVec2, sample_index: u32, seed: u64, purpose: u6
     r
 }
 
+/// A sample's [`stream_rng`] for one purpose, seeded when first drawn from
+/// (hashing the key for every sample costs more than most samples draw).
+#[derive(Clone, Debug)]
+pub(crate) struct SampleStream {
+    rng: Pcg32,
+    pixel: IVec2,
+    sample_index: u32,
+    seeded: bool,
+}
+
+impl SampleStream {
+    pub fn new() -> Self {
+        Self {
+            rng: Pcg32::new(),
+            pixel: IVec2::ZERO,
+            sample_index: 0,
+            seeded: false,
+        }
+    }
+
+    /// Starts the stream of `(pixel, sample_index)`.
+    #[inline]
+    pub fn start(&mut self, pixel: IVec2, sample_index: u32) {
+        self.pixel = pixel;
+        self.sample_index = sample_index;
+        self.seeded = false;
+    }
+
+    /// The stream `stream_rng(pixel, sample_index, seed, purpose)`, at the
+    /// value after those already drawn.
+    #[inline]
+    pub fn rng(&mut self, seed: u64, purpose: u64) -> &mut Pcg32 {
+        if !self.seeded {
+            self.rng = stream_rng(self.pixel, self.sample_index, seed, purpose);
+            self.seeded = true;
+        }
+        &mut self.rng
+    }
+}
+
 impl RandomSampler {
     pub fn new(spp: u32, seed: u64) -> Self {
         Self {

@@ -5,7 +5,7 @@
 //! changes, from a stream seeded by (pixel, seed); a pixel's arrays are made
 //! when a sample first reads them (the stream steps past the unread ones).
 
-use super::random::stream_rng;
+use super::random::{stream_rng, SampleStream};
 use super::{count, ArrayStore, SamplerKindEntry, DIMENSIONS, MAX_SAMPLES};
 use crate::sampling::bounded_fast::{BoundedDraws, Jumps};
 use crate::sampling::rng::{Pcg32, ONE_MINUS_EPSILON};
@@ -72,20 +72,13 @@ pub struct StratifiedSampler {
     samples_2d: Vec<Vec<Vec2>>,
     pub(super) arrays: ArrayStore,
     pixel: Option<IVec2>,
-    /// The pixel of the current sample.
-    pixel_now: IVec2,
     sample_index: u32,
     dim_1d: usize,
     dim_2d: usize,
-    /// Values past the tables; seeded when first needed (`rng_ready`).
-    rng: Pcg32,
-    rng_ready: bool,
+    /// Values past the tables.
+    rng: SampleStream,
     /// The shuffles' draws below every count up to the largest table.
     draws: BoundedDraws,
-    /// For each array of the current pixel not made yet: the pixel's stream
-    /// where that array begins.
-    pending_1d: Vec<Option<Pcg32>>,
-    pending_2d: Vec<Option<Pcg32>>,
 }
 
 fn shuffle<T>(s: &mut [T], rng: &mut Pcg32, draws: &BoundedDraws) {
@@ -206,22 +199,11 @@ impl StratifiedSampler {
             samples_2d: vec![vec![Vec2::ZERO; n]; SAMPLED_DIMENSIONS],
             arrays: ArrayStore::default(),
             pixel: None,
-            pixel_now: IVec2::ZERO,
             sample_index: 0,
             dim_1d: 0,
             dim_2d: 0,
-            rng: Pcg32::new(),
-            rng_ready: false,
+            rng: SampleStream::new(),
             draws: BoundedDraws::new(n as u32),
-            pending_1d: Vec::new(),
-            pending_2d: Vec::new(),
-        }
-    }
-
-    /// Covers an array's size in the shuffles' draws.
-    fn cover(&mut self, n: u32) {
-        if n > self.draws.max() {
-            self.draws = BoundedDraws::new(n);
         }
     }
 
@@ -230,16 +212,14 @@ impl StratifiedSampler {
     }
 
     pub fn request_1d_array(&mut self, n: u32) {
-        self.cover(n);
+        self.draws.cover(n);
         self.arrays.request_1d(n, self.samples_per_pixel());
-        self.pending_1d.push(None);
         self.pixel = None;
     }
 
     pub fn request_2d_array(&mut self, n: u32) {
-        self.cover(n);
+        self.draws.cover(n);
         self.arrays.request_2d(n, self.samples_per_pixel());
-        self.pending_2d.push(None);
         self.pixel = None;
     }
 
@@ -266,18 +246,18 @@ impl StratifiedSampler {
         for (i, &n) in a.sizes_1d.iter().enumerate() {
             if eager {
                 make_1d(&mut a.data_1d[i], n, &mut rng, jitter, draws);
-                self.pending_1d[i] = None;
+                a.unmade_1d[i] = None;
             } else {
-                self.pending_1d[i] = Some(rng);
+                a.unmade_1d[i] = Some(rng);
                 skip_1d(n.max(1) as usize, copies, &mut rng, jitter, draws);
             }
         }
         for (i, &n) in a.sizes_2d.iter().enumerate() {
             if eager {
                 make_2d(&mut a.data_2d[i], n, &mut rng, draws);
-                self.pending_2d[i] = None;
+                a.unmade_2d[i] = None;
             } else {
-                self.pending_2d[i] = Some(rng);
+                a.unmade_2d[i] = Some(rng);
                 skip_2d(n.max(1) as usize, copies, &mut rng, draws);
             }
         }
@@ -291,20 +271,14 @@ impl StratifiedSampler {
         self.sample_index = sample_index;
         self.dim_1d = 0;
         self.dim_2d = 0;
-        self.pixel_now = pixel;
-        self.rng_ready = false;
+        self.rng.start(pixel, sample_index);
         self.arrays.reset();
     }
 
-    /// The stream of values past the tables, seeded by (pixel, sample,
-    /// seed) when a sample first needs it.
+    /// The stream of values past the tables.
     #[inline]
     fn rng(&mut self) -> &mut Pcg32 {
-        if !self.rng_ready {
-            self.rng = stream_rng(self.pixel_now, self.sample_index, self.seed, 3);
-            self.rng_ready = true;
-        }
-        &mut self.rng
+        self.rng.rng(self.seed, 3)
     }
 
     #[inline]
@@ -341,17 +315,8 @@ impl StratifiedSampler {
         if !self.in_table() {
             return None;
         }
-        let i = self.arrays.next_1d;
-        if self.arrays.sizes_1d.get(i) == Some(&n) {
-            if let Some(mut rng) = self.pending_1d[i].take() {
-                make_1d(
-                    &mut self.arrays.data_1d[i],
-                    n,
-                    &mut rng,
-                    self.jitter,
-                    &self.draws,
-                );
-            }
+        if let Some((data, mut rng)) = self.arrays.unmade_1d(n) {
+            make_1d(data, n, &mut rng, self.jitter, &self.draws);
         }
         self.arrays.get_1d(n, self.sample_index as usize)
     }
@@ -361,11 +326,8 @@ impl StratifiedSampler {
         if !self.in_table() {
             return None;
         }
-        let i = self.arrays.next_2d;
-        if self.arrays.sizes_2d.get(i) == Some(&n) {
-            if let Some(mut rng) = self.pending_2d[i].take() {
-                make_2d(&mut self.arrays.data_2d[i], n, &mut rng, &self.draws);
-            }
+        if let Some((data, mut rng)) = self.arrays.unmade_2d(n) {
+            make_2d(data, n, &mut rng, &self.draws);
         }
         self.arrays.get_2d(n, self.sample_index as usize)
     }

@@ -43,6 +43,13 @@ impl BoundedDraws {
         self.consts.len() as u32 - 1
     }
 
+    /// Covers the bounds up to `max` too.
+    pub fn cover(&mut self, max: u32) {
+        if max > self.max() {
+            *self = Self::new(max);
+        }
+    }
+
     /// `rng.uniform_u32_below(b)` for `1 <= b <= max()` (larger bounds take
     /// the plain method).
     #[inline]
@@ -59,10 +66,11 @@ impl BoundedDraws {
     }
 }
 
-/// The states `k = 0..=LANES` steps after a state `s`, as `a[k]·s + c[k]`
-/// (mod 2^64) on one stream.
+/// Draws computed side by side by [`BoundedDraws::skip`].
 const LANES: usize = 8;
 
+/// The states `k = 0..=LANES` steps after a state `s`, as `a[k]·s + c[k]`
+/// (mod 2^64) on one stream.
 #[derive(Clone, Copy, Debug)]
 pub struct Jumps {
     a: [u64; LANES + 1],
