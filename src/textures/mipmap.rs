@@ -260,6 +260,17 @@ impl<T: TexValue> MipMap<T> {
         let t = st.y * l.h as f32 - 0.5;
         let (s0, t0) = (s.floor() as i32, t.floor() as i32);
         let (ds, dt) = (s - s0 as f32, t - t0 as f32);
+        if s0 >= 0 && s0 < l.w - 1 && t0 >= 0 && t0 < l.h - 1 {
+            // All four texels inside: every wrap mode leaves them as they are.
+            let i = (t0 * l.w + s0) as usize;
+            let row = l.w as usize;
+            let tx = &l.texels;
+            return tx[i]
+                .scale((1.0 - ds) * (1.0 - dt))
+                .add(tx[i + row].scale((1.0 - ds) * dt))
+                .add(tx[i + 1].scale(ds * (1.0 - dt)))
+                .add(tx[i + row + 1].scale(ds * dt));
+        }
         let w = self.wrap;
         texel_of(l, s0, t0, w)
             .scale((1.0 - ds) * (1.0 - dt))
@@ -477,6 +488,56 @@ mod tests {
             }
         }
         sum.div(sum_w)
+    }
+
+    /// pbrt-v3's `triangle` as written there: every texel through `Texel`.
+    fn bilerp_plain<T: TexValue>(m: &MipMap<T>, level: usize, st: Vec2) -> T {
+        let l = &m.levels[level];
+        let s = st.x * l.w as f32 - 0.5;
+        let t = st.y * l.h as f32 - 0.5;
+        let (s0, t0) = (s.floor() as i32, t.floor() as i32);
+        let (ds, dt) = (s - s0 as f32, t - t0 as f32);
+        m.texel(level, s0, t0)
+            .scale((1.0 - ds) * (1.0 - dt))
+            .add(
+                m.texel(level, s0, t0.wrapping_add(1))
+                    .scale((1.0 - ds) * dt),
+            )
+            .add(
+                m.texel(level, s0.wrapping_add(1), t0)
+                    .scale(ds * (1.0 - dt)),
+            )
+            .add(
+                m.texel(level, s0.wrapping_add(1), t0.wrapping_add(1))
+                    .scale(ds * dt),
+            )
+    }
+
+    /// The bilinear lookup's inside shortcut gives the plain lookup's
+    /// values bit for bit, at every level (down to 1 × 1), in every wrap
+    /// mode, inside the image, across its edges and far outside.
+    #[test]
+    fn bilerp_equals_the_plain_lookup() {
+        let mut rng = Pcg32::new();
+        let (w, h) = (37usize, 16usize);
+        let texels: Vec<f32> = (0..w * h).map(|_| rng.uniform_f32() * 2.0 - 0.25).collect();
+        for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Black] {
+            let m = MipMap::new(w, h, texels.clone(), false, 8.0, wrap).unwrap();
+            for level in 0..m.levels() {
+                for k in 0..4000 {
+                    let spread = [1.0, 1.2, 7.0][k % 3];
+                    let st = Vec2::new(rng.uniform_f32(), rng.uniform_f32()) * spread
+                        - Vec2::splat(0.5 * (spread - 1.0));
+                    let fast = m.bilerp(level, st);
+                    let plain = bilerp_plain(&m, level, st);
+                    assert_eq!(
+                        fast.to_bits(),
+                        plain.to_bits(),
+                        "{wrap:?} level {level} st {st}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
