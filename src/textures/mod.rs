@@ -26,6 +26,7 @@ mod marble;
 mod mipmap;
 mod mix;
 pub mod noise;
+mod noise_lanes;
 pub use noise::MAX_OCTAVES;
 mod ptex;
 pub mod ptex_file;

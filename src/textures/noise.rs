@@ -31,7 +31,7 @@ const PERM: [u8; 256] = [
 ];
 
 #[inline(always)]
-fn perm(i: i32) -> i32 {
+pub(super) fn perm(i: i32) -> i32 {
     PERM[(i & 255) as usize] as i32
 }
 
@@ -45,7 +45,7 @@ fn grad(x: i32, y: i32, z: i32, dx: f32, dy: f32, dz: f32) -> f32 {
 
 /// The quintic fade 6t⁵ − 15t⁴ + 10t³.
 #[inline(always)]
-fn weight(t: f32) -> f32 {
+pub(super) fn weight(t: f32) -> f32 {
     let t3 = t * t * t;
     let t4 = t3 * t;
     6.0 * t4 * t - 15.0 * t4 + 10.0 * t3
@@ -57,8 +57,16 @@ fn lerp(t: f32, a: f32, b: f32) -> f32 {
 }
 
 /// pbrt-v3's `Noise(x, y, z)`: gradient noise in [−1, 1], zero at integer
-/// lattice points.
+/// lattice points. Computed with the corners in lanes
+/// ([`super::noise_lanes`]), bit for bit [`noise_plain`].
+#[inline]
 pub fn noise(x: f32, y: f32, z: f32) -> f32 {
+    super::noise_lanes::noise(x, y, z)
+}
+
+/// pbrt-v3's `Noise` corner by corner, as written there (the reference of
+/// [`noise`]).
+pub fn noise_plain(x: f32, y: f32, z: f32) -> f32 {
     // C++'s float-to-int conversion; out-of-range values (|x| ≥ 2³¹) give
     // meaningless noise in both.
     let (ix, iy, iz) = (x.floor() as i32, y.floor() as i32, z.floor() as i32);
@@ -180,6 +188,31 @@ mod tests {
             max = max.max(v.abs());
         }
         assert!(max > 0.3, "noise is nearly flat: {max}");
+    }
+
+    /// The lanes' noise is the plain code's bit for bit: inside cells, on
+    /// the lattice, at negative and huge coordinates (the lattice index
+    /// wraps at 256), and NaN for NaN.
+    #[test]
+    fn lanes_equal_the_plain_noise() {
+        let mut rng = crate::sampling::rng::Pcg32::with_sequence(3);
+        let check = |x: f32, y: f32, z: f32| {
+            let (a, b) = (noise(x, y, z), noise_plain(x, y, z));
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "({x}, {y}, {z}): {a} against {b}"
+            );
+        };
+        for k in 0..200_000 {
+            let scale = [1.0, 10.0, 300.0, 1e6, 1e10][k % 5];
+            let mut c = || (rng.uniform_f32() - 0.5) * 2.0 * scale;
+            let (x, y, z) = (c(), c(), c());
+            check(x, y, z);
+            check(x.floor(), y, z.floor());
+        }
+        for v in [0.0, -0.0, 255.5, 256.0, -1e-30, f32::NAN, f32::INFINITY] {
+            check(v, 0.25, -v);
+        }
     }
 }
 
