@@ -429,7 +429,15 @@ pub(super) fn light_subpath<'a>(
     if e.pdf_pos == 0.0 || e.pdf_dir == 0.0 || e.le == Vec3::ZERO {
         return 0;
     }
-    push_at(path, Kind::Light, e.ray.o, e.n, e.le, (time, c.camera_medium));
+    // The light's rays start in its own medium (pbrt-v3: a light at a
+    // point or on a shape emits into the outside medium of its
+    // definition; distant and infinite lights from no medium).
+    let medium = if scene.media.is_empty() {
+        None
+    } else {
+        scene.light_media.get(i as usize).copied().flatten()
+    };
+    push_at(path, Kind::Light, e.ray.o, e.n, e.le, (time, medium));
     let v = &mut path[0];
     v.light = Some(i);
     v.pdf_fwd = e.pdf_pos * pmf;
@@ -439,7 +447,7 @@ pub(super) fn light_subpath<'a>(
         diff: None,
         beta,
         pdf: e.pdf_dir,
-        medium: c.camera_medium,
+        medium,
         time,
         mode: Mode::Importance,
     };

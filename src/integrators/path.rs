@@ -460,13 +460,13 @@ pub(super) fn path_step<'a, M: PathMedium>(
         ray.d,
         st.scatter_pdf,
     );
-    if st.bounces >= p.max_depth {
-        return false;
-    }
     let material = &scene.materials[s.material as usize];
-    if material.is_none() {
-        // A medium boundary only: crossed without counting a bounce
-        // (pbrt-v3: bounces--).
+    // A medium boundary only: crossed without counting a bounce (pbrt-v3:
+    // bounces--). In `volpath` also past the last bounce: the continuation
+    // is the BSDF or phase strategy of the last vertex's light sample,
+    // whose rays pbrt-v3 traces through such surfaces (`IntersectTr`); in
+    // `path` pbrt-v3's stop at them.
+    if material.is_none() && (M::MEDIA || st.bounces < p.max_depth) {
         st.pass += 1;
         if st.pass > MAX_PASS_THROUGH {
             return false;
@@ -475,6 +475,9 @@ pub(super) fn path_step<'a, M: PathMedium>(
         st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
         st.diff = None;
         return true;
+    }
+    if st.bounces >= p.max_depth {
+        return false;
     }
     shade(scene, hit, &mut s, material, true, st.diff.as_ref(), bsdf);
     st.diff = None;

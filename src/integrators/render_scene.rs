@@ -28,6 +28,9 @@ pub struct RenderScene {
     pub media: Vec<Medium>,
     /// The medium the camera is in.
     pub camera_medium: Option<u32>,
+    /// By light: the medium its emitted rays start in (bdpt's and mlt's
+    /// light subpaths).
+    pub light_media: Vec<Option<u32>>,
     /// By material slot: the media on either side of the surfaces that
     /// use it, for shapes that are medium transitions (`None`: rays keep
     /// their medium). A shape that is a transition gets a slot of its own

@@ -455,6 +455,7 @@ fn build(ctx: &mut Ctx, stmts: &[crate::lang::Stmt]) -> Built {
         materials: std::mem::take(&mut b.scene_materials),
         shapes: std::mem::take(&mut b.shapes),
         lights: std::mem::take(&mut b.lights),
+        light_media: std::mem::take(&mut b.light_media),
         objects: std::mem::take(&mut b.scene_objects),
         instances: std::mem::take(&mut b.instances),
         skipped: std::mem::take(&mut b.skipped),

@@ -132,6 +132,8 @@ pub struct Builder<'s, 'c> {
     material_lobes: Vec<usize>,
     pub shapes: Vec<ShapeDesc>,
     pub lights: Vec<Light>,
+    /// Per entry of `lights`, the medium its rays start in.
+    pub light_media: Vec<Option<MediumId>>,
     pub scene_objects: Vec<ObjectDesc>,
     pub instances: Vec<InstanceDesc>,
     pub skipped: Vec<String>,
@@ -201,6 +203,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             material_lobes: Vec::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
+            light_media: Vec::new(),
             scene_objects: Vec::new(),
             instances: Vec::new(),
             skipped: Vec::new(),
@@ -548,15 +551,23 @@ impl<'s, 'c> Builder<'s, 'c> {
                     self.ctx.error(s.loc, "the light's transform has non-finite entries (overflow in the transform statements)", "this LightSource", None);
                     self.ctx.report_unused(params, &format!("LightSource \"{}\"", name.value));
                 } else if let Some(l) = lights::light(self.ctx, name, params, self.ctm[0]) {
-                    // pbrt-v3 resolves the interface for every light (its
-                    // media matter to bdpt only): undefined names are errors.
+                    // pbrt-v3 resolves the interface for every light:
+                    // undefined names are errors. A light at a point emits
+                    // into the outside medium (pbrt-v3's `MakeLight`), which
+                    // bdpt's light subpaths start in.
                     let media = self.graphics.media.clone();
                     for n in [&media.0, &media.1] {
                         if !n.is_empty() && !self.medium_names.contains_key(n.as_str()) {
                             self.medium_id(n, media.2);
                         }
                     }
+                    let medium = if l.at_infinity() {
+                        None
+                    } else {
+                        self.medium_id(&media.1, media.2)
+                    };
                     self.lights.push(l);
+                    self.light_media.push(medium);
                 }
             }
             K::AreaLightSource => {

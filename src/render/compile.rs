@@ -77,7 +77,11 @@ impl RenderScene {
             notes.push("no geometry: no BVH built".into());
         }
 
-        let (lights, infinite_lights) = scene_lights(desc, &area, &aggregate);
+        let SceneLights {
+            lights,
+            infinite: infinite_lights,
+            media: light_media,
+        } = scene_lights(desc, &area, &aggregate);
         let zero = lights.iter().filter(|l| l.power() <= 0.0).count();
         if zero > 0 {
             notes.push(format!("{zero} lights of zero power are never sampled"));
@@ -145,6 +149,7 @@ impl RenderScene {
             notes,
             media,
             camera_medium: desc.camera_medium.map(|m| m.0),
+            light_media,
             surface_media,
             has_pass_through,
         }
@@ -157,7 +162,9 @@ impl RenderScene {
 struct WorldShapes {
     meshes: Vec<TriangleMesh>,
     quadrics: Vec<AnalyticShape>,
-    area: Vec<(AreaShape, DiffuseEmission)>,
+    /// The area lights: shape, emission and the medium their rays start
+    /// in (pbrt-v3: the shape's outside medium, on either side).
+    area: Vec<(AreaShape, DiffuseEmission, Option<u32>)>,
     moving: Vec<MovingInstance>,
     /// Animated shapes left out for a singular start or end transform.
     singular_moving: usize,
@@ -166,10 +173,11 @@ struct WorldShapes {
 fn world_shapes(desc: &SceneDescription, slots: &Slots) -> WorldShapes {
     let mut meshes = Vec::new();
     let mut quadrics = Vec::new();
-    let mut area: Vec<(AreaShape, DiffuseEmission)> = Vec::new();
+    let mut area: Vec<(AreaShape, DiffuseEmission, Option<u32>)> = Vec::new();
 
     let mut add_shape = |s: &ShapeDesc, to_world: DMat4| {
         let emit = s.area_light.filter(|a| a.l.max_element() > 0.0);
+        let medium = s.medium_interface.outside.map(|m| m.0);
         match &s.surface {
             scene::Surface::TriangleMesh(m) => {
                 let mesh_index = meshes.len() as u32;
@@ -183,6 +191,7 @@ fn world_shapes(desc: &SceneDescription, slots: &Slots) -> WorldShapes {
                                 tri,
                             },
                             a,
+                            medium,
                         ));
                     }
                 }
@@ -196,7 +205,7 @@ fn world_shapes(desc: &SceneDescription, slots: &Slots) -> WorldShapes {
                 };
                 if let Some(a) = emit {
                     q.set_light(Some(area.len() as u32));
-                    area.push((AreaShape::Analytic(quadrics.len() as u32), a));
+                    area.push((AreaShape::Analytic(quadrics.len() as u32), a, medium));
                 }
                 quadrics.push(q);
             }
@@ -229,28 +238,41 @@ fn world_shapes(desc: &SceneDescription, slots: &Slots) -> WorldShapes {
     }
 }
 
-/// The area lights of the emitting shapes, then the description's lights
-/// (preprocessed for the scene's bounds), and the indices of the infinite
-/// ones.
+/// The lights of a scene: the area lights of the emitting shapes, then the
+/// description's lights (preprocessed for the scene's bounds); the
+/// indices of the infinite ones; and each light's medium, where its
+/// emitted rays start.
+struct SceneLights {
+    lights: Vec<Light>,
+    infinite: Vec<u32>,
+    media: Vec<Option<u32>>,
+}
+
 fn scene_lights(
     desc: &SceneDescription,
-    area: &[(AreaShape, DiffuseEmission)],
+    area: &[(AreaShape, DiffuseEmission, Option<u32>)],
     geometry: &Aggregate,
-) -> (Vec<Light>, Vec<u32>) {
+) -> SceneLights {
     let mut lights: Vec<Light> = area
         .iter()
-        .map(|&(shape, a)| DiffuseLight::new(a, shape, geometry).into())
+        .map(|&(shape, a, _)| DiffuseLight::new(a, shape, geometry).into())
         .collect();
-    let mut infinite_lights = Vec::new();
-    for l in &desc.lights {
+    let mut media: Vec<Option<u32>> = area.iter().map(|a| a.2).collect();
+    let mut infinite = Vec::new();
+    for (i, l) in desc.lights.iter().enumerate() {
         let mut light = l.clone();
         light.preprocess(geometry);
         if light.is_infinite() {
-            infinite_lights.push(lights.len() as u32);
+            infinite.push(lights.len() as u32);
         }
         lights.push(light);
+        media.push(desc.light_media.get(i).copied().flatten().map(|m| m.0));
     }
-    (lights, infinite_lights)
+    SceneLights {
+        lights,
+        infinite,
+        media,
+    }
 }
 
 /// The materials, one per description material plus one per (material,

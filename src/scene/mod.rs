@@ -43,6 +43,12 @@ pub struct SceneDescription {
     /// as their kinds built them (what depends on the whole scene is set
     /// when it is built: `Light::preprocess`).
     pub lights: Vec<Light>,
+    /// Per entry of `lights`: the medium its emitted rays start in. pbrt-v3
+    /// gives point, spot, goniometric and projection lights the outside
+    /// medium of the graphics state at their `LightSource`; distant and
+    /// infinite lights emit from no medium. Only bdpt's and mlt's light
+    /// subpaths start from lights.
+    pub light_media: Vec<Option<MediumId>>,
     /// Object definitions that are instanced at least once.
     pub objects: Vec<ObjectDesc>,
     /// Placements of objects.
