@@ -2,8 +2,9 @@
 //! transmittance through a homogeneous slab, a furnace inside a scattering
 //! medium, the Henyey–Greenstein phase function by chi-square (and its
 //! sign convention), delta and ratio tracking in a constant grid against the
-//! homogeneous medium, bad input as located diagnostics, and `volpath`'s
-//! last light sample finding the sky through a medium boundary.
+//! homogeneous medium, bad input as located diagnostics, `volpath`'s
+//! last light sample finding the sky through a medium boundary, and
+//! `path` finding no light through one from a diffuse vertex (pbrt-v3's).
 
 mod common;
 
@@ -746,4 +747,57 @@ WorldEnd
     eprintln!("volpath {mv} against bdpt {mb}: mean difference {md:.5}, 8×8 block error {be:.5}");
     assert!(md < 0.03, "mean differs by {md}");
     assert!(be < 0.05, "8×8 block means differ by {be}");
+}
+
+/// pbrt-v3's `path` counts no light that a diffuse vertex would reach
+/// through a material-less surface: its light sample's shadow ray is
+/// occluded by the surface and its BSDF-sampled ray ends there (emission
+/// found further is added only after specular bounces), while the path
+/// itself crosses the surface. A floor inside a material-less sphere, lit
+/// only by a disk light outside it, is then black under `path`, as under
+/// pbrt-v3 (whose render is exactly 0 there); without the sphere it is lit.
+/// pbrs's path used to count the BSDF strategy's share of that emission
+/// beyond the surface (14% of pbrt-v3's image in a scene with the floor
+/// half inside).
+#[test]
+fn path_finds_no_light_through_a_material_less_surface_from_a_diffuse_vertex() {
+    let text = |sphere: &str| {
+        format!(
+            r#"
+LookAt 0 1.5 1.5  0 0 0  0 1 0
+Camera "perspective" "float fov" [60]
+Film "image" "integer xresolution" [16] "integer yresolution" [16]
+Sampler "random" "integer pixelsamples" [64]
+Integrator "path" "integer maxdepth" [5]
+WorldBegin
+{sphere}
+AttributeBegin
+  Translate 0 5 0
+  AreaLightSource "diffuse" "rgb L" [5 5 5]
+  Rotate 90 1 0 0
+  Shape "disk" "float radius" 1.5
+AttributeEnd
+AttributeBegin
+  Material "matte" "rgb Kd" [0.5 0.5 0.5]
+  Shape "trianglemesh" "integer indices" [0 1 2 2 3 0]
+    "point P" [-2 0 -2 2 0 -2 2 0 2 -2 0 2]
+AttributeEnd
+WorldEnd
+"#
+        )
+    };
+    let sphere =
+        "AttributeBegin\n  Material \"\"\n  Shape \"sphere\" \"float radius\" 3\nAttributeEnd";
+    let inside = render_desc(&load(&text(sphere)).scene, 1);
+    let open = render_desc(&load(&text("")).scene, 1);
+    assert!(
+        mean(&open).min_element() > 0.01,
+        "the lit floor: {}",
+        mean(&open)
+    );
+    assert_eq!(
+        mean(&inside),
+        Vec3::ZERO,
+        "light counted through the sphere"
+    );
 }

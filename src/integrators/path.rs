@@ -344,6 +344,11 @@ pub(crate) struct PathState<M> {
     /// there (for the MIS weight of emission found along it).
     prev: Option<SurfacePoint>,
     scatter_pdf: f32,
+    /// `path` only: the ray left a non-specular vertex and crossed a
+    /// material-less surface, so emission it finds is not counted (pbrt-v3's
+    /// `path` stops both strategies of that vertex's light sample there:
+    /// the shadow ray is occluded and the BSDF-sampled ray ends at it).
+    dark: bool,
 }
 
 impl<M: PathMedium> PathState<M> {
@@ -362,6 +367,7 @@ impl<M: PathMedium> PathState<M> {
         self.pass = 0;
         self.prev = None;
         self.scatter_pdf = 0.0;
+        self.dark = false;
     }
 
     #[inline]
@@ -378,6 +384,7 @@ impl<M: PathMedium> PathState<M> {
             pass: 0,
             prev: None,
             scatter_pdf: 0.0,
+            dark: false,
         }
     }
 }
@@ -438,6 +445,9 @@ pub(super) fn path_step<'a, M: PathMedium>(
     let from = st.prev.filter(|_| !st.specular_bounce);
     // By reference: a copy of the hit just read stalls on its stores.
     let Some(hit) = hit.as_ref() else {
+        if st.dark {
+            return false;
+        }
         add_escaped_mis(
             &mut st.l,
             scene,
@@ -451,15 +461,17 @@ pub(super) fn path_step<'a, M: PathMedium>(
     };
     let mut s = scene.aggregate.surface_at(hit, time);
     let wo = -ray.d;
-    st.l += emitted_mis(
-        scene,
-        lights,
-        st.beta,
-        &s,
-        from.as_ref(),
-        ray.d,
-        st.scatter_pdf,
-    );
+    if !st.dark {
+        st.l += emitted_mis(
+            scene,
+            lights,
+            st.beta,
+            &s,
+            from.as_ref(),
+            ray.d,
+            st.scatter_pdf,
+        );
+    }
     let material = &scene.materials[s.material as usize];
     // A medium boundary only: crossed without counting a bounce (pbrt-v3:
     // bounces--). In `volpath` also past the last bounce: the continuation
@@ -474,6 +486,7 @@ pub(super) fn path_step<'a, M: PathMedium>(
         st.medium = st.medium.after(p, &s, ray.d);
         st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
         st.diff = None;
+        st.dark |= !M::MEDIA && from.is_some();
         return true;
     }
     if st.bounces >= p.max_depth {
@@ -505,6 +518,7 @@ pub(super) fn path_step<'a, M: PathMedium>(
     st.specular_bounce = bs.is_specular();
     st.scatter_pdf = bs.pdf;
     st.prev = Some(s.point);
+    st.dark = false;
     st.eta_scale *= eta_scale_change(bsdf, &bs, wo, s.point.n);
     st.medium = st.medium.after(p, &s, bs.wi);
     st.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
@@ -541,6 +555,7 @@ pub(super) fn path_step<'a, M: PathMedium>(
         st.specular_bounce = false;
         st.scatter_pdf = bs.pdf;
         st.prev = Some(pi.point);
+        st.dark = false;
         st.medium = M::after_exit(p, &pi, bs.wi);
         st.ray = spawn_ray(pi.point.p, pi.point.p_error, pi.point.n, bs.wi);
     }
