@@ -12,7 +12,8 @@
 mod common;
 
 use common::{
-    assert_matches, block_means, error_text, load, load_text, reference, render_threads, Bounds,
+    assert_matches, block_means, error_text, fog_sphere, load, load_text, reference,
+    render_threads, Bounds,
 };
 use pbrs::image::io::read_image;
 use pbrs::image::Image;
@@ -214,25 +215,14 @@ fn a_camera_without_importance_is_a_located_error() {
 }
 
 /// A camera in fog inside a sphere (its boundary is material-less: fog
-/// inside, vacuum outside), lit by a point light in vacuum outside the
-/// sphere and by a constant sky, over a floor outside it.
-const FOG_SPHERE: &str = r#"
-LookAt 0 0 0.5  0 0 -1  0 1 0
-Camera "perspective" "float fov" [70]
-Film "image" "integer xresolution" [24] "integer yresolution" [24]
-Sampler "random" "integer pixelsamples" [256]
-Integrator "bdpt" "integer maxdepth" [6]
-MakeNamedMedium "fog" "string type" "homogeneous"
-  "rgb sigma_a" [0.1 0.1 0.1] "rgb sigma_s" [1.5 1.5 1.5]
-MediumInterface "" "fog"
-WorldBegin
+/// inside, vacuum outside), lit by a point light outside the sphere (in
+/// the medium `point_medium`) and by a constant sky, over a floor outside
+/// it.
+fn fog_sphere_scene(point_medium: &str) -> String {
+    let world = format!(
+        r#"
 AttributeBegin
-  MediumInterface "fog" ""
-  Material ""
-  Shape "sphere" "float radius" 1
-AttributeEnd
-AttributeBegin
-  MediumInterface "" ""
+  MediumInterface "" "{point_medium}"
   LightSource "point" "point from" [0 2.5 -0.5] "rgb I" [30 30 30]
   LightSource "infinite" "rgb L" [0.4 0.5 0.6]
 AttributeEnd
@@ -241,18 +231,19 @@ AttributeBegin
   Translate 0 -1.5 0
   Shape "trianglemesh" "integer indices" [0 1 2 2 3 0]
     "point P" [-5 0 -5 5 0 -5 5 0 5 -5 0 5]
-AttributeEnd
-WorldEnd
-"#;
+AttributeEnd"#
+    );
+    fog_sphere(r#""bdpt" "integer maxdepth" [6]"#, 256, 0.1, &world)
+}
 
 /// Light subpaths start in the light's medium as pbrt-v3's do (a point
 /// light emits into the outside medium of its `LightSource`, an infinite
-/// light from no medium), not in the camera's: in [`FOG_SPHERE`] starting
+/// light from no medium), not in the camera's: in [`fog_sphere_scene`] starting
 /// them in the camera's fog made the image 8% brighter than `volpath`'s
 /// (pbrt-v3's bdpt at 2048 spp: within 2e-5 of pbrs's mean).
 #[test]
 fn light_subpaths_start_in_the_lights_medium() {
-    let d = load_text(FOG_SPHERE).scene;
+    let d = load_text(&fog_sphere_scene("")).scene;
     let scene = pbrs::integrators::RenderScene::new(&d);
     // The sky and the point light in vacuum: no medium for either.
     assert_eq!(scene.light_media, vec![None, None]);
@@ -273,11 +264,7 @@ fn light_subpaths_start_in_the_lights_medium() {
 /// the fog), the sky still from no medium.
 #[test]
 fn a_light_in_a_medium_emits_into_it() {
-    let text = FOG_SPHERE.replace(
-        "  MediumInterface \"\" \"\"\n  LightSource \"point\"",
-        "  MediumInterface \"\" \"fog\"\n  LightSource \"point\"",
-    );
-    assert_ne!(text, FOG_SPHERE);
+    let text = fog_sphere_scene("fog");
     let d = load_text(&text).scene;
     let scene = pbrs::integrators::RenderScene::new(&d);
     assert_eq!(scene.light_media.len(), 2);

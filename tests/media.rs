@@ -712,25 +712,11 @@ fn majorant_grid_tracking_is_unbiased() {
 #[test]
 fn the_last_light_sample_finds_the_sky_through_a_medium_boundary() {
     let text = |integrator: &str| {
-        format!(
-            r#"
-LookAt 0 0 0.5  0 0 -1  0 1 0
-Camera "perspective" "float fov" [70]
-Film "image" "integer xresolution" [24] "integer yresolution" [24]
-Sampler "random" "integer pixelsamples" [1024]
-Integrator "{integrator}" "integer maxdepth" [1]
-MakeNamedMedium "fog" "string type" "homogeneous"
-  "rgb sigma_a" [0 0 0] "rgb sigma_s" [1.5 1.5 1.5]
-MediumInterface "" "fog"
-WorldBegin
-AttributeBegin
-  MediumInterface "fog" ""
-  Material ""
-  Shape "sphere" "float radius" 1
-AttributeEnd
-LightSource "infinite" "rgb L" [0.4 0.5 0.6]
-WorldEnd
-"#
+        common::fog_sphere(
+            &format!(r#""{integrator}" "integer maxdepth" [1]"#),
+            1024,
+            0.0,
+            r#"LightSource "infinite" "rgb L" [0.4 0.5 0.6]"#,
         )
     };
     let v = render_desc(&load(&text("volpath")).scene, 1);

@@ -431,3 +431,30 @@ pub fn assert_bit_identical(a: &Image, b: &Image, what: &str) {
         "{what} differ"
     );
 }
+
+/// A 24×24 view from inside a sphere of radius 1 whose material-less
+/// boundary has fog inside (σs 1.5, σa `sigma_a`) and vacuum outside, the
+/// camera in the fog; `integrator` is the `Integrator` statement's
+/// arguments, `world` what the world holds besides the sphere.
+pub fn fog_sphere(integrator: &str, spp: u32, sigma_a: f32, world: &str) -> String {
+    format!(
+        r#"
+LookAt 0 0 0.5  0 0 -1  0 1 0
+Camera "perspective" "float fov" [70]
+Film "image" "integer xresolution" [24] "integer yresolution" [24]
+Sampler "random" "integer pixelsamples" [{spp}]
+Integrator {integrator}
+MakeNamedMedium "fog" "string type" "homogeneous"
+  "rgb sigma_a" [{sigma_a} {sigma_a} {sigma_a}] "rgb sigma_s" [1.5 1.5 1.5]
+MediumInterface "" "fog"
+WorldBegin
+AttributeBegin
+  MediumInterface "fog" ""
+  Material ""
+  Shape "sphere" "float radius" 1
+AttributeEnd
+{world}
+WorldEnd
+"#
+    )
+}
