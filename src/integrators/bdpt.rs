@@ -432,11 +432,7 @@ pub(super) fn light_subpath<'a>(
     // The light's rays start in its own medium (pbrt-v3: a light at a
     // point or on a shape emits into the outside medium of its
     // definition; distant and infinite lights from no medium).
-    let medium = if scene.media.is_empty() {
-        None
-    } else {
-        scene.light_media.get(i as usize).copied().flatten()
-    };
+    let medium = scene.light_media[i as usize];
     push_at(path, Kind::Light, e.ray.o, e.n, e.le, (time, medium));
     let v = &mut path[0];
     v.light = Some(i);

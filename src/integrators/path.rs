@@ -477,7 +477,7 @@ pub(super) fn path_step<'a, M: PathMedium>(
     // bounces--). In `volpath` also past the last bounce: the continuation
     // is the BSDF or phase strategy of the last vertex's light sample,
     // whose rays pbrt-v3 traces through such surfaces (`IntersectTr`); in
-    // `path` pbrt-v3's stop at them.
+    // `path` pbrt-v3's rays stop there (see `PathState::dark`).
     if material.is_none() && (M::MEDIA || st.bounces < p.max_depth) {
         st.pass += 1;
         if st.pass > MAX_PASS_THROUGH {

@@ -28,8 +28,8 @@ pub struct RenderScene {
     pub media: Vec<Medium>,
     /// The medium the camera is in.
     pub camera_medium: Option<u32>,
-    /// By light: the medium its emitted rays start in (bdpt's and mlt's
-    /// light subpaths).
+    /// One per entry of `lights`: the medium its emitted rays start in
+    /// (bdpt's and mlt's light subpaths; `Some` only in a scene with media).
     pub light_media: Vec<Option<u32>>,
     /// By material slot: the media on either side of the surfaces that
     /// use it, for shapes that are medium transitions (`None`: rays keep
