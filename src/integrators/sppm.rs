@@ -47,6 +47,7 @@ use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues, SamplerDesc, SamplerKind};
 use glam::{DVec3, IVec2, IVec3, Vec2, Vec3};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec::int_opt("iterations", "iterations (≥ 1; default 64)"),
@@ -289,11 +290,11 @@ pub struct SppmRun<'r> {
 /// Photons per chunk: the unit of parallel work whose contributions are
 /// added in order (small enough that an iteration of one photon per pixel
 /// of a small film still keeps every thread busy to its end).
-const PHOTON_CHUNK: u32 = 1024;
+const PHOTON_CHUNK: u32 = 256;
 
 /// Chunks in flight per thread: their records are kept until the group is
 /// added in.
-const CHUNKS_PER_THREAD: usize = 32;
+const CHUNKS_PER_THREAD: usize = 128;
 
 impl Sppm {
     /// Renders all iterations. `done(k, image)` is called after iteration
@@ -688,9 +689,11 @@ struct Grid {
     bounds: Bounds3,
     res: IVec3,
     buckets: Buckets,
-    /// Bucket b lists `entries[starts[b]..starts[b + 1]]`.
+    /// Bucket b lists `entries[starts[b]..starts[b + 1]]` (atomic only
+    /// so that the build's runs can write their disjoint slots in
+    /// parallel; read and written relaxed, plain loads and stores).
     starts: Vec<u32>,
-    entries: Vec<u32>,
+    entries: Vec<AtomicU32>,
     /// Each pixel's visible point and search radius, by pixel index (none
     /// where the pixel has no visible point that carries light).
     points: Vec<Option<(Vec3, f32)>>,
@@ -698,6 +701,9 @@ struct Grid {
     /// first key, and the buckets of every pixel's cells in pixel order.
     key_starts: Vec<u32>,
     keys: Vec<u32>,
+    /// Work space of the build: each run's count of keys per bucket, then
+    /// its next slot per bucket.
+    counts: Vec<Vec<u32>>,
 }
 
 impl Grid {
@@ -796,21 +802,47 @@ impl Grid {
                 }
             }
         });
-        // Counted and filled so that buckets list pixels in pixel order.
-        for &b in &keys {
-            self.starts[b as usize + 1] += 1;
-        }
-        for b in 0..size {
-            self.starts[b + 1] += self.starts[b];
-        }
-        self.entries.resize(total as usize, 0);
-        let mut fill = self.starts.clone();
-        for (i, w) in key_starts.windows(2).enumerate() {
-            for &b in &keys[w[0] as usize..w[1] as usize] {
-                self.entries[fill[b as usize] as usize] = i as u32;
-                fill[b as usize] += 1;
+        // A counting sort, so that buckets list pixels in pixel order: the
+        // pixels in a few runs, each counting its keys per bucket, then
+        // writing them after the earlier runs' (runs in parallel; the same
+        // lists for any number of runs).
+        let n = self.points.len();
+        let parts = rayon::current_num_threads().clamp(1, MAX_GRID_PARTS).min(n.max(1));
+        let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
+        let mut counts = std::mem::take(&mut self.counts);
+        counts.resize_with(parts, Vec::new);
+        counts.par_iter_mut().enumerate().for_each(|(p, c)| {
+            c.clear();
+            c.resize(size, 0);
+            let run = key_starts[bounds[p]] as usize..key_starts[bounds[p + 1]] as usize;
+            for &b in &keys[run] {
+                c[b as usize] += 1;
             }
+        });
+        // Each bucket's start, and each run's first slot in it.
+        for b in 0..size {
+            let mut next = self.starts[b];
+            for c in counts.iter_mut() {
+                let k = c[b];
+                c[b] = next;
+                next += k;
+            }
+            self.starts[b + 1] = next;
         }
+        self.entries.clear();
+        self.entries.resize_with(total as usize, || AtomicU32::new(0));
+        let entries = &self.entries;
+        counts.par_iter_mut().enumerate().for_each(|(p, fill)| {
+            for i in bounds[p]..bounds[p + 1] {
+                let run = key_starts[i] as usize..key_starts[i + 1] as usize;
+                for &b in &keys[run] {
+                    // Each slot is written by one run only.
+                    entries[fill[b as usize] as usize].store(i as u32, Ordering::Relaxed);
+                    fill[b as usize] += 1;
+                }
+            }
+        });
+        self.counts = counts;
         self.key_starts = key_starts;
         self.keys = keys;
     }
@@ -856,7 +888,8 @@ impl Grid {
         }
         let b = self.buckets.of(c);
         let (lo, hi) = (self.starts[b] as usize, self.starts[b + 1] as usize);
-        for &i in &self.entries[lo..hi] {
+        for i in &self.entries[lo..hi] {
+            let i = i.load(Ordering::Relaxed);
             // Only pixels with a visible point are listed.
             let Some((q, radius)) = self.points[i as usize] else {
                 continue;
@@ -870,6 +903,10 @@ impl Grid {
         }
     }
 }
+
+/// Runs of pixels the grid's counting sort is split into at most (each
+/// holds a count per bucket, four bytes per pixel of the film).
+const MAX_GRID_PARTS: usize = 4;
 
 /// Pixels per task of the grid's parallel key pass.
 const GRID_CHUNK: usize = 4096;
