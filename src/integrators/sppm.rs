@@ -808,13 +808,13 @@ impl Grid {
         // lists for any number of runs).
         let n = self.points.len();
         let parts = rayon::current_num_threads().clamp(1, MAX_GRID_PARTS).min(n.max(1));
-        let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
+        let edges: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
         let mut counts = std::mem::take(&mut self.counts);
         counts.resize_with(parts, Vec::new);
         counts.par_iter_mut().enumerate().for_each(|(p, c)| {
             c.clear();
             c.resize(size, 0);
-            let run = key_starts[bounds[p]] as usize..key_starts[bounds[p + 1]] as usize;
+            let run = key_starts[edges[p]] as usize..key_starts[edges[p + 1]] as usize;
             for &b in &keys[run] {
                 c[b as usize] += 1;
             }
@@ -829,11 +829,11 @@ impl Grid {
             }
             self.starts[b + 1] = next;
         }
-        self.entries.clear();
+        // Cleared at the top of the build.
         self.entries.resize_with(total as usize, || AtomicU32::new(0));
         let entries = &self.entries;
         counts.par_iter_mut().enumerate().for_each(|(p, fill)| {
-            for i in bounds[p]..bounds[p + 1] {
+            for i in edges[p]..edges[p + 1] {
                 let run = key_starts[i] as usize..key_starts[i + 1] as usize;
                 for &b in &keys[run] {
                     // Each slot is written by one run only.
