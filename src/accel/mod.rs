@@ -737,8 +737,10 @@ impl Shapes<'_> {
         }
     }
 
+    /// The hit's shading data with `time` in place (a hit built and then
+    /// copied with its time changed stalls on store forwarding).
     #[inline(always)]
-    fn surface(&self, prim: PrimRef, local: HitLocal) -> (SurfaceHit, bool) {
+    fn surface(&self, prim: PrimRef, local: HitLocal, time: f32) -> (SurfaceHit, bool) {
         match local {
             HitLocal::Bary(b) => {
                 let m = &self.meshes[prim.mesh as usize];
@@ -747,7 +749,7 @@ impl Shapes<'_> {
                         point: m.surface_point(prim.index, b),
                         material: m.material,
                         light: m.first_light.map(|l| l + prim.index),
-                        time: 0.0,
+                        time,
                     },
                     m.n.is_some(),
                 )
@@ -759,7 +761,7 @@ impl Shapes<'_> {
                         point: s.surface_point(p),
                         material: s.material(),
                         light: s.light(),
-                        time: 0.0,
+                        time,
                     },
                     false,
                 )
@@ -1009,7 +1011,7 @@ impl Aggregate {
             return DiffGeom::ZERO;
         };
         let shapes = object.shapes();
-        let (local, _) = shapes.surface(hit.prim, hit.local);
+        let (local, _) = shapes.surface(hit.prim, hit.local, 0.0);
         place.geom_to_world(shapes.diff_geom(hit.prim, hit.local, local.point.ns))
     }
 
@@ -1023,13 +1025,12 @@ impl Aggregate {
     #[inline]
     pub fn surface_at(&self, hit: &Hit, time: f32) -> SurfaceHit {
         if hit.instance == NO_INSTANCE {
-            let s = self.shapes().surface(hit.prim, hit.local).0;
-            return SurfaceHit { time, ..s };
+            return self.shapes().surface(hit.prim, hit.local, time).0;
         }
         let (object, place) = self
             .placed(hit, time)
             .expect("a moving instance's hit has an invertible transform at its time");
-        let (s, vertex_normals) = object.shapes().surface(hit.prim, hit.local);
+        let (s, vertex_normals) = object.shapes().surface(hit.prim, hit.local, time);
         SurfaceHit {
             point: place.point_to_world(s.point, vertex_normals),
             material: s.material,

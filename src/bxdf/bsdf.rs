@@ -80,6 +80,27 @@ impl<'a> Bsdf<'a> {
         Bsdf::new(frame, Vec3::Z, 1.0)
     }
 
+    /// Writes [`Bsdf::empty`] into `dst` one field at a time, so that no
+    /// BSDF is assembled on the stack and copied (a copy whose wide loads
+    /// span the narrow stores that built it stalls on store forwarding).
+    ///
+    /// # Safety
+    /// `dst` must be valid for writes and aligned; what it held is
+    /// overwritten without being dropped.
+    #[inline(always)]
+    pub unsafe fn write_empty(dst: *mut Bsdf<'a>) {
+        use std::ptr::addr_of_mut;
+        // SAFETY: the caller's contract; each field is written once.
+        unsafe {
+            addr_of_mut!((*dst).frame.s).write(Vec3::X);
+            addr_of_mut!((*dst).frame.t).write(Vec3::Y);
+            addr_of_mut!((*dst).frame.n).write(Vec3::Z);
+            addr_of_mut!((*dst).ng).write(Vec3::Z);
+            addr_of_mut!((*dst).eta).write(1.0);
+            addr_of_mut!((*dst).lobes).write(ArrayVec::new());
+        }
+    }
+
     /// Empties the BSDF for a new hit (eta 1).
     #[inline]
     pub fn reset(&mut self, frame: Frame, ng: Vec3) {

@@ -3,7 +3,7 @@
 //! that strategy against every other that could have made the same path
 //! (pbrt-v3's `MISWeight`, with its remapping of delta densities to 1).
 
-use super::vertex::{Kind, Mode, Vertex};
+use super::vertex::{push_at, Kind, Mode, Vertex};
 use super::Ctx;
 use crate::geometry::{spawn_ray_to, Ray};
 use crate::integrators::volpath::transmittance;
@@ -47,12 +47,32 @@ fn g(c: &Ctx, v0: &Vertex, v1: &Vertex, sampler: &mut Sampler, scratch: &mut Scr
     g * tr(c, v0, v1, sampler, scratch)
 }
 
-/// Strategy (s, t) over the subpaths `light` and `camera`.
-#[allow(clippy::too_many_arguments)]
+/// Strategy (s, t) over the subpaths `light` and `camera`. A strategy
+/// that samples a new endpoint (t = 1: a camera vertex, s = 1: a light
+/// vertex) builds it past the end of that subpath, which is as long as it
+/// was again when this returns.
 pub(crate) fn connect<'a>(
     c: &Ctx<'a>,
-    light: &mut [Vertex<'a>],
-    camera: &mut [Vertex<'a>],
+    light: &mut Vec<Vertex<'a>>,
+    camera: &mut Vec<Vertex<'a>>,
+    s: usize,
+    t: usize,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Strategy {
+    let (n_light, n_camera) = (light.len(), camera.len());
+    debug_assert!(s <= n_light && t <= n_camera);
+    let st = strategy(c, light, camera, s, t, sampler, scratch);
+    light.truncate(n_light);
+    camera.truncate(n_camera);
+    st
+}
+
+/// [`connect`], with a sampled endpoint left at the end of its subpath.
+fn strategy<'a>(
+    c: &Ctx<'a>,
+    light: &mut Vec<Vertex<'a>>,
+    camera: &mut Vec<Vertex<'a>>,
     s: usize,
     t: usize,
     sampler: &mut Sampler,
@@ -66,7 +86,9 @@ pub(crate) fn connect<'a>(
     if t > 1 && s != 0 && camera[t - 1].kind == Kind::Light {
         return none;
     }
-    let mut sampled: Option<Vertex<'a>> = None;
+    // A sampled endpoint was pushed (onto `camera` for t = 1, else onto
+    // `light`), to take the place of the subpath's own for the MIS weight.
+    let mut sampled = false;
     let mut p_raster = None;
     let mut l = Vec3::ZERO;
     // The scattering densities the connection's BSDF values came with:
@@ -84,24 +106,25 @@ pub(crate) fn connect<'a>(
             if let Some(is) = c.camera.sample_wi(qs.p, u, qs.time) {
                 p_raster = Some(is.p_raster);
                 if is.pdf > 0.0 && is.we != Vec3::ZERO {
-                    let v = Vertex::at(
+                    push_at(
+                        camera,
                         Kind::Camera,
                         is.p_lens,
                         is.n,
                         is.we / is.pdf,
-                        qs.time,
-                        c.camera_medium,
+                        (qs.time, c.camera_medium),
                     );
-                    let (f, pdf) = qs.f(&v, Mode::Importance);
+                    sampled = true;
+                    let v = &camera[camera.len() - 1];
+                    let (f, pdf) = qs.f(v, Mode::Importance);
                     dens.at_qs = qs.scatters().then_some(pdf);
                     l = qs.beta * f * v.beta;
                     if qs.on_surface() {
                         l *= is.wi.dot(qs.ns).abs();
                     }
                     if l != Vec3::ZERO {
-                        l *= tr(c, qs, &v, sampler, scratch);
+                        l *= tr(c, qs, v, sampler, scratch);
                     }
-                    sampled = Some(v);
                 }
             }
         }
@@ -118,8 +141,10 @@ pub(crate) fn connect<'a>(
             );
             let u2 = sampler.get_2d();
             if let Some((i, pmf)) = chosen {
-                if let Some((v, shadow, wi)) = light_vertex(c, pt, i, pmf, u2) {
-                    let (f, pdf) = pt.f(&v, Mode::Radiance);
+                if let Some((shadow, wi)) = light_vertex(c, pt, i, pmf, u2, light) {
+                    sampled = true;
+                    let v = &light[light.len() - 1];
+                    let (f, pdf) = pt.f(v, Mode::Radiance);
                     dens.at_pt = pt.scatters().then_some(pdf);
                     l = pt.beta * f * v.beta;
                     if pt.on_surface() {
@@ -129,7 +154,6 @@ pub(crate) fn connect<'a>(
                         let medium = pt.medium_towards(wi);
                         l *= transmittance(c.scene, &shadow, pt.time, medium, sampler, scratch);
                     }
-                    sampled = Some(v);
                 }
             }
         }
@@ -149,7 +173,7 @@ pub(crate) fn connect<'a>(
     let weight = if l == Vec3::ZERO {
         0.0
     } else {
-        mis_weight(c, light, camera, sampled.as_mut(), dens, s, t)
+        mis_weight(c, light, camera, sampled, dens, s, t)
     };
     Strategy {
         l: l * weight,
@@ -169,16 +193,18 @@ struct Densities {
     at_pt: Option<f32>,
 }
 
-/// The light vertex of the s = 1 strategy: light `i` (chosen with
-/// probability `pmf`) sampled from `pt` (pbrt-v3's `Sample_Li`), with its
-/// density of origin; its shadow ray and direction.
+/// The light vertex of the s = 1 strategy, pushed onto `path`: light `i`
+/// (chosen with probability `pmf`) sampled from `pt` (pbrt-v3's
+/// `Sample_Li`), with its density of origin; returns its shadow ray and
+/// direction.
 fn light_vertex<'a>(
     c: &Ctx<'a>,
     pt: &Vertex<'a>,
     i: u32,
     pmf: f32,
     u: Vec2,
-) -> Option<(Vertex<'a>, Ray, Vec3)> {
+    path: &mut Vec<Vertex<'a>>,
+) -> Option<(Ray, Vec3)> {
     let light = &c.scene.lights[i as usize];
     let r = crate::shapes::SurfacePoint {
         p: pt.p,
@@ -201,21 +227,30 @@ fn light_vertex<'a>(
     if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return None;
     }
-    let mut v = Vertex::at(Kind::Light, p, n, ls.li / (ls.pdf * pmf), pt.time, None);
+    push_at(
+        path,
+        Kind::Light,
+        p,
+        n,
+        ls.li / (ls.pdf * pmf),
+        (pt.time, None),
+    );
+    let v = path.last_mut().expect("just pushed");
     v.light = Some(i);
     v.pdf_fwd = v.pdf_light_origin(c, pt);
-    Some((v, ls.shadow, ls.wi))
+    Some((ls.shadow, ls.wi))
 }
 
 /// pbrt-v3's `MISWeight`: the subpaths' reverse densities are set for
-/// this strategy (and the sampled endpoint put in place), the ratios of
+/// this strategy (and a sampled endpoint, the last vertex of `camera` for
+/// t = 1 and of `light` for s = 1, put in place), the ratios of
 /// every other strategy's density to this one's summed, and the subpaths
 /// restored.
 fn mis_weight<'a>(
     c: &Ctx<'a>,
     light: &mut [Vertex<'a>],
     camera: &mut [Vertex<'a>],
-    mut sampled: Option<&mut Vertex<'a>>,
+    sampled: bool,
     dens: Densities,
     s: usize,
     t: usize,
@@ -224,13 +259,8 @@ fn mis_weight<'a>(
         return 1.0;
     }
     // The sampled endpoint replaces the subpath's.
-    if let Some(v) = sampled.as_deref_mut() {
-        let slot = if s == 1 {
-            &mut light[0]
-        } else {
-            &mut camera[0]
-        };
-        slot.swap_endpoint(v);
+    if sampled {
+        swap_sampled_endpoint(if s == 1 { light } else { camera });
     }
     // The new reverse densities, computed before any is set.
     let (qs, pt) = (s.checked_sub(1), t - 1);
@@ -300,13 +330,15 @@ fn mis_weight<'a>(
     if let (Some(m), Some(v)) = (qs_m, saved_qs_m) {
         light[m].pdf_rev = v;
     }
-    if let Some(v) = sampled {
-        let slot = if s == 1 {
-            &mut light[0]
-        } else {
-            &mut camera[0]
-        };
-        slot.swap_endpoint(v);
+    if sampled {
+        swap_sampled_endpoint(if s == 1 { light } else { camera });
     }
     1.0 / (1.0 + sum_ri)
+}
+
+/// Exchanges a subpath's first vertex with the sampled endpoint at its end.
+fn swap_sampled_endpoint(path: &mut [Vertex]) {
+    let (first, rest) = path.split_at_mut(1);
+    let last = rest.last_mut().expect("a sampled endpoint past the first");
+    first[0].swap_endpoint(last);
 }

@@ -16,9 +16,12 @@ use crate::media::HenyeyGreenstein;
 use crate::samplers::Sampler;
 use glam::Vec3;
 
-/// Appends [`Vertex::at`]`(kind, p, n, beta, time, medium)` to `path`,
-/// built in the vector's next slot: a vertex holds its BSDF's storage,
-/// which a vertex built on the stack and pushed would copy whole.
+/// Appends a vertex of `kind` at `p` (geometric and shading normal `n`)
+/// with throughput `beta`, time and medium, nothing else set, to `path`,
+/// written field by field into the vector's next slot: a vertex holds its
+/// BSDF's storage, which a vertex built on the stack and pushed would copy
+/// whole, and a copy of one assembled from narrow stores stalls on store
+/// forwarding.
 pub(crate) fn push_at<'a>(
     path: &mut Vec<Vertex<'a>>,
     kind: Kind,
@@ -27,11 +30,52 @@ pub(crate) fn push_at<'a>(
     beta: Vec3,
     (time, medium): (f32, Option<u32>),
 ) {
+    use std::ptr::addr_of_mut;
     path.reserve(1);
     let len = path.len();
-    path.spare_capacity_mut()[0].write(Vertex::at(kind, p, n, beta, time, medium));
-    // SAFETY: `reserve` made slot `len` exist and it was just written.
-    unsafe { path.set_len(len + 1) };
+    let v = path.spare_capacity_mut()[0].as_mut_ptr();
+    // Every field, named, so that a new one must be written here too.
+    let _fields = |v: &Vertex| {
+        let Vertex {
+            kind: _,
+            beta: _,
+            p: _,
+            p_error: _,
+            n: _,
+            ns: _,
+            wo: _,
+            time: _,
+            medium: _,
+            media: _,
+            light: _,
+            bsdf: _,
+            phase: _,
+            delta: _,
+            pdf_fwd: _,
+            pdf_rev: _,
+        } = v;
+    };
+    // SAFETY: `reserve` made slot `len` exist; every field of the vertex
+    // is written below before the length covers it.
+    unsafe {
+        addr_of_mut!((*v).kind).write(kind);
+        addr_of_mut!((*v).beta).write(beta);
+        addr_of_mut!((*v).p).write(p);
+        addr_of_mut!((*v).p_error).write(Vec3::ZERO);
+        addr_of_mut!((*v).n).write(n);
+        addr_of_mut!((*v).ns).write(n);
+        addr_of_mut!((*v).wo).write(Vec3::ZERO);
+        addr_of_mut!((*v).time).write(time);
+        addr_of_mut!((*v).medium).write(medium);
+        addr_of_mut!((*v).media).write(None);
+        addr_of_mut!((*v).light).write(None);
+        Bsdf::write_empty(addr_of_mut!((*v).bsdf));
+        addr_of_mut!((*v).phase).write(HenyeyGreenstein { g: 0.0 });
+        addr_of_mut!((*v).delta).write(false);
+        addr_of_mut!((*v).pdf_fwd).write(0.0);
+        addr_of_mut!((*v).pdf_rev).write(0.0);
+        path.set_len(len + 1);
+    }
 }
 
 /// What a vertex is (pbrt-v3's `VertexType`).
@@ -83,28 +127,6 @@ pub(crate) struct Vertex<'a> {
 }
 
 impl<'a> Vertex<'a> {
-    /// A vertex of `kind` at `p` with throughput `beta`, nothing else set.
-    pub fn at(kind: Kind, p: Vec3, n: Vec3, beta: Vec3, time: f32, medium: Option<u32>) -> Self {
-        Vertex {
-            kind,
-            beta,
-            p,
-            p_error: Vec3::ZERO,
-            n,
-            ns: n,
-            wo: Vec3::ZERO,
-            time,
-            medium,
-            media: None,
-            light: None,
-            bsdf: Bsdf::empty(),
-            phase: HenyeyGreenstein { g: 0.0 },
-            delta: false,
-            pdf_fwd: 0.0,
-            pdf_rev: 0.0,
-        }
-    }
-
     /// Exchanges everything but the BSDF and phase function with `other`:
     /// how a strategy's sampled camera or light vertex takes the place of
     /// the subpath's endpoint (neither scatters, so they have neither)
@@ -444,7 +466,7 @@ pub(crate) fn random_walk<'a>(
         if let Some(m) = medium {
             let med = &scene.media[m as usize];
             let segment = Ray {
-                t_max: hit.map_or(f32::INFINITY, |h| h.t),
+                t_max: hit.as_ref().map_or(f32::INFINITY, |h| h.t),
                 ..ray
             };
             let (wt, t) = med.sample(&segment, sampler);
@@ -474,7 +496,7 @@ pub(crate) fn random_walk<'a>(
             ray = Ray::new(p, wi);
             diff = None;
         } else {
-            let Some(h) = hit else {
+            let Some(h) = hit.as_ref() else {
                 if mode == Mode::Radiance {
                     push_at(path, Kind::Light, ray.o + ray.d, -ray.d, beta, (time, medium));
                     path[prev + 1].pdf_fwd = pdf_fwd;
@@ -482,7 +504,7 @@ pub(crate) fn random_walk<'a>(
                 }
                 break;
             };
-            let mut s = scene.aggregate.surface_at(&h, time);
+            let mut s = scene.aggregate.surface_at(h, time);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 crossed += 1;
@@ -498,7 +520,7 @@ pub(crate) fn random_walk<'a>(
             let v = &mut new[0];
             shade(
                 scene,
-                &h,
+                h,
                 &mut s,
                 material,
                 true,
