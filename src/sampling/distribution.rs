@@ -5,6 +5,10 @@
 
 use super::rng::ONE_MINUS_EPSILON;
 use glam::Vec2;
+use rayon::prelude::*;
+
+/// Bins from which a 2D distribution builds its rows in parallel.
+const PARALLEL_2D: usize = 1 << 16;
 
 /// Piecewise-constant distribution over `[0, 1)` with `count()` equal bins.
 #[derive(Clone, Debug)]
@@ -202,8 +206,13 @@ impl Distribution2D {
     pub fn new(f: &[f32], nu: usize, nv: usize) -> Self {
         assert!(nu > 0 && nv > 0, "Distribution2D needs at least one bin");
         assert_eq!(f.len(), nu * nv, "Distribution2D: f.len() != nu * nv");
-        let conditional: Vec<Distribution1D> =
-            f.chunks_exact(nu).map(Distribution1D::new).collect();
+        // Big ones (an environment map's) row by row on all threads; the
+        // rows are independent, so the result is the same.
+        let conditional: Vec<Distribution1D> = if f.len() >= PARALLEL_2D {
+            f.par_chunks_exact(nu).map(Distribution1D::new).collect()
+        } else {
+            f.chunks_exact(nu).map(Distribution1D::new).collect()
+        };
         let marginal_func: Vec<f32> = conditional.iter().map(|d| d.func_int()).collect();
         let marginal = Distribution1D::new(&marginal_func);
         Self {
