@@ -72,17 +72,18 @@ impl<'a> Bsdf<'a> {
     /// A BSDF with no lobes and a z-up frame, to be [`Bsdf::reset`].
     #[inline]
     pub fn empty() -> Bsdf<'a> {
-        let frame = Frame {
-            s: Vec3::X,
-            t: Vec3::Y,
-            n: Vec3::Z,
-        };
-        Bsdf::new(frame, Vec3::Z, 1.0)
+        let mut b = std::mem::MaybeUninit::uninit();
+        // SAFETY: `write_empty` writes every field.
+        unsafe {
+            Self::write_empty(b.as_mut_ptr());
+            b.assume_init()
+        }
     }
 
-    /// Writes [`Bsdf::empty`] into `dst` one field at a time, so that no
-    /// BSDF is assembled on the stack and copied (a copy whose wide loads
-    /// span the narrow stores that built it stalls on store forwarding).
+    /// Writes [`Bsdf::empty`] into `dst` one field at a time, so that a
+    /// vertex that holds one need not assemble it on the stack and copy it
+    /// (a copy whose wide loads span the narrow stores that built it
+    /// stalls on store forwarding).
     ///
     /// # Safety
     /// `dst` must be valid for writes and aligned; what it held is
