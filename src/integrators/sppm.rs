@@ -428,10 +428,6 @@ impl Sppm {
                 px.ld += beta * escaped(scene, ray.d);
                 return;
             };
-            // Made before the surface is (made late, its copy into the
-            // light sample's arguments read it back before its stores
-            // had left the store buffer: a store-forwarding stall).
-            let wo = -ray.d;
             let mut s = scene.aggregate.surface_at(&hit, time);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
@@ -444,6 +440,7 @@ impl Sppm {
             }
             shade(scene, &hit, &mut s, material, true, None, &mut vp.bsdf);
             let bsdf = &vp.bsdf;
+            let wo = -ray.d;
             if depth == 0 || specular_bounce {
                 px.ld += beta * emitted(scene, &s, wo);
             }

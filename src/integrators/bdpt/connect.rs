@@ -62,22 +62,6 @@ pub(crate) fn connect<'a>(
 ) -> Strategy {
     let (n_light, n_camera) = (light.len(), camera.len());
     debug_assert!(s <= n_light && t <= n_camera);
-    let st = strategy(c, light, camera, s, t, sampler, scratch);
-    light.truncate(n_light);
-    camera.truncate(n_camera);
-    st
-}
-
-/// [`connect`], with a sampled endpoint left at the end of its subpath.
-fn strategy<'a>(
-    c: &Ctx<'a>,
-    light: &mut Vec<Vertex<'a>>,
-    camera: &mut Vec<Vertex<'a>>,
-    s: usize,
-    t: usize,
-    sampler: &mut Sampler,
-    scratch: &mut Scratch,
-) -> Strategy {
     let none = Strategy {
         l: Vec3::ZERO,
         weight: 0.0,
@@ -175,6 +159,10 @@ fn strategy<'a>(
     } else {
         mis_weight(c, light, camera, sampled, dens, s, t)
     };
+    // A sampled endpoint goes again (the one early return comes before
+    // anything is pushed).
+    light.truncate(n_light);
+    camera.truncate(n_camera);
     Strategy {
         l: l * weight,
         weight,
