@@ -383,17 +383,21 @@ impl Level {
         if count > BINNED_MIN {
             return Level::build_binned(meshes, quadrics, extra, moving);
         }
-        let ploc = Level::build_ploc(meshes, quadrics, extra, moving);
-        // Levels of many coincident boxes keep the bounded builder's tree
-        // (see `split`), whose work `build` counts.
-        if count <= COMPARE_MIN || ploc.build.bounded {
-            return ploc;
-        }
         // Neither builder makes the better tree everywhere (the f16 of
         // pbrt-v3's caustic-glass scenes traces faster with the binned one,
-        // the Stanford dragon with PLOC's): both are built and the one the
+        // the Stanford dragon with PLOC's): both are built, side by side
+        // (PLOC's reinsertion pass is mostly on one thread), and the one the
         // surface area heuristic rates cheaper is kept.
-        let binned = Level::build_binned(meshes, quadrics, extra, moving);
+        let (ploc, binned) = rayon::join(
+            || Level::build_ploc(meshes, quadrics, extra, moving),
+            || (count > COMPARE_MIN).then(|| Level::build_binned(meshes, quadrics, extra, moving)),
+        );
+        // Levels of many coincident boxes keep the bounded builder's tree
+        // (see `split`), whose work `build` counts.
+        let binned = match binned {
+            Some(b) if !ploc.build.bounded => b,
+            _ => return ploc,
+        };
         let cost = |l: &Level| l.bvh.as_ref().map_or(f64::INFINITY, |b| b.sah_cost());
         if cost(&binned) < cost(&ploc) {
             binned
