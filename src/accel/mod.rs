@@ -508,10 +508,13 @@ const PLOC_BYTES_PER_PRIMITIVE: u64 = 320;
 pub const MAX_LEVEL_PRIMITIVES: u64 = (1 << 29) - 1;
 
 /// The bytes a level's BVH over `primitives` will need at most (see
-/// [`BVH_BYTES_PER_TRIANGLE`]), for the loader's memory check.
+/// [`BVH_BYTES_PER_TRIANGLE`]), for the loader's memory check: levels that
+/// build both trees side by side hold both builds at once.
 pub fn bvh_memory_estimate(primitives: u64) -> u64 {
     if primitives > BINNED_MIN as u64 {
         primitives.saturating_mul(BVH_BYTES_PER_TRIANGLE)
+    } else if primitives > COMPARE_MIN as u64 {
+        primitives * (PLOC_BYTES_PER_PRIMITIVE + BVH_BYTES_PER_TRIANGLE)
     } else {
         primitives * PLOC_BYTES_PER_PRIMITIVE
     }
