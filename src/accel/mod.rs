@@ -383,6 +383,9 @@ impl Level {
         if count > BINNED_MIN {
             return Level::build_binned(meshes, quadrics, extra, moving);
         }
+        if count <= COMPARE_MIN {
+            return Level::build_ploc(meshes, quadrics, extra, moving);
+        }
         // Neither builder makes the better tree everywhere (the f16 of
         // pbrt-v3's caustic-glass scenes traces faster with the binned one,
         // the Stanford dragon with PLOC's): both are built, side by side
@@ -390,14 +393,13 @@ impl Level {
         // surface area heuristic rates cheaper is kept.
         let (ploc, binned) = rayon::join(
             || Level::build_ploc(meshes, quadrics, extra, moving),
-            || (count > COMPARE_MIN).then(|| Level::build_binned(meshes, quadrics, extra, moving)),
+            || Level::build_binned(meshes, quadrics, extra, moving),
         );
         // Levels of many coincident boxes keep the bounded builder's tree
         // (see `split`), whose work `build` counts.
-        let binned = match binned {
-            Some(b) if !ploc.build.bounded => b,
-            _ => return ploc,
-        };
+        if ploc.build.bounded {
+            return ploc;
+        }
         let cost = |l: &Level| l.bvh.as_ref().map_or(f64::INFINITY, |b| b.sah_cost());
         if cost(&binned) < cost(&ploc) {
             binned

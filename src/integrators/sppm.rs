@@ -795,6 +795,7 @@ impl Grid {
             runs.push((first..last, run));
             rest = tail;
         }
+        // One task per run (as the camera pass's rows).
         runs.into_par_iter().with_max_len(1).for_each(|(range, run)| {
             let mut k = 0;
             for pt in &self.points[range] {
