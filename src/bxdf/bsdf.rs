@@ -203,43 +203,17 @@ impl<'a> Bsdf<'a> {
     /// `(f, pdf)` for a pair of world directions in one pass.
     #[inline]
     pub fn f_pdf(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> (Vec3, f32) {
-        let wo = self.frame.to_local(wo_w);
-        if wo.z == 0.0 {
-            return (Vec3::ZERO, 0.0);
+        f_pdf_of(&self.frame, self.ng, &self.lobes, wo_w, wi_w, flags)
+    }
+
+    /// The BSDF without its lobes (kept apart by [`BsdfHead::f_pdf`]'s
+    /// callers).
+    #[inline]
+    pub fn head(&self) -> BsdfHead {
+        BsdfHead {
+            frame: self.frame,
+            ng: self.ng,
         }
-        let wi = self.frame.to_local(wi_w);
-        let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
-        if let [l] = self.lobes.as_slice() {
-            // One lobe (the common case): no sums, the same values.
-            if !l.flags.matches(flags) {
-                return (Vec3::ZERO, 0.0);
-            }
-            let (lobe_f, lobe_pdf) = lambertian_inline_f_pdf(&l.bxdf, wo, wi);
-            let side =
-                (reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission());
-            return (if side { lobe_f * l.scale } else { Vec3::ZERO }, lobe_pdf);
-        }
-        let mut f = Vec3::ZERO;
-        let mut pdf = 0.0;
-        let mut matching = 0u32;
-        for l in &self.lobes {
-            let lf = l.flags;
-            if !lf.matches(flags) {
-                continue;
-            }
-            matching += 1;
-            let (lobe_f, lobe_pdf) = l.bxdf.f_pdf(wo, wi);
-            pdf += lobe_pdf;
-            if (reflect && lf.is_reflection()) || (!reflect && lf.is_transmission()) {
-                f += lobe_f * l.scale;
-            }
-        }
-        let pdf = if matching > 1 {
-            pdf / matching as f32
-        } else {
-            pdf
-        };
-        (f, pdf)
     }
 
     /// pbrt-v3's `BSDF::Pdf(wo, wi, flags)`.
@@ -385,6 +359,72 @@ impl<'a> Bsdf<'a> {
             flags: s.flags,
         })
     }
+}
+
+/// A BSDF whose lobes are stored elsewhere (sppm keeps its visible points'
+/// lobes packed in one array per row of pixels, not in a slot for the most
+/// lobes a BSDF can have).
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfHead {
+    pub frame: Frame,
+    pub ng: Vec3,
+}
+
+impl BsdfHead {
+    /// [`Bsdf::f_pdf`] of the BSDF with this head and `lobes`: the same
+    /// values.
+    #[inline]
+    pub fn f_pdf(&self, lobes: &[Lobe], wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> (Vec3, f32) {
+        f_pdf_of(&self.frame, self.ng, lobes, wo_w, wi_w, flags)
+    }
+}
+
+/// `(f, pdf)` of the BSDF with this frame, geometric normal and lobes.
+#[inline(always)]
+fn f_pdf_of(
+    frame: &Frame,
+    ng: Vec3,
+    lobes: &[Lobe],
+    wo_w: Vec3,
+    wi_w: Vec3,
+    flags: BxdfFlags,
+) -> (Vec3, f32) {
+    let wo = frame.to_local(wo_w);
+    if wo.z == 0.0 {
+        return (Vec3::ZERO, 0.0);
+    }
+    let wi = frame.to_local(wi_w);
+    let reflect = wi_w.dot(ng) * wo_w.dot(ng) > 0.0;
+    if let [l] = lobes {
+        // One lobe (the common case): no sums, the same values.
+        if !l.flags.matches(flags) {
+            return (Vec3::ZERO, 0.0);
+        }
+        let (lobe_f, lobe_pdf) = lambertian_inline_f_pdf(&l.bxdf, wo, wi);
+        let side = (reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission());
+        return (if side { lobe_f * l.scale } else { Vec3::ZERO }, lobe_pdf);
+    }
+    let mut f = Vec3::ZERO;
+    let mut pdf = 0.0;
+    let mut matching = 0u32;
+    for l in lobes {
+        let lf = l.flags;
+        if !lf.matches(flags) {
+            continue;
+        }
+        matching += 1;
+        let (lobe_f, lobe_pdf) = l.bxdf.f_pdf(wo, wi);
+        pdf += lobe_pdf;
+        if (reflect && lf.is_reflection()) || (!reflect && lf.is_transmission()) {
+            f += lobe_f * l.scale;
+        }
+    }
+    let pdf = if matching > 1 {
+        pdf / matching as f32
+    } else {
+        pdf
+    };
+    (f, pdf)
 }
 
 /// `b.f_pdf` with Lambertian reflection, the most common lobe, inline; every

@@ -22,7 +22,7 @@ mod oren_nayar;
 mod specular;
 mod sw_adapter;
 
-pub use bsdf::{Bsdf, BsdfSample, MAX_BXDFS};
+pub use bsdf::{Bsdf, BsdfHead, BsdfSample, Lobe, MAX_BXDFS};
 pub use disney::{
     fr_schlick, gtr1, schlick_r0_from_eta, schlick_weight, DisneyClearcoat, DisneyDiffuse,
     DisneyFakeSS, DisneyFresnel, DisneyMicrofacet, DisneyRetro, DisneySheen,

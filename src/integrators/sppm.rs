@@ -40,6 +40,7 @@ use super::{
 use crate::geometry::{luminance, spawn_ray, Bounds2i, Bounds3, Ray, RayDiff};
 use crate::integrators::RenderScene;
 use crate::lights::LightSampler;
+use crate::bxdf::{BsdfHead, Lobe, MAX_BXDFS};
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::lowdiscrepancy::{RadicalTable, PRIMES};
 use crate::samplers::{CameraSample, Sampler};
@@ -250,12 +251,27 @@ impl Integrate for Sppm {
 }
 
 /// A pixel's visible point: where its camera path met a diffuse surface;
-/// none while `beta` is zero. Its BSDF is shaded in place.
-struct VisiblePoint<'a> {
+/// none while `beta` is zero. Its BSDF's lobes are `lobes[row][first..][..n]`
+/// (each row of pixels packs its visible points' lobes in one array, as
+/// pbrt-v3's arenas do: a BSDF with room for the most lobes would make the
+/// visible points 800 bytes each, and the camera pass's writes to them
+/// would sweep the caches).
+struct VisiblePoint {
     p: Vec3,
     wo: Vec3,
-    bsdf: Bsdf<'a>,
     beta: Vec3,
+    bsdf: BsdfHead,
+    row: u32,
+    first: u32,
+    n: u32,
+}
+
+impl VisiblePoint {
+    #[inline]
+    fn f<'l>(&self, lobes: &'l [Vec<Lobe<'l>>], wi: Vec3) -> Vec3 {
+        let lobes = &lobes[self.row as usize][self.first as usize..][..self.n as usize];
+        self.bsdf.f_pdf(lobes, self.wo, wi, BxdfFlags::ALL).0
+    }
 }
 
 /// What SPPM keeps per pixel across iterations (pbrt-v3's `SPPMPixel`
@@ -274,7 +290,8 @@ struct Pixel {
 /// and the photon grid's copy of the point), for the driver's memory check
 /// before anything is allocated.
 pub const PIXEL_BYTES: u64 = (std::mem::size_of::<Pixel>()
-    + std::mem::size_of::<VisiblePoint<'static>>()
+    + std::mem::size_of::<VisiblePoint>()
+    + MAX_BXDFS * std::mem::size_of::<Lobe<'static>>()
     + std::mem::size_of::<Option<(Vec3, f32)>>()) as u64;
 
 /// What [`Sppm::render`] needs of the render: the scene, the film's
@@ -322,10 +339,16 @@ impl Sppm {
             .map(|_| VisiblePoint {
                 p: Vec3::ZERO,
                 wo: Vec3::ZERO,
-                bsdf: Bsdf::empty(),
                 beta: Vec3::ZERO,
+                bsdf: Bsdf::empty().head(),
+                row: 0,
+                first: 0,
+                n: 0,
             })
             .collect();
+        // Each row's lobes, refilled by every camera pass (their capacity
+        // kept: no allocation after the first iterations).
+        let mut lobes: Vec<Vec<Lobe>> = (0..pb.height().max(0)).map(|_| Vec::new()).collect();
         let desc = SamplerDesc {
             kind: SamplerKind::Halton,
             pixel_samples: s.iterations,
@@ -340,9 +363,9 @@ impl Sppm {
         // again as the pixels are updated.
         let mut acc = vec![(DVec3::ZERO, 0u32); n_pixels];
         for iter in 0..s.iterations {
-            counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
+            counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, &mut lobes, iter));
             run.pool.install(|| grid.rebuild(&pixels, &vps));
-            let c = self.photon_pass(run, &grid, &vps, &bases, iter, photons, &mut acc);
+            let c = self.photon_pass(run, &grid, &vps, &lobes, &bases, iter, photons, &mut acc);
             counts.add(&c);
             let k = iter + 1;
             let write = k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
@@ -372,7 +395,8 @@ impl Sppm {
         run: &SppmRun<'a>,
         sampler: &Sampler,
         pixels: &mut [Pixel],
-        vps: &mut [VisiblePoint<'a>],
+        vps: &mut [VisiblePoint],
+        lobes: &mut [Vec<Lobe<'a>>],
         iter: u32,
     ) -> RayCounts {
         let pb = run.pixel_bounds;
@@ -382,20 +406,30 @@ impl Sppm {
             pixels
             .par_chunks_mut(w)
             .zip(vps.par_chunks_mut(w))
+            .zip(lobes.par_iter_mut())
             .enumerate()
             // One task per row: rayon splits a range further only when it
             // is stolen, so without this a thread that finishes early sits
             // idle while the other works through a long run of costly rows
             // (a fifth of this pass's wall time on pbrt-v3's f16-9a).
             .with_max_len(1)
-            .map(|(row, (px, vp))| {
+            .map(|(row, ((px, vp), lobes))| {
                 let mut sampler = sampler.clone();
                 let mut scratch = Scratch::default();
+                let mut bsdf = Bsdf::empty();
+                lobes.clear();
                 let y = pb.min.y + row as i32;
                 for (i, (p, vp)) in px.iter_mut().zip(vp).enumerate() {
                     let pixel = IVec2::new(pb.min.x + i as i32, y);
                     sampler.start_pixel_sample(pixel, iter);
-                    self.visible_point(scene, &mut sampler, &mut scratch, pixel, (p, vp));
+                    let out = (p, &mut *vp, &mut bsdf);
+                    if self.visible_point(scene, &mut sampler, &mut scratch, pixel, out) {
+                        vp.row = row as u32;
+                        vp.first = lobes.len() as u32;
+                        vp.n = bsdf.lobes().len() as u32;
+                        vp.bsdf = bsdf.head();
+                        lobes.extend_from_slice(bsdf.lobes());
+                    }
                 }
                 scratch.counts()
             })
@@ -407,20 +441,21 @@ impl Sppm {
     }
 
     /// One pixel's camera path (pbrt-v3's loop "Follow camera ray path
-    /// until a visible point is created").
+    /// until a visible point is created"). Returns true if it made one:
+    /// then `vp` holds all of it but its BSDF, which is `bsdf`.
     fn visible_point<'a>(
         &self,
         scene: &'a RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
         pixel: IVec2,
-        (px, vp): (&mut Pixel, &mut VisiblePoint<'a>),
-    ) {
+        (px, vp, bsdf): (&mut Pixel, &mut VisiblePoint, &mut Bsdf<'a>),
+    ) -> bool {
         let lens = scene.camera.uses_lens() || scene.camera.is_moving();
         let cs: CameraSample = sampler.camera_sample(pixel, lens);
         let (mut ray, weight) = scene.camera.generate_ray(&cs);
         if weight <= 0.0 || weight.is_nan() {
-            return;
+            return false;
         }
         let time = scene.camera.time(&cs);
         let max_depth = self.settings.max_depth;
@@ -431,20 +466,20 @@ impl Sppm {
             scratch.counts.closest += 1;
             let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
                 px.ld += beta * escaped(scene, ray.d);
-                return;
+                return false;
             };
             let mut s = scene.aggregate.surface_at(&hit, time);
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
                 crossed += 1;
                 if crossed > MAX_PASS_THROUGH {
-                    return;
+                    return false;
                 }
                 ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
                 continue;
             }
-            shade(scene, &hit, &mut s, material, true, None, &mut vp.bsdf);
-            let bsdf = &vp.bsdf;
+            shade(scene, &hit, &mut s, material, true, None, bsdf);
+            let bsdf = &*bsdf;
             let wo = -ray.d;
             if depth == 0 || specular_bounce {
                 px.ld += beta * emitted(scene, &s, wo);
@@ -460,14 +495,14 @@ impl Sppm {
                 vp.p = s.point.p;
                 vp.wo = wo;
                 vp.beta = beta;
-                return;
+                return true;
             }
             if depth + 1 < max_depth {
                 let Some(bs) = bsdf.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
-                    return;
+                    return false;
                 };
                 if bs.pdf == 0.0 || bs.f == Vec3::ZERO {
-                    return;
+                    return false;
                 }
                 specular_bounce = bs.is_specular();
                 beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
@@ -475,7 +510,7 @@ impl Sppm {
                 if y < 0.25 {
                     let continue_prob = y.min(1.0);
                     if sampler.get_1d() > continue_prob {
-                        return;
+                        return false;
                     }
                     beta /= continue_prob;
                 }
@@ -483,6 +518,7 @@ impl Sppm {
             }
             depth += 1;
         }
+        false
     }
 
     /// Step (3): photons in fixed chunks traced in parallel, each chunk's
@@ -495,6 +531,7 @@ impl Sppm {
         run: &SppmRun,
         grid: &Grid,
         vps: &[VisiblePoint],
+        lobes: &[Vec<Lobe>],
         bases: &[RadicalTable],
         iter: u32,
         photons: u32,
@@ -525,7 +562,7 @@ impl Sppm {
                     let mut counts = RayCounts::default();
                     for i in start..end {
                         let index = iter as u64 * photons as u64 + i as u64;
-                        self.trace_photon(run.scene, grid, vps, bases, index, &mut recs, &mut counts);
+                        self.trace_photon(run.scene, grid, (vps, lobes), bases, index, &mut recs, &mut counts);
                     }
                     (recs, counts)
                 })
@@ -594,7 +631,7 @@ impl Sppm {
         &self,
         scene: &RenderScene,
         grid: &Grid,
-        vps: &[VisiblePoint],
+        vps: (&[VisiblePoint], &[Vec<Lobe>]),
         bases: &[RadicalTable],
         index: u64,
         recs: &mut Vec<(u32, Vec3)>,
@@ -887,7 +924,7 @@ impl Grid {
         p: Vec3,
         wi: Vec3,
         beta: Vec3,
-        vps: &[VisiblePoint],
+        (vps, lobes): (&[VisiblePoint], &[Vec<Lobe>]),
         recs: &mut Vec<(u32, Vec3)>,
     ) {
         let (c, inside) = self.cell(p);
@@ -905,8 +942,7 @@ impl Grid {
             if q.distance_squared(p) > radius * radius {
                 continue;
             }
-            let vp = &vps[i as usize];
-            let phi = beta * vp.bsdf.f(vp.wo, wi, BxdfFlags::ALL);
+            let phi = beta * vps[i as usize].f(lobes, wi);
             recs.push((i, phi));
         }
     }
