@@ -206,8 +206,8 @@ impl<'a> Bsdf<'a> {
         f_pdf_of(&self.frame, self.ng, &self.lobes, wo_w, wi_w, flags)
     }
 
-    /// The BSDF without its lobes (kept apart by [`BsdfHead::f_pdf`]'s
-    /// callers).
+    /// The BSDF's frame and geometric normal, for callers that keep its
+    /// lobes elsewhere (see [`BsdfHead`]).
     #[inline]
     pub fn head(&self) -> BsdfHead {
         BsdfHead {

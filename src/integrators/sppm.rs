@@ -39,9 +39,8 @@ use super::{
 };
 use crate::geometry::{luminance, spawn_ray, Bounds2i, Bounds3, Ray, RayDiff};
 use crate::integrators::RenderScene;
+use crate::bxdf::{Bsdf, BsdfHead, BxdfFlags, Lobe, MAX_BXDFS};
 use crate::lights::LightSampler;
-use crate::bxdf::{BsdfHead, Lobe, MAX_BXDFS};
-use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::lowdiscrepancy::{RadicalTable, PRIMES};
 use crate::samplers::{CameraSample, Sampler};
 use crate::scene::kind::{Report, Support};
@@ -251,11 +250,8 @@ impl Integrate for Sppm {
 }
 
 /// A pixel's visible point: where its camera path met a diffuse surface;
-/// none while `beta` is zero. Its BSDF's lobes are `lobes[row][first..][..n]`
-/// (each row of pixels packs its visible points' lobes in one array, as
-/// pbrt-v3's arenas do: a BSDF with room for the most lobes would make the
-/// visible points 800 bytes each, and the camera pass's writes to them
-/// would sweep the caches).
+/// none while `beta` is zero. Its BSDF's lobes are those of
+/// [`VisiblePoints::lobes`]`[row][first..][..n]`.
 struct VisiblePoint {
     p: Vec3,
     wo: Vec3,
@@ -266,11 +262,24 @@ struct VisiblePoint {
     n: u32,
 }
 
-impl VisiblePoint {
+/// Every pixel's visible point, with the lobes of their BSDFs packed in one
+/// array per row of pixels (as pbrt-v3's arenas do: a BSDF with room for the
+/// most lobes would make a visible point 800 bytes, and the camera pass's
+/// writes to them would sweep the caches).
+struct VisiblePoints<'a> {
+    points: Vec<VisiblePoint>,
+    /// Refilled by every camera pass, their capacity kept (no allocation
+    /// after the first iterations).
+    lobes: Vec<Vec<Lobe<'a>>>,
+}
+
+impl VisiblePoints<'_> {
+    /// The BSDF of pixel `i`'s visible point towards `wi`.
     #[inline]
-    fn f<'l>(&self, lobes: &'l [Vec<Lobe<'l>>], wi: Vec3) -> Vec3 {
-        let lobes = &lobes[self.row as usize][self.first as usize..][..self.n as usize];
-        self.bsdf.f_pdf(lobes, self.wo, wi, BxdfFlags::ALL).0
+    fn f(&self, i: usize, wi: Vec3) -> Vec3 {
+        let vp = &self.points[i];
+        let lobes = &self.lobes[vp.row as usize][vp.first as usize..][..vp.n as usize];
+        vp.bsdf.f_pdf(lobes, vp.wo, wi, BxdfFlags::ALL).0
     }
 }
 
@@ -335,7 +344,7 @@ impl Sppm {
                 tau: Vec3::ZERO,
             })
             .collect();
-        let mut vps: Vec<VisiblePoint> = (0..n_pixels)
+        let points = (0..n_pixels)
             .map(|_| VisiblePoint {
                 p: Vec3::ZERO,
                 wo: Vec3::ZERO,
@@ -346,9 +355,10 @@ impl Sppm {
                 n: 0,
             })
             .collect();
-        // Each row's lobes, refilled by every camera pass (their capacity
-        // kept: no allocation after the first iterations).
-        let mut lobes: Vec<Vec<Lobe>> = (0..pb.height().max(0)).map(|_| Vec::new()).collect();
+        let mut vps = VisiblePoints {
+            points,
+            lobes: (0..pb.height().max(0)).map(|_| Vec::new()).collect(),
+        };
         let desc = SamplerDesc {
             kind: SamplerKind::Halton,
             pixel_samples: s.iterations,
@@ -363,16 +373,16 @@ impl Sppm {
         // again as the pixels are updated.
         let mut acc = vec![(DVec3::ZERO, 0u32); n_pixels];
         for iter in 0..s.iterations {
-            counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, &mut lobes, iter));
-            run.pool.install(|| grid.rebuild(&pixels, &vps));
-            let c = self.photon_pass(run, &grid, &vps, &lobes, &bases, iter, photons, &mut acc);
+            counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
+            run.pool.install(|| grid.rebuild(&pixels, &vps.points));
+            let c = self.photon_pass(run, &grid, &vps, &bases, iter, photons, &mut acc);
             counts.add(&c);
             let k = iter + 1;
             let write = k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
             let np = k as u64 * photons as u64;
             // Each pixel on its own: in parallel, the same values.
             run.pool.install(|| {
-                (pixels.par_iter_mut(), vps.par_iter_mut(), acc.par_iter_mut(), image.par_iter_mut())
+                (pixels.par_iter_mut(), vps.points.par_iter_mut(), acc.par_iter_mut(), image.par_iter_mut())
                     .into_par_iter()
                     .for_each(|(p, vp, a, l)| {
                         let (phi, m) = std::mem::take(a);
@@ -395,8 +405,7 @@ impl Sppm {
         run: &SppmRun<'a>,
         sampler: &Sampler,
         pixels: &mut [Pixel],
-        vps: &mut [VisiblePoint],
-        lobes: &mut [Vec<Lobe<'a>>],
+        vps: &mut VisiblePoints<'a>,
         iter: u32,
     ) -> RayCounts {
         let pb = run.pixel_bounds;
@@ -405,8 +414,8 @@ impl Sppm {
         let rows: Vec<RayCounts> = run.pool.install(|| {
             pixels
             .par_chunks_mut(w)
-            .zip(vps.par_chunks_mut(w))
-            .zip(lobes.par_iter_mut())
+            .zip(vps.points.par_chunks_mut(w))
+            .zip(vps.lobes.par_iter_mut())
             .enumerate()
             // One task per row: rayon splits a range further only when it
             // is stolen, so without this a thread that finishes early sits
@@ -530,8 +539,7 @@ impl Sppm {
         &self,
         run: &SppmRun,
         grid: &Grid,
-        vps: &[VisiblePoint],
-        lobes: &[Vec<Lobe>],
+        vps: &VisiblePoints,
         bases: &[RadicalTable],
         iter: u32,
         photons: u32,
@@ -562,7 +570,7 @@ impl Sppm {
                     let mut counts = RayCounts::default();
                     for i in start..end {
                         let index = iter as u64 * photons as u64 + i as u64;
-                        self.trace_photon(run.scene, grid, (vps, lobes), bases, index, &mut recs, &mut counts);
+                        self.trace_photon(run.scene, grid, vps, bases, index, &mut recs, &mut counts);
                     }
                     (recs, counts)
                 })
@@ -631,7 +639,7 @@ impl Sppm {
         &self,
         scene: &RenderScene,
         grid: &Grid,
-        vps: (&[VisiblePoint], &[Vec<Lobe>]),
+        vps: &VisiblePoints,
         bases: &[RadicalTable],
         index: u64,
         recs: &mut Vec<(u32, Vec3)>,
@@ -924,7 +932,7 @@ impl Grid {
         p: Vec3,
         wi: Vec3,
         beta: Vec3,
-        (vps, lobes): (&[VisiblePoint], &[Vec<Lobe>]),
+        vps: &VisiblePoints,
         recs: &mut Vec<(u32, Vec3)>,
     ) {
         let (c, inside) = self.cell(p);
@@ -942,7 +950,7 @@ impl Grid {
             if q.distance_squared(p) > radius * radius {
                 continue;
             }
-            let phi = beta * vps[i as usize].f(lobes, wi);
+            let phi = beta * vps.f(i as usize, wi);
             recs.push((i, phi));
         }
     }
