@@ -614,7 +614,7 @@ struct Halton<'b> {
 }
 
 impl Halton<'_> {
-    #[inline]
+    #[inline(always)]
     fn next(&mut self) -> f32 {
         // Dimensions past the last base start again at the first.
         let b = &self.bases[self.dim];
@@ -650,16 +650,18 @@ impl Sppm {
             index,
             dim: 0,
         };
+        // The emission's dimensions drawn together, before anything
+        // branches on them: their digit chains are then in flight at once.
         let u = h.next();
+        let u_light0 = h.next_2d();
+        let u_light1 = h.next_2d();
+        let u_time = h.next();
         let Some((light, light_pmf)) =
             self.power
                 .sample(Vec3::ZERO, Vec3::ZERO, u, &scene.lights, &scene.aggregate)
         else {
             return;
         };
-        let u_light0 = h.next_2d();
-        let u_light1 = h.next_2d();
-        let u_time = h.next();
         let time = scene.camera.time(&CameraSample {
             time: u_time,
             ..CameraSample::default()
@@ -695,10 +697,14 @@ impl Sppm {
                 ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
                 continue;
             }
+            // This vertex's dimensions (the BSDF sample's and Russian
+            // roulette's), drawn before the shading that needs them.
+            let u_bsdf = h.next_2d();
+            let u_rr = h.next();
             let mut bsdf = Bsdf::empty();
             shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
             let wo = -ray.d;
-            let Some(bs) = bsdf.sample(wo, h.next_2d(), BxdfFlags::ALL) else {
+            let Some(bs) = bsdf.sample(wo, u_bsdf, BxdfFlags::ALL) else {
                 return;
             };
             if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
@@ -706,7 +712,7 @@ impl Sppm {
             }
             let bnew = beta * bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf * importance(&bsdf, &bs, wo);
             let q = (1.0 - luminance(bnew) / luminance(beta)).max(0.0);
-            if h.next() < q {
+            if u_rr < q {
                 return;
             }
             beta = bnew / (1.0 - q);
