@@ -685,11 +685,11 @@ impl Sppm {
                 return;
             };
             let mut s = scene.aggregate.surface_at(&hit, time);
-            if depth > 0 {
-                grid.gather(s.point.p, -ray.d, beta, vps, recs);
-            }
             let material = &scene.materials[s.material as usize];
             if material.is_none() {
+                if depth > 0 {
+                    grid.gather(s.point.p, -ray.d, beta, vps, recs);
+                }
                 crossed += 1;
                 if crossed > MAX_PASS_THROUGH {
                     return;
@@ -697,26 +697,43 @@ impl Sppm {
                 ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
                 continue;
             }
-            // This vertex's dimensions (the BSDF sample's and Russian
-            // roulette's), drawn before the shading that needs them.
-            let u_bsdf = h.next_2d();
-            let u_rr = h.next();
-            let mut bsdf = Bsdf::empty();
-            shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
-            let wo = -ray.d;
-            let Some(bs) = bsdf.sample(wo, u_bsdf, BxdfFlags::ALL) else {
+            // The photon's next ray first, the visible points it reaches
+            // here after it: the gather is off the path's critical chain.
+            let gather_at = (s.point.p, -ray.d, beta);
+            let next = 'step: {
+                // This vertex's dimensions (the BSDF sample's and Russian
+                // roulette's), drawn before the shading that needs them.
+                let u_bsdf = h.next_2d();
+                let u_rr = h.next();
+                let mut bsdf = Bsdf::empty();
+                shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
+                let wo = -ray.d;
+                let Some(bs) = bsdf.sample(wo, u_bsdf, BxdfFlags::ALL) else {
+                    break 'step None;
+                };
+                if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+                    break 'step None;
+                }
+                let bnew =
+                    beta * bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf * importance(&bsdf, &bs, wo);
+                let q = (1.0 - luminance(bnew) / luminance(beta)).max(0.0);
+                if u_rr < q {
+                    break 'step None;
+                }
+                Some((
+                    bnew / (1.0 - q),
+                    spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi),
+                ))
+            };
+            if depth > 0 {
+                let (p, wo, b) = gather_at;
+                grid.gather(p, wo, b, vps, recs);
+            }
+            let Some((b, r)) = next else {
                 return;
             };
-            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
-                return;
-            }
-            let bnew = beta * bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf * importance(&bsdf, &bs, wo);
-            let q = (1.0 - luminance(bnew) / luminance(beta)).max(0.0);
-            if u_rr < q {
-                return;
-            }
-            beta = bnew / (1.0 - q);
-            ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+            beta = b;
+            ray = r;
             depth += 1;
         }
     }
