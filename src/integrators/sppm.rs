@@ -698,8 +698,8 @@ impl Sppm {
                 continue;
             }
             // The photon's next ray first, the visible points it reaches
-            // here after it: the gather is off the path's critical chain.
-            let gather_at = (s.point.p, -ray.d, beta);
+            // here after it: the gather is off the path's critical chain
+            // (the step changes neither the ray, the power nor the point).
             let next = 'step: {
                 // This vertex's dimensions (the BSDF sample's and Russian
                 // roulette's), drawn before the shading that needs them.
@@ -726,8 +726,7 @@ impl Sppm {
                 ))
             };
             if depth > 0 {
-                let (p, wo, b) = gather_at;
-                grid.gather(p, wo, b, vps, recs);
+                grid.gather(s.point.p, -ray.d, beta, vps, recs);
             }
             let Some((b, r)) = next else {
                 return;
