@@ -568,9 +568,17 @@ impl Sppm {
                     let end = (start + PHOTON_CHUNK).min(photons);
                     let mut recs = Vec::new();
                     let mut counts = RayCounts::default();
+                    let first = iter as u64 * photons as u64 + start as u64;
+                    let mut runs = PhotonRuns::new(first, (end - start) as usize);
                     for i in start..end {
                         let index = iter as u64 * photons as u64 + i as u64;
-                        self.trace_photon(run.scene, grid, vps, bases, index, &mut recs, &mut counts);
+                        let mut h = Halton {
+                            bases,
+                            runs: &mut runs,
+                            index,
+                            dim: 0,
+                        };
+                        self.trace_photon(run.scene, grid, vps, &mut h, &mut recs, &mut counts);
                     }
                     (recs, counts)
                 })
@@ -606,23 +614,64 @@ fn update_pixel(p: &mut Pixel, vp: &mut VisiblePoint, phi: DVec3, m: u32) {
     vp.beta = Vec3::ZERO;
 }
 
+/// Dimensions of the photons' Halton sequence that a chunk fills in runs
+/// (those whose base has a digit table; the others are looked up one value
+/// at a time).
+const RUN_DIMS: usize = 32;
+
+/// A chunk's photons have consecutive indices: dimension `d` of all of
+/// them from the first photon that draws it to the chunk's end, filled at
+/// once ([`RadicalTable::fill`]).
+struct PhotonRuns {
+    first: u64,
+    len: usize,
+    /// Bit `d`: dimension `d` is filled from some photon on.
+    filled: u32,
+    values: Vec<f32>,
+}
+
+impl PhotonRuns {
+    fn new(first: u64, len: usize) -> PhotonRuns {
+        PhotonRuns {
+            first,
+            len,
+            filled: 0,
+            values: vec![0.0; RUN_DIMS * len],
+        }
+    }
+}
+
 /// The radical inverses of one photon's index, dimension by dimension.
-struct Halton<'b> {
+struct Halton<'b, 'r> {
     bases: &'b [RadicalTable],
+    runs: &'r mut PhotonRuns,
     index: u64,
     dim: usize,
 }
 
-impl Halton<'_> {
+impl Halton<'_, '_> {
     #[inline(always)]
     fn next(&mut self) -> f32 {
+        let d = self.dim;
         // Dimensions past the last base start again at the first.
-        let b = &self.bases[self.dim];
         self.dim += 1;
         if self.dim == self.bases.len() {
             self.dim = 0;
         }
-        b.radical_inverse(self.index)
+        let b = &self.bases[d];
+        if d < RUN_DIMS && b.fills() {
+            let runs = &mut *self.runs;
+            let i = (self.index - runs.first) as usize;
+            let row = &mut runs.values[d * runs.len..(d + 1) * runs.len];
+            if runs.filled & (1 << d) == 0 {
+                // This photon and the chunk's later ones.
+                b.fill(self.index, &mut row[i..]);
+                runs.filled |= 1 << d;
+            }
+            row[i]
+        } else {
+            b.radical_inverse(self.index)
+        }
     }
     #[inline]
     fn next_2d(&mut self) -> Vec2 {
@@ -640,16 +689,10 @@ impl Sppm {
         scene: &RenderScene,
         grid: &Grid,
         vps: &VisiblePoints,
-        bases: &[RadicalTable],
-        index: u64,
+        h: &mut Halton,
         recs: &mut Vec<(u32, Vec3)>,
         counts: &mut RayCounts,
     ) {
-        let mut h = Halton {
-            bases,
-            index,
-            dim: 0,
-        };
         // The emission's dimensions drawn together, before anything
         // branches on them: their digit chains are then in flight at once.
         let u = h.next();
@@ -1049,6 +1092,35 @@ mod tests {
                     r.uniform_u32() as i32 >> 7,
                 );
                 assert_eq!(b.of(c), hash(c, size), "size {size} cell {c}");
+            }
+        }
+    }
+
+    /// A chunk's photons, each drawing its own number of dimensions (some
+    /// past the filled ones, and wrapping past the last base), get every
+    /// value the table gives their index.
+    #[test]
+    fn photon_runs_are_the_tables_values() {
+        let bases: Vec<RadicalTable> = PRIMES.iter().map(|&p| RadicalTable::new(p)).collect();
+        let mut r = Pcg32::with_sequence(9);
+        for (first, len) in [(0u64, 256usize), (1_000_000, 256), (4095, 17), (1 << 40, 30)] {
+            let mut runs = PhotonRuns::new(first, len);
+            for index in first..first + len as u64 {
+                let dims = match r.uniform_u32() % 8 {
+                    0 => 0,
+                    1 => bases.len() + 5,
+                    k => (r.uniform_u32() % (6 + 12 * k)) as usize,
+                };
+                let mut h = Halton {
+                    bases: &bases,
+                    runs: &mut runs,
+                    index,
+                    dim: 0,
+                };
+                for d in 0..dims {
+                    let want = bases[d % bases.len()].radical_inverse(index);
+                    assert_eq!(h.next().to_bits(), want.to_bits(), "index {index} dim {d}");
+                }
             }
         }
     }

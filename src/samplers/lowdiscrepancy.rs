@@ -192,21 +192,21 @@ const RADICAL_CHUNK_MAX: u64 = 4096;
 /// 2^53, where that is exact); bases above 64 (one digit per chunk) use the
 /// plain loop.
 pub struct RadicalTable {
-    base: DigitBase,
+    pub(super) base: DigitBase,
     /// `base^k`, the chunk, and its magic number (as [`DigitBase`]'s).
-    chunk: u64,
+    pub(super) chunk: u64,
     chunk_magic: u64,
-    k: usize,
+    pub(super) k: usize,
     /// For `v < chunk`: its `k` digits reversed (`.0`), its significant
     /// digits reversed (`.1`), and how many those are (`.2`). Empty where
     /// the table is not used (base 2 below 2^53, whose bits are reversed,
     /// and bases above 64).
-    entries: Box<[(u16, u16, u16)]>,
+    pub(super) entries: Box<[(u16, u16, u16)]>,
     /// `base^n` for `n ≤ k`.
-    pow: [u64; 13],
+    pub(super) pow: [u64; 13],
     /// 1/base multiplied into 1.0 `n` times in f64, one step at a time (the
     /// rounding of `radical_inverse`'s loop).
-    inv_powers: [f64; 65],
+    pub(super) inv_powers: [f64; 65],
 }
 
 impl RadicalTable {
@@ -254,13 +254,21 @@ impl RadicalTable {
 
     /// `radical_inverse(&DigitBase::new(base), a)`, bit for bit.
     #[inline]
-    pub fn radical_inverse(&self, mut a: u64) -> f32 {
+    pub fn radical_inverse(&self, a: u64) -> f32 {
         if self.base.base == 2 && a < 1 << 53 {
             return radical_inverse_base2(a);
         }
         if self.entries.is_empty() {
             return radical_inverse(&self.base, a);
         }
+        let (reversed, n) = self.reversed_digits(a);
+        ((reversed as f64 * self.inv_powers[n]) as f32).min(ONE_MINUS_EPSILON)
+    }
+
+    /// The significant digits of `a` reversed (wrapping) and how many they
+    /// are, for a base with a table.
+    #[inline(always)]
+    pub(super) fn reversed_digits(&self, mut a: u64) -> (u64, usize) {
         let mut reversed: u64 = 0;
         let mut n = 0usize;
         while a >= self.chunk {
@@ -279,7 +287,7 @@ impl RadicalTable {
             .wrapping_mul(self.pow[e.2 as usize])
             .wrapping_add(e.1 as u64);
         n += e.2 as usize;
-        ((reversed as f64 * self.inv_powers[n]) as f32).min(ONE_MINUS_EPSILON)
+        (reversed, n)
     }
 }
 

@@ -16,6 +16,7 @@ pub mod lowdiscrepancy;
 pub mod maxmindist;
 pub mod mlt;
 pub mod pixel;
+pub mod radical_fast;
 pub mod random;
 pub mod sobol;
 pub mod sobolmatrices;
