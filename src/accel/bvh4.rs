@@ -343,22 +343,36 @@ impl Bvh4 {
         )
     }
 
-    /// Closest hit with `t <= t_max`: triangles are tested here, other
-    /// primitives (at BVH position `pos`) by `other(pos, t_max)`, which
-    /// returns the distance of what it accepted (a closer `t_max` from then
-    /// on) and keeps what it needs of it.
-    #[inline]
+    /// [`Bvh4::closest_hinted`] without a hint.
+    #[cfg(test)]
     pub(super) fn closest(
         &self,
         ray: &Ray,
         t_max: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Closest {
+        self.closest_hinted(ray, t_max, other, |_| {})
+    }
+
+    /// Closest hit with `t <= t_max`: triangles are tested here, other
+    /// primitives (at BVH position `pos`) by `other(pos, t_max)`, which
+    /// returns the distance of what it accepted (a closer `t_max` from then
+    /// on) and keeps what it needs of it. `hint` is told the BVH position of
+    /// each triangle that becomes the closest so far, so that the caller
+    /// can start fetching what it will read of the hit.
+    #[inline]
+    pub(super) fn closest_hinted(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        other: impl FnMut(u32, f32) -> Option<f32>,
+        hint: impl FnMut(u32),
+    ) -> Closest {
         if self.stack_need <= TINY_STACK {
             let mut stack = [(0u32, 0f32); TINY_STACK];
-            self.closest_with(ray, t_max, other, &mut stack)
+            self.closest_with(ray, t_max, other, hint, &mut stack)
         } else {
-            self.closest_deep(ray, t_max, other)
+            self.closest_deep(ray, t_max, other, hint)
         }
     }
 
@@ -368,16 +382,17 @@ impl Bvh4 {
         ray: &Ray,
         t_max: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
+        hint: impl FnMut(u32),
     ) -> Closest {
         if self.stack_need <= SMALL_STACK {
             let mut stack = [(0u32, 0f32); SMALL_STACK];
-            self.closest_with(ray, t_max, other, &mut stack)
+            self.closest_with(ray, t_max, other, hint, &mut stack)
         } else if self.stack_need <= LARGE_STACK {
-            self.closest_large(ray, t_max, other)
+            self.closest_large(ray, t_max, other, hint)
         } else {
             // Degenerate trees only (hundreds of levels deep).
             let mut stack = vec![(0u32, 0f32); self.stack_need];
-            self.closest_with(ray, t_max, other, &mut stack)
+            self.closest_with(ray, t_max, other, hint, &mut stack)
         }
     }
 
@@ -387,9 +402,10 @@ impl Bvh4 {
         ray: &Ray,
         t_max: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
+        hint: impl FnMut(u32),
     ) -> Closest {
         let mut stack = [(0u32, 0f32); LARGE_STACK];
-        self.closest_with(ray, t_max, other, &mut stack)
+        self.closest_with(ray, t_max, other, hint, &mut stack)
     }
 
     #[inline(always)]
@@ -398,14 +414,15 @@ impl Bvh4 {
         ray: &Ray,
         t_max: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
+        hint: impl FnMut(u32),
         stack: &mut [(u32, f32)],
     ) -> Closest {
         let br = BoxRay::new(ray);
         let tr = TriangleRay4::new(ray.o, ray.d);
         match tr.kz() {
-            0 => self.closest_k::<0>(&br, &tr, t_max, other, stack),
-            1 => self.closest_k::<1>(&br, &tr, t_max, other, stack),
-            _ => self.closest_k::<2>(&br, &tr, t_max, other, stack),
+            0 => self.closest_k::<0>(&br, &tr, t_max, other, hint, stack),
+            1 => self.closest_k::<1>(&br, &tr, t_max, other, hint, stack),
+            _ => self.closest_k::<2>(&br, &tr, t_max, other, hint, stack),
         }
     }
 
@@ -417,6 +434,7 @@ impl Bvh4 {
         tr: &TriangleRay4,
         mut t_max: f32,
         mut other: impl FnMut(u32, f32) -> Option<f32>,
+        mut hint: impl FnMut(u32),
         stack: &mut [(u32, f32)],
     ) -> Closest {
         let mut found = Closest::Nothing;
@@ -450,6 +468,7 @@ impl Bvh4 {
                     {
                         let pos = leaf.first + lane;
                         t_max = t;
+                        hint(pos);
                         found = Closest::Triangle { pos, t, b };
                     }
                 }
@@ -848,9 +867,18 @@ mod tests {
             for _ in 0..2000 {
                 let ray = random_ray(&mut rng, 1.0);
                 let expect = brute(&tris, &ray).map(|h| h.0);
-                let got = match bvh.closest(&ray, ray.t_max, |_, _| None) {
-                    Closest::Triangle { t, .. } => Some(t),
-                    _ => None,
+                // The hint's last position is the hit's.
+                let mut last = None;
+                let got = match bvh.closest_hinted(&ray, ray.t_max, |_, _| None, |p| last = Some(p))
+                {
+                    Closest::Triangle { t, pos, .. } => {
+                        assert_eq!(last, Some(pos));
+                        Some(t)
+                    }
+                    _ => {
+                        assert_eq!(last, None);
+                        None
+                    }
                 };
                 assert_eq!(expect, got, "{n} triangles, ray {ray:?}");
                 assert_eq!(bvh.any(&ray, ray.t_max, |_| false), expect.is_some());
@@ -1015,7 +1043,7 @@ mod tests {
         for _ in 0..3000 {
             let ray = random_ray(&mut rng, 1.0);
             let mut stack = vec![(0u32, 0f32); bvh.stack_need];
-            bvh.closest_with(&ray, ray.t_max, |_, _| None, &mut stack);
+            bvh.closest_with(&ray, ray.t_max, |_, _| None, |_| {}, &mut stack);
             let mut stack = vec![0u32; bvh.stack_need];
             bvh.any_with(&ray, ray.t_max, |_| false, &mut stack);
         }

@@ -639,6 +639,16 @@ impl Level {
     }
 }
 
+/// Asks for the cache line at `p` (a hint: nothing is read).
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing and cannot fault.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p as *const i8);
+    }
+}
+
 /// A level's BVH with the shapes its leaves refer to.
 #[derive(Clone, Copy)]
 struct Shapes<'a> {
@@ -660,26 +670,41 @@ impl Shapes<'_> {
         let bvh = self.level.bvh.as_ref()?;
         // Quadrics and instances found so far (triangles come back as values).
         let mut other: Option<Hit> = None;
-        let found = bvh.closest(ray, ray.t_max, |pos, t_max| {
-            let prim = self.level.prims[pos as usize];
-            let h = if prim.mesh == INSTANCE_TAG {
-                instance_hit(prim.index, t_max)
-            } else if prim.mesh == QUADRIC_TAG {
-                let s = &self.quadrics[prim.index as usize];
-                s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
-                    t,
-                    prim,
-                    instance: NO_INSTANCE,
-                    local: HitLocal::Analytic(p),
-                })
-            } else if prim.mesh == MOVING_TAG {
-                moving_hit(prim.index, t_max)
-            } else {
-                self.alpha_triangle(ray, prim, t_max, false)
-            }?;
-            other = Some(h);
-            Some(h.t)
-        });
+        let prims = &self.level.prims;
+        let meshes = self.meshes;
+        let hint = |pos: u32| {
+            // The hit triangle's vertex indices: surface reconstruction
+            // reads them first, behind the primitive reference.
+            let p = prims[pos as usize];
+            if let Some(m) = meshes.get(p.mesh as usize) {
+                prefetch(m.indices.as_ptr().wrapping_add(3 * p.index as usize));
+            }
+        };
+        let found = bvh.closest_hinted(
+            ray,
+            ray.t_max,
+            |pos, t_max| {
+                let prim = self.level.prims[pos as usize];
+                let h = if prim.mesh == INSTANCE_TAG {
+                    instance_hit(prim.index, t_max)
+                } else if prim.mesh == QUADRIC_TAG {
+                    let s = &self.quadrics[prim.index as usize];
+                    s.intersect(ray.o, ray.d, t_max).map(|(t, p)| Hit {
+                        t,
+                        prim,
+                        instance: NO_INSTANCE,
+                        local: HitLocal::Analytic(p),
+                    })
+                } else if prim.mesh == MOVING_TAG {
+                    moving_hit(prim.index, t_max)
+                } else {
+                    self.alpha_triangle(ray, prim, t_max, false)
+                }?;
+                other = Some(h);
+                Some(h.t)
+            },
+            hint,
+        );
         match found {
             Closest::Nothing => None,
             Closest::Triangle { pos, t, b } => Some(Hit {
