@@ -694,7 +694,8 @@ impl Sppm {
         counts: &mut RayCounts,
     ) {
         // The emission's dimensions drawn together, before anything
-        // branches on them: their digit chains are then in flight at once.
+        // branches on them (those looked up one index at a time then have
+        // their digit chains in flight at once).
         let u = h.next();
         let u_light0 = h.next_2d();
         let u_light1 = h.next_2d();

@@ -203,7 +203,7 @@ pub struct RadicalTable {
     /// and bases above 64).
     pub(super) entries: Box<[(u16, u16, u16)]>,
     /// `base^n` for `n ≤ k`.
-    pub(super) pow: [u64; 13],
+    pow: [u64; 13],
     /// 1/base multiplied into 1.0 `n` times in f64, one step at a time (the
     /// rounding of `radical_inverse`'s loop).
     pub(super) inv_powers: [f64; 65],
