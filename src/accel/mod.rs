@@ -686,7 +686,7 @@ impl Shapes<'_> {
             ray,
             ray.t_max,
             |pos, t_max| {
-                let prim = self.level.prims[pos as usize];
+                let prim = prims[pos as usize];
                 let h = if prim.mesh == INSTANCE_TAG {
                     instance_hit(prim.index, t_max)
                 } else if prim.mesh == QUADRIC_TAG {
@@ -711,7 +711,7 @@ impl Shapes<'_> {
             Closest::Nothing => None,
             Closest::Triangle { pos, t, b } => Some(Hit {
                 t,
-                prim: self.level.prims[pos as usize],
+                prim: prims[pos as usize],
                 instance: NO_INSTANCE,
                 local: HitLocal::Bary(b),
             }),

@@ -568,10 +568,11 @@ impl Sppm {
                     let end = (start + PHOTON_CHUNK).min(photons);
                     let mut recs = Vec::new();
                     let mut counts = RayCounts::default();
-                    let first = iter as u64 * photons as u64 + start as u64;
-                    let mut runs = PhotonRuns::new(first, (end - start) as usize);
-                    for i in start..end {
-                        let index = iter as u64 * photons as u64 + i as u64;
+                    // The chunk's photon indices (iteration-major).
+                    let from = iter as u64 * photons as u64 + start as u64;
+                    let len = (end - start) as usize;
+                    let mut runs = PhotonRuns::new(from, len);
+                    for index in from..from + len as u64 {
                         let mut h = Halton {
                             bases,
                             runs: &mut runs,
@@ -661,14 +662,13 @@ impl Halton<'_, '_> {
         let b = &self.bases[d];
         if d < RUN_DIMS && b.fills() {
             let runs = &mut *self.runs;
-            let i = (self.index - runs.first) as usize;
-            let row = &mut runs.values[d * runs.len..(d + 1) * runs.len];
+            let at = d * runs.len + (self.index - runs.first) as usize;
             if runs.filled & (1 << d) == 0 {
                 // This photon and the chunk's later ones.
-                b.fill(self.index, &mut row[i..]);
+                b.fill(self.index, &mut runs.values[at..(d + 1) * runs.len]);
                 runs.filled |= 1 << d;
             }
-            row[i]
+            runs.values[at]
         } else {
             b.radical_inverse(self.index)
         }
