@@ -29,6 +29,7 @@ use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::bvh2::Bvh2;
 use obvhs::ploc::PlocBuilder;
 use obvhs::BvhBuildParams;
+use std::mem::MaybeUninit;
 
 use super::{binned, split};
 
@@ -56,8 +57,8 @@ pub(super) const LEAF: u32 = 1 << 31;
 /// Most primitives in a leaf (one SIMD pack).
 pub(super) const LEAF_SIZE: usize = 4;
 /// Traversal stack sizes (entries): a tiny one for small trees, kept in the
-/// caller's frame (zeroing it is part of every ray's cost), and larger ones
-/// in frames of their own.
+/// caller's frame, and larger ones in frames of their own. Stacks are left
+/// uninitialised (zeroing 512 bytes was a few percent of a deep query).
 const TINY_STACK: usize = 16;
 const SMALL_STACK: usize = 64;
 const LARGE_STACK: usize = 512;
@@ -170,7 +171,7 @@ impl Bvh4 {
         let mut work = 0u64;
         let run = split::largest_coincident_run(aabbs, &mut work);
         let bounded = run > COINCIDENT_LIMIT;
-        let bvh2 = if bounded {
+        let mut bvh2 = if bounded {
             split::build(aabbs, &mut work)
         } else {
             let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
@@ -184,7 +185,7 @@ impl Bvh4 {
             bvh2
         };
         work += bvh2.nodes.len() as u64;
-        let (bvh, order) = Self::from_bvh2(&bvh2, triangle);
+        let (bvh, order) = Self::from_bvh2(&mut bvh2, triangle);
         (
             bvh,
             order,
@@ -256,7 +257,17 @@ impl Bvh4 {
         self.leaves.len()
     }
 
-    fn from_bvh2(bvh2: &Bvh2, triangle: impl Fn(usize) -> Option<[Vec3; 3]>) -> (Bvh4, Vec<u32>) {
+    fn from_bvh2(
+        bvh2: &mut Bvh2,
+        triangle: impl Fn(usize) -> Option<[Vec3; 3]>,
+    ) -> (Bvh4, Vec<u32>) {
+        // Parents before children, siblings side by side, in depth-first
+        // order: the passes below run backwards over the array (children
+        // first) instead of jumping through it, which PLOC's merge order
+        // and reinsertion's moves make a cache miss per node. Only the
+        // array changes, not the tree, so neither does the BVH made of it.
+        bvh2.reorder_in_stack_traversal_order();
+        let bvh2 = &*bvh2;
         let nodes2 = &bvh2.nodes;
         // PLOC makes a leaf per primitive; a leaf is never opened below.
         assert!(
@@ -282,10 +293,11 @@ impl Bvh4 {
         let mut leaves: Vec<Leaf> = Vec::new();
         let mut max_depth = 0usize;
 
+        let mut stack = Vec::new();
         let mut leaf_of = |root: usize, order: &mut Vec<u32>| -> u32 {
             let first = order.len() as u32;
             // The subtree's primitives, left to right.
-            let mut stack = vec![root];
+            stack.push(root);
             while let Some(i) = stack.pop() {
                 let n = &nodes2[i];
                 if n.prim_count == 0 {
@@ -300,7 +312,6 @@ impl Bvh4 {
             leaves.push(make_leaf(order, first, count, &triangle));
             (leaves.len() - 1) as u32 | LEAF
         };
-
         let plan = CollapsePlan::new(bvh2, &counts);
         // Work list: (BVH2 node, BVH4 node to fill, depth).
         nodes.push(empty_node());
@@ -369,7 +380,7 @@ impl Bvh4 {
         hint: impl FnMut(u32),
     ) -> Closest {
         if self.stack_need <= TINY_STACK {
-            let mut stack = [(0u32, 0f32); TINY_STACK];
+            let mut stack = [MaybeUninit::uninit(); TINY_STACK];
             self.closest_with(ray, t_max, other, hint, &mut stack)
         } else {
             self.closest_deep(ray, t_max, other, hint)
@@ -385,13 +396,13 @@ impl Bvh4 {
         hint: impl FnMut(u32),
     ) -> Closest {
         if self.stack_need <= SMALL_STACK {
-            let mut stack = [(0u32, 0f32); SMALL_STACK];
+            let mut stack = [MaybeUninit::uninit(); SMALL_STACK];
             self.closest_with(ray, t_max, other, hint, &mut stack)
         } else if self.stack_need <= LARGE_STACK {
             self.closest_large(ray, t_max, other, hint)
         } else {
             // Degenerate trees only (hundreds of levels deep).
-            let mut stack = vec![(0u32, 0f32); self.stack_need];
+            let mut stack = vec![MaybeUninit::uninit(); self.stack_need];
             self.closest_with(ray, t_max, other, hint, &mut stack)
         }
     }
@@ -404,7 +415,7 @@ impl Bvh4 {
         other: impl FnMut(u32, f32) -> Option<f32>,
         hint: impl FnMut(u32),
     ) -> Closest {
-        let mut stack = [(0u32, 0f32); LARGE_STACK];
+        let mut stack = [MaybeUninit::uninit(); LARGE_STACK];
         self.closest_with(ray, t_max, other, hint, &mut stack)
     }
 
@@ -415,7 +426,7 @@ impl Bvh4 {
         t_max: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
         hint: impl FnMut(u32),
-        stack: &mut [(u32, f32)],
+        stack: &mut [MaybeUninit<(u32, f32)>],
     ) -> Closest {
         let br = BoxRay::new(ray);
         let tr = TriangleRay4::new(ray.o, ray.d);
@@ -435,7 +446,7 @@ impl Bvh4 {
         mut t_max: f32,
         mut other: impl FnMut(u32, f32) -> Option<f32>,
         mut hint: impl FnMut(u32),
-        stack: &mut [(u32, f32)],
+        stack: &mut [MaybeUninit<(u32, f32)>],
     ) -> Closest {
         let mut found = Closest::Nothing;
         let mut sp = 0usize;
@@ -454,9 +465,39 @@ impl Bvh4 {
                     let near = (t0m.cmpeq(Vec4::splat(t0m.min_element())).bitmask() & mask)
                         .trailing_zeros() as usize;
                     let rest = mask & !(1 << near);
-                    for (i, (&c, t)) in n.child.iter().zip(t0.to_array()).enumerate() {
-                        stack[sp] = (c, t);
-                        sp += ((rest >> i) & 1) as usize;
+                    let ts = t0.to_array();
+                    if rest & rest.wrapping_sub(1) == 0 {
+                        for (i, (&c, t)) in n.child.iter().zip(ts).enumerate() {
+                            stack[sp] = MaybeUninit::new((c, t));
+                            sp += ((rest >> i) & 1) as usize;
+                        }
+                    } else {
+                        // Two or three more: pushed far to near, so that the
+                        // nearer ones are popped first.
+                        let mut e = [(0u32, 0f32); 3];
+                        let mut k = 0;
+                        let mut m = rest;
+                        while m != 0 {
+                            let i = m.trailing_zeros() as usize;
+                            e[k] = (n.child[i], ts[i]);
+                            k += 1;
+                            m &= m - 1;
+                        }
+                        if e[0].1 < e[1].1 {
+                            e.swap(0, 1);
+                        }
+                        if k == 3 {
+                            if e[1].1 < e[2].1 {
+                                e.swap(1, 2);
+                            }
+                            if e[0].1 < e[1].1 {
+                                e.swap(0, 1);
+                            }
+                        }
+                        for (slot, &x) in stack[sp..sp + 3].iter_mut().zip(&e) {
+                            *slot = MaybeUninit::new(x);
+                        }
+                        sp += k;
                     }
                     cur = n.child[near];
                     continue;
@@ -489,7 +530,9 @@ impl Bvh4 {
                     return found;
                 }
                 sp -= 1;
-                let (c, t0) = stack[sp];
+                // SAFETY: entries below the stack pointer were written
+                // (the pointer only moves past written entries).
+                let (c, t0) = unsafe { stack[sp].assume_init() };
                 if t0 <= t_max {
                     cur = c;
                     break;
@@ -503,7 +546,7 @@ impl Bvh4 {
     #[inline]
     pub(super) fn any(&self, ray: &Ray, t_max: f32, blocks: impl FnMut(u32) -> bool) -> bool {
         if self.stack_need <= TINY_STACK {
-            let mut stack = [0u32; TINY_STACK];
+            let mut stack = [MaybeUninit::uninit(); TINY_STACK];
             self.any_with(ray, t_max, blocks, &mut stack)
         } else {
             self.any_deep(ray, t_max, blocks)
@@ -513,13 +556,13 @@ impl Bvh4 {
     #[inline(never)]
     fn any_deep(&self, ray: &Ray, t_max: f32, blocks: impl FnMut(u32) -> bool) -> bool {
         if self.stack_need <= SMALL_STACK {
-            let mut stack = [0u32; SMALL_STACK];
+            let mut stack = [MaybeUninit::uninit(); SMALL_STACK];
             self.any_with(ray, t_max, blocks, &mut stack)
         } else if self.stack_need <= LARGE_STACK {
-            let mut stack = [0u32; LARGE_STACK];
+            let mut stack = [MaybeUninit::uninit(); LARGE_STACK];
             self.any_with(ray, t_max, blocks, &mut stack)
         } else {
-            let mut stack = vec![0u32; self.stack_need];
+            let mut stack = vec![MaybeUninit::uninit(); self.stack_need];
             self.any_with(ray, t_max, blocks, &mut stack)
         }
     }
@@ -530,7 +573,7 @@ impl Bvh4 {
         ray: &Ray,
         t_max: f32,
         blocks: impl FnMut(u32) -> bool,
-        stack: &mut [u32],
+        stack: &mut [MaybeUninit<u32>],
     ) -> bool {
         let br = BoxRay::new(ray);
         let tr = TriangleRay4::new(ray.o, ray.d);
@@ -548,7 +591,7 @@ impl Bvh4 {
         tr: &TriangleRay4,
         t_max: f32,
         mut blocks: impl FnMut(u32) -> bool,
-        stack: &mut [u32],
+        stack: &mut [MaybeUninit<u32>],
     ) -> bool {
         let mut sp = 0usize;
         let mut cur = 0u32;
@@ -560,7 +603,7 @@ impl Bvh4 {
                     let first = mask.trailing_zeros() as usize;
                     let rest = mask & !(1 << first);
                     for i in 0..4 {
-                        stack[sp] = n.child[i];
+                        stack[sp] = MaybeUninit::new(n.child[i]);
                         sp += ((rest >> i) & 1) as usize;
                     }
                     cur = n.child[first];
@@ -583,7 +626,9 @@ impl Bvh4 {
                 return false;
             }
             sp -= 1;
-            cur = stack[sp];
+            // SAFETY: as in `closest_k`, entries below the pointer were
+            // written.
+            cur = unsafe { stack[sp].assume_init() };
         }
     }
 }
@@ -664,9 +709,8 @@ impl CollapsePlan {
             leaf: vec![false; n],
             node_split: vec![0; n],
         };
-        // Children first (post-order without recursion).
-        let mut stack = vec![(0usize, false)];
-        while let Some((i, done)) = stack.pop() {
+        // Children first: they follow their parents in the array.
+        for i in (0..n).rev() {
             let node = &nodes[i];
             let area = node.aabb.half_area().max(0.0);
             if node.prim_count != 0 {
@@ -675,12 +719,7 @@ impl CollapsePlan {
                 continue;
             }
             let f = node.first_index as usize;
-            if !done {
-                stack.push((i, true));
-                stack.push((f, false));
-                stack.push((f + 1, false));
-                continue;
-            }
+            debug_assert!(f > i, "children after their parent");
             let (a, b) = (plan.cost[f], plan.cost[f + 1]);
             // Both children in `k` slots (at least one each).
             let both = |k: usize| -> (f32, u8) {
@@ -758,31 +797,23 @@ impl CollapsePlan {
     }
 }
 
-/// Primitive count of every BVH2 node's subtree (without recursion: trees
-/// can be deep).
-/// Per BVH2 node, the sum of `weights` of the primitives below it.
+/// Per BVH2 node, the sum of `weights` of the primitives below it (children
+/// after their parents in `bvh2`'s array).
 fn subtree_counts(bvh2: &Bvh2, weights: &[u32]) -> Vec<u32> {
     let nodes = &bvh2.nodes;
     let mut counts = vec![0u32; nodes.len()];
-    // Post-order: a node is finished when it is popped the second time.
-    let mut stack = vec![(0usize, false)];
-    while let Some((i, done)) = stack.pop() {
-        let n = &nodes[i];
-        if n.prim_count != 0 {
-            let s = n.first_index as usize;
-            counts[i] = bvh2.primitive_indices[s..s + n.prim_count as usize]
+    // Children first: they follow their parents in the array.
+    for (i, n) in nodes.iter().enumerate().rev() {
+        let s = n.first_index as usize;
+        counts[i] = if n.prim_count != 0 {
+            bvh2.primitive_indices[s..s + n.prim_count as usize]
                 .iter()
                 .map(|&p| weights[p as usize])
-                .sum();
-        } else if done {
-            let f = n.first_index as usize;
-            counts[i] = counts[f] + counts[f + 1];
+                .sum()
         } else {
-            let f = n.first_index as usize;
-            stack.push((i, true));
-            stack.push((f, false));
-            stack.push((f + 1, false));
-        }
+            debug_assert!(s > i, "children after their parent");
+            counts[s] + counts[s + 1]
+        };
     }
     counts
 }
@@ -1042,9 +1073,9 @@ mod tests {
         let mut rng = Pcg32::with_sequence(11);
         for _ in 0..3000 {
             let ray = random_ray(&mut rng, 1.0);
-            let mut stack = vec![(0u32, 0f32); bvh.stack_need];
+            let mut stack = vec![MaybeUninit::uninit(); bvh.stack_need];
             bvh.closest_with(&ray, ray.t_max, |_, _| None, |_| {}, &mut stack);
-            let mut stack = vec![0u32; bvh.stack_need];
+            let mut stack = vec![MaybeUninit::uninit(); bvh.stack_need];
             bvh.any_with(&ray, ray.t_max, |_| false, &mut stack);
         }
     }
@@ -1101,12 +1132,12 @@ mod tests {
         nodes[1] = inner([3, 4], 3, &nodes);
         nodes[2] = inner([5, 6], 5, &nodes);
         nodes[0] = inner([1, 2], 1, &nodes);
-        let bvh2 = Bvh2 {
+        let mut bvh2 = Bvh2 {
             nodes,
             primitive_indices: (0..8).collect(),
             ..Bvh2::default()
         };
-        let (bvh, order) = Bvh4::from_bvh2(&bvh2, |i| Some(tris[i]));
+        let (bvh, order) = Bvh4::from_bvh2(&mut bvh2, |i| Some(tris[i]));
         assert_eq!(order.len(), 8);
         for leaf in &bvh.leaves {
             let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
