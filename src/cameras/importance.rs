@@ -18,6 +18,10 @@ pub struct CameraImportance<'c> {
     /// Camera-to-world of a still camera (a moving one's is taken at each
     /// ray's time).
     to_world: Affine3A,
+    /// A still camera's world-to-camera and viewing direction, computed
+    /// once (the same values `frame` gives, inverted and normalised at each
+    /// call for a moving one).
+    still: Option<(Affine3A, Vec3)>,
     screen: [f32; 4],
     resolution: Vec2,
     tan_half_fov: f32,
@@ -64,9 +68,14 @@ impl<'c> CameraImportance<'c> {
         let [x0, x1, y0, y1] = p.screen();
         let t = p.tan_half_fov();
         let lens_radius = p.lens_radius();
+        let to_world = p.camera_to_world();
         Ok(CameraImportance {
             camera,
-            to_world: p.camera_to_world(),
+            to_world,
+            still: camera
+                .motion
+                .is_none()
+                .then(|| (to_world.inverse(), view_direction(&to_world))),
             screen: p.screen(),
             resolution: p.resolution(),
             tan_half_fov: t,
@@ -94,7 +103,22 @@ impl<'c> CameraImportance<'c> {
     /// The viewing direction in world space at `time`.
     #[inline]
     pub fn forward(&self, time: f32) -> Vec3 {
-        self.frame(time).transform_vector3(Vec3::Z).normalize()
+        match &self.still {
+            Some((_, forward)) => *forward,
+            None => view_direction(&self.frame(time)),
+        }
+    }
+
+    /// World-to-camera and the viewing direction at `time`.
+    #[inline]
+    fn inverse_and_forward(&self, time: f32) -> (Affine3A, Vec3) {
+        match self.still {
+            Some(s) => s,
+            None => {
+                let m = self.frame(time);
+                (m.inverse(), view_direction(&m))
+            }
+        }
     }
 
     /// The film position a world ray from the lens (origin `o`, unit
@@ -102,8 +126,8 @@ impl<'c> CameraImportance<'c> {
     /// `None` if it points backwards or lands outside the sample bounds.
     #[inline]
     fn raster(&self, o: Vec3, d: Vec3, time: f32) -> Option<(Vec2, f32)> {
-        let m = self.frame(time);
-        let cos = d.dot(m.transform_vector3(Vec3::Z).normalize());
+        let (from_world, forward) = self.inverse_and_forward(time);
+        let cos = d.dot(forward);
         if cos.is_nan() || cos <= 0.0 {
             return None;
         }
@@ -112,7 +136,7 @@ impl<'c> CameraImportance<'c> {
         } else {
             1.0
         };
-        let q = m.inverse().transform_point3(o + d * (focus / cos));
+        let q = from_world.transform_point3(o + d * (focus / cos));
         let [x0, x1, y0, y1] = self.screen;
         let sx = q.x / q.z / self.tan_half_fov;
         let sy = q.y / q.z / self.tan_half_fov;
@@ -158,7 +182,10 @@ impl<'c> CameraImportance<'c> {
         let m = self.frame(time);
         let lens = self.lens_radius * concentric_sample_disk(u);
         let p_lens = m.transform_point3(Vec3::new(lens.x, lens.y, 0.0));
-        let n = m.transform_vector3(Vec3::Z).normalize();
+        let n = match &self.still {
+            Some((_, forward)) => *forward,
+            None => view_direction(&m),
+        };
         let v = p_lens - p;
         let dist = v.length();
         if dist == 0.0 || dist.is_nan() {
@@ -176,4 +203,10 @@ impl<'c> CameraImportance<'c> {
             n,
         })
     }
+}
+
+/// The camera's +z axis in world space, normalised.
+#[inline]
+fn view_direction(to_world: &Affine3A) -> Vec3 {
+    to_world.transform_vector3(Vec3::Z).normalize()
 }
