@@ -3,7 +3,7 @@
 
 use glam::Vec2;
 use pbrs::sampling::chi2::{chi2_square, sidak_significance, Chi2Config};
-use pbrs::sampling::{Distribution1D, Distribution2D, Pcg32, ONE_MINUS_EPSILON};
+use pbrs::sampling::{DiscreteCdf, Distribution1D, Distribution2D, Pcg32, ONE_MINUS_EPSILON};
 
 /// Chi-square tests in this file (for the Šidák correction).
 const N_CHI2_TESTS: usize = 2 * 8;
@@ -248,4 +248,88 @@ fn chi_square_rejects_a_wrong_distribution() {
         &cfg,
     );
     assert!(!r.passed(significance()), "{r}");
+}
+
+/// `DiscreteCdf` chooses the bin `Distribution1D::sample_discrete` chooses,
+/// for every u (random ones, each CDF entry and its neighbours, the ends,
+/// out-of-range and NaN), and has the same `func_int`, bit for bit: on
+/// random functions with zeros, negatives, NaN and infinities, all-zero
+/// ones, a single bin, the empty function and a long one.
+#[test]
+fn discrete_cdf_chooses_distribution1ds_bins() {
+    let mut rng = Pcg32::with_sequence(0x05ee_dcdf);
+    let mut funcs: Vec<Vec<f32>> = vec![
+        vec![],
+        vec![0.0],
+        vec![3.0],
+        vec![0.0; 7],
+        vec![f32::NAN, -1.0, 0.0],
+        vec![1.0, f32::INFINITY, 2.0, f32::INFINITY],
+        vec![f32::MAX, f32::MAX, 1.0],
+        vec![1e-30, 1.0, 1e-30, 0.0, 5.0],
+    ];
+    for n in [2, 3, 17, 100, 1000] {
+        for _ in 0..6 {
+            funcs.push(random_func(&mut rng, n));
+        }
+    }
+    funcs.push(
+        (0..100_000)
+            .map(|i| {
+                if i % 7 == 0 {
+                    0.0
+                } else {
+                    rng.uniform_f32() * 10.0
+                }
+            })
+            .collect(),
+    );
+    for f in &funcs {
+        let d = Distribution1D::new(f);
+        let c = DiscreteCdf::new(f);
+        assert_eq!(c.func_int().to_bits(), d.func_int().to_bits(), "{f:?}");
+        let n = d.count();
+        let mut us: Vec<f32> = (0..2000).map(|_| rng.uniform_f32()).collect();
+        // The CDF entries (as Distribution1D's documentation defines them:
+        // f64 prefix sums of the values, NaN and negatives as 0, over the
+        // total) and the floats beside them.
+        let clean = |v: f32| {
+            if v.is_nan() || v <= 0.0 {
+                0.0
+            } else {
+                v.min(f32::MAX) as f64
+            }
+        };
+        let total: f64 = f.iter().map(|&v| clean(v)).sum();
+        let mut acc = 0.0f64;
+        for &v in f {
+            acc += clean(v);
+            let edge = (acc / total) as f32;
+            for u in [
+                edge,
+                f32::from_bits(edge.to_bits().saturating_sub(1)),
+                f32::from_bits(edge.to_bits() + 1),
+            ] {
+                us.push(u);
+            }
+        }
+        us.extend([
+            0.0,
+            -0.0,
+            -1.0,
+            1.0,
+            2.0,
+            ONE_MINUS_EPSILON,
+            f32::NAN,
+            f32::INFINITY,
+        ]);
+        for u in us {
+            assert_eq!(
+                c.sample_index(u),
+                d.sample_discrete(u).0,
+                "u = {u} over {} bins",
+                n
+            );
+        }
+    }
 }

@@ -46,7 +46,7 @@ use crate::lights::LightSampler;
 use crate::render::film::Film;
 use crate::samplers::mlt::{CAMERA_STREAM, CONNECTION_STREAM, LIGHT_STREAM};
 use crate::samplers::{CameraSample, MltSampler, Sampler};
-use crate::sampling::distribution::Distribution1D;
+use crate::sampling::distribution::DiscreteCdf;
 use crate::sampling::rng::{hash_words, Pcg32};
 use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
@@ -154,8 +154,8 @@ impl MltSettings {
             );
             bootstrap_samples = 1;
         }
-        // Each bootstrap path keeps its weight and the distribution's
-        // function and CDF entries (three f32).
+        // Each bootstrap path keeps its weight (f32) and its prefix sum
+        // (f64) in the distribution the chains start from.
         let paths = bootstrap_samples as u64 * (max_depth as u64 + 1);
         if let Err(why) = crate::scene::memory::check_budget("the bootstrap paths' distribution", paths * 12) {
             r.error(
@@ -386,7 +386,8 @@ impl Mlt {
             progress(round + 1, steps, film);
         }
         done.bootstrap_paths = weights.len() as u64;
-        let bootstrap = Distribution1D::new(&weights);
+        let bootstrap = DiscreteCdf::new(&weights);
+        drop(weights);
         let b = bootstrap.func_int() * depths as f32;
         done.b = b as f64;
         film.set_splat_scale(b as f64 / mpp as f64);
@@ -400,7 +401,7 @@ impl Mlt {
         let chain = |i: u64, group: &mut Group, scratch: &mut Scratch| {
             let n = chain_start(i + 1).min(total) - chain_start(i);
             let mut rng = Pcg32::with_sequence(sequence(i, seed));
-            let (index, _, _) = bootstrap.sample_discrete(rng.uniform_f32());
+            let index = bootstrap.sample_index(rng.uniform_f32());
             let depth = (index % depths) as u32;
             let mut sampler = sampler_for(index);
             let (mut l_current, mut p_current) = paths.path(&mut sampler, depth, scratch);

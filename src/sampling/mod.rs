@@ -10,6 +10,6 @@ pub mod interpolation;
 pub mod rng;
 pub mod warps;
 
-pub use distribution::{Distribution1D, Distribution2D};
+pub use distribution::{DiscreteCdf, Distribution1D, Distribution2D};
 pub use rng::{Pcg32, ONE_MINUS_EPSILON};
 pub use warps::*;
