@@ -239,11 +239,11 @@ pub struct MltDone {
 }
 
 /// Mutations per group of chains: the unit of parallel work whose splats
-/// are added to the film in order (about 1.5 MiB of splats at most). Small
-/// enough that two threads end the chains together (four groups on
-/// `scenes/mlt/caustic.pbrt` left one thread idle for up to a quarter of
-/// the chains); the image does not depend on it (splats are added in chain
-/// order whatever the grouping).
+/// are added to the film in order (about 1.5 MiB of splats at most). Small,
+/// so that the threads end the chains at nearly the same time
+/// (`scenes/mlt/caustic.pbrt` had four groups for two threads, so one
+/// thread could idle while the other ran the last); the image does not
+/// depend on it (splats are added in chain order whatever the grouping).
 const GROUP_MUTATIONS: u64 = 1 << 15;
 
 /// Bootstrap samples (each `maxdepth` + 1 paths) per unit of parallel
