@@ -90,31 +90,18 @@ impl Distribution1D {
             f.iter().map(|&v| sanitise(v)).collect()
         };
         let n = func.len();
-        let mut cdf = vec![0.0f32; n + 1];
-        // Accumulate in f64 so long distributions keep their precision.
-        let mut acc = 0.0f64;
-        let mut sums = Vec::with_capacity(n + 1);
-        sums.push(0.0f64);
-        for &v in &func {
-            acc += v as f64;
-            sums.push(acc);
-        }
-        let total = acc;
-        let func_int = (total / n as f64) as f32;
-        let pdf: Vec<f32>;
-        if total > 0.0 && total.is_finite() {
-            for i in 1..=n {
-                cdf[i] = (sums[i] / total) as f32;
-            }
+        // The CDF as `DiscreteCdf` defines it (f64 sums, so long
+        // distributions keep their precision).
+        let sums = DiscreteCdf::new(&func);
+        let cdf: Vec<f32> = (0..=n).map(|i| sums.cdf(i)).collect();
+        let total = sums.total();
+        let func_int = sums.func_int();
+        let pdf: Vec<f32> = if total > 0.0 && total.is_finite() {
             let inv = n as f64 / total;
-            pdf = func.iter().map(|&v| (v as f64 * inv) as f32).collect();
+            func.iter().map(|&v| (v as f64 * inv) as f32).collect()
         } else {
-            for (i, c) in cdf.iter_mut().enumerate() {
-                *c = i as f32 / n as f32;
-            }
-            pdf = vec![1.0; n];
-        }
-        cdf[n] = 1.0;
+            vec![1.0; n]
+        };
         Self {
             func,
             pdf,
@@ -195,8 +182,8 @@ impl Distribution1D {
 
 /// The bin choice of [`Distribution1D::sample_discrete`] and its
 /// `func_int`, without the density and function arrays: only the prefix
-/// sums (in f64, added in the same order as `Distribution1D::new` adds
-/// them), from which a CDF entry is computed when the search reads it. For
+/// sums (in f64), from which a CDF entry is computed when the search reads
+/// it (`Distribution1D::new` stores the same entries). For
 /// long functions sampled a few times (mlt's bootstrap weights, millions of
 /// them, sampled once per chain): 8 bytes per bin instead of 12 (20 while
 /// a `Distribution1D` is built), and no per-bin division.
@@ -225,16 +212,21 @@ impl DiscreteCdf {
         self.sums.len() - 1
     }
 
-    /// `Distribution1D::func_int` of the same function.
-    pub fn func_int(&self) -> f32 {
-        (self.sums[self.count()] / self.count() as f64) as f32
+    fn total(&self) -> f64 {
+        self.sums[self.count()]
     }
 
-    /// `Distribution1D`'s CDF entry `i`.
+    /// `Distribution1D::func_int` of the same function.
+    pub fn func_int(&self) -> f32 {
+        (self.total() / self.count() as f64) as f32
+    }
+
+    /// `Distribution1D`'s CDF entry `i` (0 at 0, 1 at `count`): the sums
+    /// over their total, or `i / count` where the total is 0 or infinite.
     #[inline]
     fn cdf(&self, i: usize) -> f32 {
         let n = self.count();
-        let total = self.sums[n];
+        let total = self.total();
         if i == n {
             1.0
         } else if total > 0.0 && total.is_finite() {
