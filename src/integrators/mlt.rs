@@ -248,7 +248,7 @@ const GROUP_MUTATIONS: u64 = 1 << 15;
 
 /// Bootstrap samples (each `maxdepth` + 1 paths) per unit of parallel
 /// work, and the most rounds of them between progress reports.
-const BOOTSTRAP_CHUNK: usize = 1024;
+const BOOTSTRAP_CHUNK: usize = 256;
 const BOOTSTRAP_ROUNDS: usize = 16;
 
 /// The sequence number of PCG32 stream `index` under `seed` (seed 0:
@@ -375,7 +375,7 @@ impl Mlt {
                         let mut sampler = sampler_for(0);
                         for (j, w) in chunk.iter_mut().enumerate() {
                             let index = first + k * chunk_len + j;
-                            mlt(&mut sampler).restart(sequence(index as u64, seed));
+                            mlt(&mut sampler).restart_unkept(sequence(index as u64, seed));
                             let depth = (index % depths) as u32;
                             *w = luminance(paths.path(&mut sampler, depth, &mut scratch).0);
                         }

@@ -35,9 +35,95 @@ struct PrimarySample {
     modified_backup: i64,
 }
 
+/// How many of the sampler's random numbers are drawn ahead.
+const AHEAD: usize = 16;
+
+/// The sampler's next random numbers, drawn ahead of their use, and, once
+/// a small step asks for one, the normal variate each would give: a small
+/// step's values then wait for no erf⁻¹ (a chain of dependent operations
+/// behind a logarithm), whose results for the whole batch the processor
+/// computes side by side. The numbers are PCG32's in order, each used
+/// exactly once, as a uniform value or through its normal variate,
+/// whichever the reader asks for, so the values are those of drawing
+/// each when it is needed.
+#[derive(Clone, Debug)]
+struct Ahead {
+    rng: Pcg32,
+    uniform: [f32; AHEAD],
+    normal: [f32; AHEAD],
+    /// The next unread slot (`AHEAD`: none drawn).
+    next: usize,
+    /// Whether `normal` holds the variates of this batch's unread slots.
+    normals: bool,
+}
+
+impl Ahead {
+    fn new(sequence: u64) -> Ahead {
+        Ahead {
+            rng: Pcg32::with_sequence(sequence),
+            uniform: [0.0; AHEAD],
+            normal: [0.0; AHEAD],
+            next: AHEAD,
+            normals: false,
+        }
+    }
+
+    /// As [`Ahead::new`] makes it (the arrays are written before they are read).
+    fn restart(&mut self, sequence: u64) {
+        self.rng = Pcg32::with_sequence(sequence);
+        self.next = AHEAD;
+        self.normals = false;
+    }
+
+    #[inline]
+    fn slot(&mut self) -> usize {
+        if self.next == AHEAD {
+            self.draw();
+        }
+        self.next += 1;
+        self.next - 1
+    }
+
+    /// Draws the next batch.
+    #[inline(never)]
+    fn draw(&mut self) {
+        for u in &mut self.uniform {
+            *u = self.rng.uniform_f32();
+        }
+        self.next = 0;
+        self.normals = false;
+    }
+
+    /// The normal variates of the unread slots from `i` on.
+    #[inline(never)]
+    fn make_normals(&mut self, i: usize) {
+        for j in i..AHEAD {
+            self.normal[j] = std::f32::consts::SQRT_2 * erf_inv(2.0 * self.uniform[j] - 1.0);
+        }
+        self.normals = true;
+    }
+
+    /// The next number, uniform in [0, 1).
+    #[inline]
+    fn uniform_f32(&mut self) -> f32 {
+        let i = self.slot();
+        self.uniform[i]
+    }
+
+    /// The standard normal variate of the next number u: √2·erf⁻¹(2u − 1).
+    #[inline]
+    fn normal(&mut self) -> f32 {
+        let i = self.slot();
+        if !self.normals {
+            self.make_normals(i);
+        }
+        self.normal[i]
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct MltSampler {
-    rng: Pcg32,
+    rng: Ahead,
     sigma: f32,
     large_step_probability: f32,
     x: Vec<PrimarySample>,
@@ -51,6 +137,8 @@ pub struct MltSampler {
     mutations_per_pixel: u32,
     /// No arrays are requested of it (bdpt asks for none).
     pub(super) arrays: ArrayStore,
+    /// Whether X is kept: false for a bootstrap path ([`MltSampler::restart_unkept`]).
+    keep: bool,
 }
 
 impl MltSampler {
@@ -64,7 +152,7 @@ impl MltSampler {
         large_step_probability: f32,
     ) -> MltSampler {
         MltSampler {
-            rng: Pcg32::with_sequence(sequence),
+            rng: Ahead::new(sequence),
             sigma,
             large_step_probability,
             x: Vec::new(),
@@ -75,13 +163,14 @@ impl MltSampler {
             index: 0,
             mutations_per_pixel,
             arrays: ArrayStore::default(),
+            keep: true,
         }
     }
 
     /// This sampler as [`MltSampler::new`] makes it with `sequence`,
     /// keeping its storage (the bootstrap makes a fresh sampler per path).
     pub fn restart(&mut self, sequence: u64) {
-        self.rng = Pcg32::with_sequence(sequence);
+        self.rng.restart(sequence);
         self.x.clear();
         self.iteration = 0;
         self.large_step = true;
@@ -89,6 +178,18 @@ impl MltSampler {
         self.stream = 0;
         self.index = 0;
         self.arrays = ArrayStore::default();
+        self.keep = true;
+    }
+
+    /// [`MltSampler::restart`] for a path that is made once and never
+    /// mutated (a bootstrap path): its values are not kept. At the first
+    /// iteration every value read is a large step's fresh one, one random
+    /// number per read in the order of the reads (`ensure_ready` with
+    /// `large_step` and no large step after the value's last change), so
+    /// the values are those of a kept X bit for bit.
+    pub fn restart_unkept(&mut self, sequence: u64) {
+        self.restart(sequence);
+        self.keep = false;
     }
 
     pub fn samples_per_pixel(&self) -> u32 {
@@ -98,6 +199,7 @@ impl MltSampler {
     /// Starts the next proposal: a large step with the large-step
     /// probability, else a small one.
     pub fn start_iteration(&mut self) {
+        debug_assert!(self.keep, "an unkept path is never mutated");
         self.iteration += 1;
         self.large_step = self.rng.uniform_f32() < self.large_step_probability;
     }
@@ -129,6 +231,11 @@ impl MltSampler {
 
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
+        if !self.keep {
+            // Drawn one at a time (a bootstrap path reads few values and
+            // asks for no normal variates): `restart` emptied the batch.
+            return self.rng.rng.uniform_f32();
+        }
         let i = self.stream + STREAMS * self.index;
         self.index += 1;
         self.ensure_ready(i);
@@ -142,9 +249,10 @@ impl MltSampler {
     }
 
     /// Brings X[i] up to the current iteration (pbrt-v3's `EnsureReady`).
+    #[inline]
     fn ensure_ready(&mut self, i: usize) {
         if i >= self.x.len() {
-            self.x.resize(i + 1, PrimarySample::default());
+            self.grow(i);
         }
         let (iteration, large, last_large) =
             (self.iteration, self.large_step, self.last_large_step);
@@ -160,12 +268,24 @@ impl MltSampler {
             xi.value = self.rng.uniform_f32();
         } else {
             let n_small = iteration - xi.last_modified;
-            let normal = std::f32::consts::SQRT_2 * erf_inv(2.0 * self.rng.uniform_f32() - 1.0);
-            let sigma = self.sigma * (n_small as f32).sqrt();
+            let normal = self.rng.normal();
+            // Most values are read at every iteration: one step, σ·√1 = σ.
+            let sigma = if n_small == 1 {
+                self.sigma
+            } else {
+                self.sigma * (n_small as f32).sqrt()
+            };
             xi.value += normal * sigma;
             xi.value -= xi.value.floor();
         }
         xi.last_modified = iteration;
+    }
+
+    /// X up to X[i], the new values never changed.
+    #[cold]
+    #[inline(never)]
+    fn grow(&mut self, i: usize) {
+        self.x.resize(i + 1, PrimarySample::default());
     }
 
     // What the `Sampler` enum asks of every sampler.
@@ -213,6 +333,59 @@ mod tests {
         s.large_step = false;
         let again: Vec<f32> = (0..5).map(|_| s.get_1d()).collect();
         assert_eq!(first, again);
+    }
+
+    #[test]
+    fn an_unkept_path_reads_the_values_a_kept_one_does() {
+        for sequence in [0, 11, 1 << 40] {
+            let mut kept = MltSampler::new(4, sequence, 0.01, 0.3);
+            let mut unkept = MltSampler::new(4, sequence ^ 5, 0.01, 0.3);
+            unkept.restart_unkept(sequence);
+            // Streams read in turn, one of them twice (its values drawn
+            // afresh the second time, as the first iteration's large step
+            // draws them).
+            for (k, n) in [
+                (CAMERA_STREAM, 7),
+                (LIGHT_STREAM, 5),
+                (CONNECTION_STREAM, 3),
+                (CAMERA_STREAM, 9),
+                (LIGHT_STREAM, 2),
+            ] {
+                kept.start_stream(k);
+                unkept.start_stream(k);
+                for _ in 0..n {
+                    assert_eq!(kept.get_1d().to_bits(), unkept.get_1d().to_bits());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn numbers_drawn_ahead_are_those_drawn_when_needed() {
+        let mut ahead = Ahead::new(9);
+        let mut rng = Pcg32::with_sequence(9);
+        let mut pick = Pcg32::with_sequence(1);
+        // Uniforms and normals in a random order over many batches, and
+        // runs of each longer than a batch.
+        for k in 0..2000 {
+            let normal = match k / 500 {
+                1 => true,
+                2 => false,
+                _ => pick.uniform_f32() < 0.7,
+            };
+            let u = rng.uniform_f32();
+            if normal {
+                let n = std::f32::consts::SQRT_2 * erf_inv(2.0 * u - 1.0);
+                assert_eq!(ahead.normal().to_bits(), n.to_bits());
+            } else {
+                assert_eq!(ahead.uniform_f32().to_bits(), u.to_bits());
+            }
+        }
+        ahead.restart(4);
+        let mut rng = Pcg32::with_sequence(4);
+        for _ in 0..40 {
+            assert_eq!(ahead.uniform_f32().to_bits(), rng.uniform_f32().to_bits());
+        }
     }
 
     #[test]
