@@ -3,6 +3,7 @@
 //! all-zero function samples uniformly (with the matching pdf) instead of
 //! producing zero pdfs.
 
+use super::distribution_guide::GuideTable;
 use super::rng::ONE_MINUS_EPSILON;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -15,12 +16,23 @@ const PARALLEL_2D: usize = 1 << 16;
 pub struct Distribution1D {
     /// Sanitised function values (finite, >= 0).
     func: Vec<f32>,
-    /// Density per bin over `[0, 1]` (integrates to 1).
-    pdf: Vec<f32>,
-    /// `count + 1` entries, `cdf[0] == 0`, `cdf[count] == 1`.
-    cdf: Vec<f32>,
+    /// `count + 1` entries: the CDF (`[0].cdf == 0`, `[count].cdf == 1`)
+    /// and each bin's density over `[0, 1]` (integrating to 1; the last
+    /// entry's is 0 and unused), side by side, so that a sample's search
+    /// ends reading its bin's density from the cache line of its CDF.
+    bins: Vec<Bin>,
     /// Integral of the (sanitised) function over `[0, 1]`: `Σ f / n`.
     func_int: f32,
+    /// Narrows the search of the CDF (to the plain bisection's result).
+    guide: GuideTable,
+}
+
+/// A bin's CDF entry (at its start) and density.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct Bin {
+    cdf: f32,
+    pdf: f32,
 }
 
 #[inline]
@@ -45,9 +57,10 @@ pub(crate) fn sanitise_u(u: f32) -> f32 {
 }
 
 /// Index of the last `i` in `[0, cdf.len() - 2]` with `cdf[i] <= u`
-/// (pbrt's `FindInterval`).
-#[inline]
-fn find_interval(cdf: &[f32], u: f32) -> usize {
+/// (pbrt's `FindInterval`) by bisection of the whole CDF: what
+/// [`GuideTable::find_interval`] must find.
+#[cfg(test)]
+pub(crate) fn find_interval_plain(cdf: &[f32], u: f32) -> usize {
     find_interval_by(cdf.len(), u, |i| cdf[i])
 }
 
@@ -93,21 +106,46 @@ impl Distribution1D {
         // The CDF as `DiscreteCdf` defines it (f64 sums, so long
         // distributions keep their precision).
         let sums = DiscreteCdf::new(&func);
-        let cdf: Vec<f32> = (0..=n).map(|i| sums.cdf(i)).collect();
         let total = sums.total();
         let func_int = sums.func_int();
-        let pdf: Vec<f32> = if total > 0.0 && total.is_finite() {
-            let inv = n as f64 / total;
-            func.iter().map(|&v| (v as f64 * inv) as f32).collect()
-        } else {
-            vec![1.0; n]
-        };
+        let inv = n as f64 / total;
+        let uniform = !(total > 0.0 && total.is_finite());
+        let bins: Vec<Bin> = (0..=n)
+            .map(|i| Bin {
+                cdf: sums.cdf(i),
+                pdf: match func.get(i) {
+                    None => 0.0,
+                    Some(_) if uniform => 1.0,
+                    Some(&v) => (v as f64 * inv) as f32,
+                },
+            })
+            .collect();
+        let guide = GuideTable::new(bins.len(), |i| bins[i].cdf);
         Self {
             func,
-            pdf,
-            cdf,
+            bins,
             func_int,
+            guide,
         }
+    }
+
+    /// The CDF entry at the start of bin `i` (`count()` for the end, 1).
+    #[inline]
+    fn cdf_at(&self, i: usize) -> f32 {
+        self.bins[i].cdf
+    }
+
+    /// The search for the bin of `u` in `[0, 1)`: pbrt's `FindInterval`.
+    #[inline]
+    fn find(&self, u: f32) -> usize {
+        self.guide
+            .find_interval(self.bins.len(), u, |i| self.bins[i].cdf)
+    }
+
+    /// The CDF: `count() + 1` entries from 0 to 1.
+    #[cfg(test)]
+    pub(crate) fn cdf(&self) -> Vec<f32> {
+        self.bins.iter().map(|b| b.cdf).collect()
     }
 
     /// Number of bins.
@@ -133,25 +171,25 @@ impl Distribution1D {
     #[inline]
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
         let u = sanitise_u(u);
-        let offset = find_interval(&self.cdf, u);
-        let c0 = self.cdf[offset];
-        let width = self.cdf[offset + 1] - c0;
+        let offset = self.find(u);
+        let c0 = self.cdf_at(offset);
+        let width = self.cdf_at(offset + 1) - c0;
         let mut du = u - c0;
         if width > 0.0 {
             du /= width;
         }
         let du = du.clamp(0.0, ONE_MINUS_EPSILON);
         let x = point_in_bin(offset, du, self.count());
-        (x, self.pdf[offset], offset)
+        (x, self.bins[offset].pdf, offset)
     }
 
     /// Samples a bin; returns `(index, probability, u remapped to [0,1))`.
     #[inline]
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
         let u = sanitise_u(u);
-        let offset = find_interval(&self.cdf, u);
-        let c0 = self.cdf[offset];
-        let width = self.cdf[offset + 1] - c0;
+        let offset = self.find(u);
+        let c0 = self.cdf_at(offset);
+        let width = self.cdf_at(offset + 1) - c0;
         let ur = if width > 0.0 {
             ((u - c0) / width).clamp(0.0, ONE_MINUS_EPSILON)
         } else {
@@ -163,13 +201,13 @@ impl Distribution1D {
     /// Probability of bin `i` under `sample_discrete`.
     #[inline]
     pub fn discrete_pdf(&self, i: usize) -> f32 {
-        self.pdf[i] / self.count() as f32
+        self.bins[i].pdf / self.count() as f32
     }
 
     /// Density at `x` in `[0,1]` (values outside are clamped to the end bins).
     #[inline]
     pub fn pdf(&self, x: f32) -> f32 {
-        self.pdf[self.bin(x)]
+        self.bins[self.bin(x)].pdf
     }
 
     #[inline]
@@ -283,7 +321,7 @@ impl Distribution2D {
     #[inline]
     pub fn pdf(&self, p: Vec2) -> f32 {
         let iv = self.marginal.bin(p.y);
-        self.marginal.pdf[iv] * self.conditional[iv].pdf(p.x)
+        self.marginal.bins[iv].pdf * self.conditional[iv].pdf(p.x)
     }
 
     pub fn marginal(&self) -> &Distribution1D {

@@ -6,6 +6,7 @@ pub mod alias;
 pub mod bounded_fast;
 pub mod chi2;
 pub mod distribution;
+pub mod distribution_guide;
 pub mod interpolation;
 pub mod rng;
 pub mod warps;
