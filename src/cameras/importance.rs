@@ -103,9 +103,16 @@ impl<'c> CameraImportance<'c> {
     /// The viewing direction in world space at `time`.
     #[inline]
     pub fn forward(&self, time: f32) -> Vec3 {
+        self.forward_of(|| self.frame(time))
+    }
+
+    /// The viewing direction: a still camera's, or that of the frame
+    /// `frame` gives.
+    #[inline]
+    fn forward_of(&self, frame: impl FnOnce() -> Affine3A) -> Vec3 {
         match &self.still {
             Some((_, forward)) => *forward,
-            None => view_direction(&self.frame(time)),
+            None => view_direction(&frame()),
         }
     }
 
@@ -182,10 +189,7 @@ impl<'c> CameraImportance<'c> {
         let m = self.frame(time);
         let lens = self.lens_radius * concentric_sample_disk(u);
         let p_lens = m.transform_point3(Vec3::new(lens.x, lens.y, 0.0));
-        let n = match &self.still {
-            Some((_, forward)) => *forward,
-            None => view_direction(&m),
-        };
+        let n = self.forward_of(|| m);
         let v = p_lens - p;
         let dist = v.length();
         if dist == 0.0 || dist.is_nan() {

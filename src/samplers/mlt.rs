@@ -103,6 +103,14 @@ impl Ahead {
         self.normals = true;
     }
 
+    /// The next number, drawn now: only while no batch is pending (after
+    /// a restart, for a sampler that never draws ahead).
+    #[inline]
+    fn uniform_unbatched(&mut self) -> f32 {
+        debug_assert_eq!(self.next, AHEAD, "a batch is pending");
+        self.rng.uniform_f32()
+    }
+
     /// The next number, uniform in [0, 1).
     #[inline]
     fn uniform_f32(&mut self) -> f32 {
@@ -234,7 +242,7 @@ impl MltSampler {
         if !self.keep {
             // Drawn one at a time (a bootstrap path reads few values and
             // asks for no normal variates): `restart` emptied the batch.
-            return self.rng.rng.uniform_f32();
+            return self.rng.uniform_unbatched();
         }
         let i = self.stream + STREAMS * self.index;
         self.index += 1;
