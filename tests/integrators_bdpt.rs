@@ -130,6 +130,41 @@ fn the_image_with_its_splats_does_not_depend_on_the_thread_count() {
     common::assert_bit_identical(&a, &b, "1 and 2 threads");
 }
 
+/// The s = 1 strategies' values drawn ahead, with their sky samples
+/// taken together (speed only), give the plain code's image bit for bit
+/// with the same rays: under an image sky from inside a homogeneous medium
+/// with a spot light beside it (the power distribution chooses either),
+/// with the sky sampled by the CDF search and by alias tables,
+/// each with a global and a pixel sampler; and on an image-lit scene
+/// without media.
+#[test]
+fn strategies_that_draw_ahead_give_the_plain_image() {
+    let file = common::repo().join("scenes/bdpt/sky-fog.pbrt");
+    let text = std::fs::read_to_string(&file).unwrap();
+    for sampling in ["map", "alias"] {
+        for sampler in ["sobol", "02sequence"] {
+            let text = text
+                .replace(
+                    "[\"../textures-env/sky.exr\"]",
+                    &format!("[\"../textures-env/sky.exr\"] \"string sampling\" \"{sampling}\""),
+                )
+                .replace("Sampler \"sobol\"", &format!("Sampler \"{sampler}\""));
+            let d = pbrs::loader::load_scene_str(&text, &file)
+                .unwrap_or_else(|f| panic!("{:?}", f.errors))
+                .scene;
+            let what = format!("sky-fog {sampling} {sampler}");
+            assert!(text.contains(sampling) && text.contains(sampler), "{what}");
+            common::assert_fast_is_scalar(&sized(d, 20, 20, 8), &what);
+        }
+    }
+    let mut d = sized(load("scenes/textures-env/textures-env.pbrt"), 20, 20, 8);
+    d.integrator = IntegratorSettings::Bdpt(BdptSettings {
+        max_depth: 5,
+        ..Default::default()
+    });
+    common::assert_fast_is_scalar(&d, "textures-env");
+}
+
 #[test]
 fn sample_parts_carry_their_splats_and_tiles_are_refused() {
     let d = sized(load("scenes/bdpt/caustic.pbrt"), 16, 16, 8);

@@ -641,7 +641,7 @@ impl Level {
 
 /// Asks for the cache line at `p` (a hint: nothing is read).
 #[inline(always)]
-fn prefetch<T>(p: *const T) {
+pub(crate) fn prefetch<T>(p: *const T) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: a prefetch reads nothing and cannot fault.
     unsafe {

@@ -33,6 +33,7 @@
 //! only the BSDF of such a material: its dielectric boundary).
 
 pub(super) mod connect;
+mod draw_ahead;
 pub(crate) mod vertex;
 
 use super::common::light_sampler;
@@ -42,7 +43,7 @@ use super::{MAX_DEPTH, PIXEL_BOUNDS};
 use crate::cameras::CameraImportance;
 use crate::geometry::{Bounds2i, Ray, RayDiff};
 use crate::integrators::RenderScene;
-use crate::lights::LightSampler;
+use crate::lights::{Light, LightSampler};
 use crate::samplers::Sampler;
 use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
@@ -183,6 +184,8 @@ fn buffer_index(s: usize, t: usize) -> usize {
 pub struct Subpaths {
     pub(super) camera: Vec<Vertex<'static>>,
     pub(super) light: Vec<Vertex<'static>>,
+    /// The s = 1 strategies' values drawn ahead.
+    pub(super) drawn: Vec<Option<connect::LightDraw>>,
 }
 
 /// An empty vector's storage for vertices of another lifetime (the same
@@ -197,6 +200,10 @@ pub(super) fn recycle<'x, 'y>(mut v: Vec<Vertex<'x>>) -> Vec<Vertex<'y>> {
 /// sample bounds (where the camera's importance is not zero) and the
 /// scene's bounding radius.
 pub struct Bdpt {
+    /// Whether the s = 1 strategies draw their values ahead
+    /// (`draw_ahead::draw_ahead`, where `draw_ahead::draws_ahead`; not in the
+    /// scalar loop, the tests' plain reference).
+    draw_ahead: bool,
     settings: BdptSettings,
     lights: LightSampler,
     sample_bounds: Option<Bounds2i>,
@@ -204,8 +211,9 @@ pub struct Bdpt {
 }
 
 impl Bdpt {
-    pub fn new(settings: &BdptSettings, scene: &RenderScene, _scalar: bool) -> Bdpt {
+    pub fn new(settings: &BdptSettings, scene: &RenderScene, scalar: bool) -> Bdpt {
         Bdpt {
+            draw_ahead: !scalar && draw_ahead::draws_ahead(scene),
             settings: *settings,
             lights: light_sampler(settings.light_sample_strategy, scene),
             sample_bounds: None,
@@ -233,6 +241,18 @@ impl Ctx<'_> {
         let s = self.scene;
         self.lights
             .pmf(self.p_camera, Vec3::ZERO, i, &s.lights, &s.aggregate)
+    }
+
+    /// Asks for the cache lines of the infinite lights' radiance and
+    /// density along a ray that has left the scene in direction `d`, which
+    /// its strategies read after the light subpath is made.
+    #[inline]
+    pub fn prefetch_sky(&self, d: Vec3) {
+        for &i in &self.scene.infinite_lights {
+            if let Light::Infinite(l) = &self.scene.lights[i as usize] {
+                l.map.prefetch(d);
+            }
+        }
     }
 
     /// pbrt-v3's `InfiniteLightDensity`: the density of the infinite
@@ -335,13 +355,24 @@ impl Bdpt {
             Vec2::ZERO
         };
         let mut l = Vec3::ZERO;
+        let ahead = self.draw_ahead && n_light >= 1;
+        let mut drawn = std::mem::take(&mut scratch.bdpt.drawn);
+        drawn.clear();
         for t in 1..=n_camera {
+            if t == 2 && ahead {
+                draw_ahead::draw_ahead(c, &cam[..n_camera], max_depth, sampler, &mut drawn);
+            }
             for s in 0..=n_light {
                 let depth = (t + s) as i64 - 2;
                 if (s == 1 && t == 1) || depth < 0 || depth > max_depth as i64 {
                     continue;
                 }
-                let st = connect::connect(c, light, cam, s, t, sampler, scratch);
+                let d = if s == 1 && t >= 2 {
+                    drawn.get(t - 2).copied().flatten()
+                } else {
+                    None
+                };
+                let st = connect::connect(c, light, cam, (s, t), d, sampler, scratch);
                 let at = st.p_raster.unwrap_or(p_film);
                 if self.settings.visualizes() {
                     let value = if self.settings.visualize_weights {
@@ -368,6 +399,7 @@ impl Bdpt {
                 }
             }
         }
+        scratch.bdpt.drawn = drawn;
         l
     }
 }

@@ -573,7 +573,7 @@ impl PathMaker<'_, '_> {
             };
             if n_light == s {
                 mlt(sampler).start_stream(CONNECTION_STREAM);
-                let st = connect::connect(&c, &mut light, &mut cam, s, t, sampler, scratch);
+                let st = connect::connect(&c, &mut light, &mut cam, (s, t), None, sampler, scratch);
                 let p = if t == 1 {
                     st.p_raster.unwrap_or(p_raster)
                 } else {

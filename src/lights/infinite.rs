@@ -118,6 +118,25 @@ pub struct InfiniteLight {
 }
 
 impl InfiniteLight {
+    /// `sample_li` at `r` from the map's sample (`EnvMap::sample`, which
+    /// does not depend on `r`, drawn beforehand).
+    #[inline]
+    pub fn sample_li_from(
+        &self,
+        r: &SurfacePoint,
+        drawn: Option<EnvSample>,
+    ) -> Option<LightSample> {
+        let (wi, li, pdf) = drawn?;
+        // Anything in the way occludes an infinitely distant light.
+        let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
+        Some(LightSample {
+            li,
+            wi,
+            pdf,
+            shadow,
+        })
+    }
+
     /// pbrt-v3's `CreateInfiniteLight`, with `ctm` as light-to-world.
     pub fn new(p: &ParamValues, ctm: DMat4, report: &mut dyn Report) -> InfiniteLight {
         let l = p.spectrum("L") * p.spectrum("scale");
@@ -177,15 +196,7 @@ impl LightModel for InfiniteLight {
 
     #[inline]
     fn sample_li(&self, r: &SurfacePoint, u: Vec2, _geom: &Aggregate) -> Option<LightSample> {
-        let (wi, li, pdf) = self.map.sample(u)?;
-        // Anything in the way occludes an infinitely distant light.
-        let shadow = spawn_ray(r.p, r.p_error, r.n, wi);
-        Some(LightSample {
-            li,
-            wi,
-            pdf,
-            shadow,
-        })
+        self.sample_li_from(r, self.map.sample(u))
     }
 
     #[inline]
@@ -227,7 +238,7 @@ impl LightModel for InfiniteLight {
 
 /// One level of the MIP map: RGB texels, row-major, row 0 at t = 0.
 #[derive(Clone, Debug)]
-struct Level {
+pub(super) struct Level {
     w: usize,
     h: usize,
     texels: Vec<Vec3>,
@@ -240,6 +251,24 @@ impl Level {
         let s = s.rem_euclid(self.w as i64) as usize;
         let t = t.rem_euclid(self.h as i64) as usize;
         self.texels[t * self.w + s]
+    }
+
+    /// Asks for the cache lines `bilerp(st)` reads (a hint).
+    #[inline]
+    pub(super) fn prefetch(&self, st: Vec2) {
+        let s = st.x * self.w as f32 - 0.5;
+        let t = st.y * self.h as f32 - 0.5;
+        let (sa, sb) = wrap_pair(s.floor() as i64, self.w);
+        let (ra, rb) = wrap_pair(t.floor() as i64, self.h);
+        let tx = self.texels.as_ptr();
+        for i in [
+            ra * self.w + sa,
+            ra * self.w + sb,
+            rb * self.w + sa,
+            rb * self.w + sb,
+        ] {
+            crate::accel::prefetch(tx.wrapping_add(i));
+        }
     }
 
     /// pbrt-v3's `triangle`: bilinear between the four nearest texel centres.
@@ -279,15 +308,15 @@ fn wrap_pair(i: i64, n: usize) -> (usize, usize) {
 /// distribution and transform.
 #[derive(Debug)]
 pub struct EnvMap {
-    levels: Vec<Level>,
-    distribution: Distribution2D,
+    pub(super) levels: Vec<Level>,
+    pub(super) distribution: Distribution2D,
     /// The alias tables of `distribution` (`sampling "alias"` only).
     alias: Option<Box<Alias2D>>,
     /// The radiance of a one-texel map (no map, or a 1 × 1 image): then
     /// every lookup is this value and the sampling distribution uniform in
     /// (φ, θ), so lookups and sampling skip the map's arithmetic.
-    constant: Option<Vec3>,
-    sampling: EnvSampling,
+    pub(super) constant: Option<Vec3>,
+    pub(super) sampling: EnvSampling,
     light_to_world: Mat3,
     world_to_light: Mat3,
 }
@@ -355,6 +384,10 @@ fn resample_pow2(img: &[Vec3], w: usize, h: usize) -> (Vec<Vec3>, usize, usize) 
     }
     (out, nw, nh)
 }
+
+/// A sample of an environment map: the world direction towards the light,
+/// its radiance and its solid-angle density.
+pub type EnvSample = (Vec3, Vec3, f32);
 
 impl EnvMap {
     /// The map `image` (raw values) times `l`, or `l` alone; `light_to_world`
@@ -476,18 +509,46 @@ impl EnvMap {
         self.levels[0].bilerp(Self::st(w))
     }
 
+    /// Asks for the cache lines that `le(d)` and `pdf(d)` read (a hint):
+    /// for a ray that has left the scene, whose radiance and density are
+    /// wanted later.
+    #[inline]
+    pub fn prefetch(&self, d: Vec3) {
+        if self.constant.is_some() {
+            return;
+        }
+        let w = (self.world_to_light * d).normalize();
+        let st = Self::st(w);
+        self.levels[0].prefetch(st);
+        if self.sampling != EnvSampling::Uniform {
+            self.distribution.prefetch_pdf(st);
+        }
+    }
+
     /// A direction towards the light, its radiance and solid-angle density.
     #[inline]
-    pub fn sample(&self, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
+    pub fn sample(&self, u: Vec2) -> Option<EnvSample> {
         if self.sampling == EnvSampling::Uniform {
             let wi = uniform_sample_sphere(u);
             return Some((wi, self.le(wi), uniform_sphere_pdf()));
         }
-        let (uv, map_pdf) = match (self.constant, &self.alias) {
+        let (uv, map_pdf) = self.sample_map(u);
+        self.sample_direction(uv, map_pdf)
+    }
+
+    /// `sample`'s point in the map and its density there.
+    #[inline]
+    pub(super) fn sample_map(&self, u: Vec2) -> (Vec2, f32) {
+        match (self.constant, &self.alias) {
             (Some(_), _) => (u, 1.0),
             (None, Some(alias)) => alias.sample_continuous(u),
             (None, None) => self.distribution.sample_continuous(u),
-        };
+        }
+    }
+
+    /// `sample`'s direction, radiance and density from its point in the map.
+    #[inline]
+    pub(super) fn sample_direction(&self, uv: Vec2, map_pdf: f32) -> Option<EnvSample> {
         if map_pdf == 0.0 {
             return None;
         }
@@ -544,7 +605,7 @@ impl EnvMap {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::scene::SampleDepth;
 
@@ -557,7 +618,7 @@ mod tests {
     }
 
     /// A lopsided map: a bright spot, a dark band and a smooth gradient.
-    fn lumpy(w: u32, h: u32) -> RgbImage {
+    pub(in crate::lights) fn lumpy(w: u32, h: u32) -> RgbImage {
         image(w, h, |x, y| {
             let base = 0.2 + (x as f32 / w as f32) + 0.5 * (y as f32 / h as f32);
             let spot = if x == w / 3 && y == h / 4 { 200.0 } else { 0.0 };
@@ -566,7 +627,7 @@ mod tests {
         })
     }
 
-    fn rotated() -> DMat4 {
+    pub(in crate::lights) fn rotated() -> DMat4 {
         DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2) * DMat4::from_rotation_z(0.3)
     }
 

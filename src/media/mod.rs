@@ -212,6 +212,11 @@ impl Medium {
         )
     }
 
+    /// Whether `tr` draws sample values (ratio tracking through a grid).
+    pub fn tr_draws(&self) -> bool {
+        matches!(self.density, Density::Grid(_))
+    }
+
     /// Transmittance along `ray` from 0 to `ray.t_max` (pbrt-v3's `Tr`).
     #[inline]
     pub fn tr(&self, ray: &Ray, sampler: &mut Sampler) -> Vec3 {

@@ -324,6 +324,35 @@ impl Distribution2D {
         self.marginal.bins[iv].pdf * self.conditional[iv].pdf(p.x)
     }
 
+    /// Asks for the cache line of `pdf(p)`'s density (a hint).
+    #[inline]
+    pub fn prefetch_pdf(&self, p: Vec2) {
+        let iv = self.marginal.bin(p.y);
+        let row = &self.conditional[iv];
+        crate::accel::prefetch(row.bins.as_ptr().wrapping_add(row.bin(p.x)));
+    }
+
+    /// The first of two hints before `sample_continuous(u)`: asks for the
+    /// guide table entries of the row that `u` chooses. Several samples'
+    /// hints given together let their cache misses overlap.
+    #[inline]
+    pub fn prefetch_sample_row(&self, u: Vec2) {
+        let v = self.marginal.find(sanitise_u(u.y));
+        self.conditional[v].guide.prefetch(sanitise_u(u.x));
+    }
+
+    /// The second hint (once the first's lines have arrived): asks for the
+    /// CDF entries the row's search reads.
+    #[inline]
+    pub fn prefetch_sample_bins(&self, u: Vec2) {
+        let row = &self.conditional[self.marginal.find(sanitise_u(u.y))];
+        let (lo, hi) = row.guide.cell(sanitise_u(u.x));
+        let bins = row.bins.as_ptr();
+        for i in [lo, (lo + hi) / 2, hi] {
+            crate::accel::prefetch(bins.wrapping_add(i.min(row.bins.len() - 1)));
+        }
+    }
+
     pub fn marginal(&self) -> &Distribution1D {
         &self.marginal
     }

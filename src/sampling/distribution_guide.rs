@@ -59,14 +59,28 @@ impl GuideTable {
         }
     }
 
+    /// The range of CDF indices a search for `u` in [0, 1) bisects.
+    #[inline]
+    pub fn cell(&self, u: f32) -> (usize, usize) {
+        let j = (u * self.cells) as usize;
+        (self.first[j] as usize, self.first[j + 1] as usize)
+    }
+
+    /// Asks for the cache line of the table entries `find_interval(.., u,
+    /// ..)` reads (a hint).
+    #[inline]
+    pub fn prefetch(&self, u: f32) {
+        let j = (u * self.cells) as usize;
+        crate::accel::prefetch(self.first.as_ptr().wrapping_add(j));
+    }
+
     /// The index of the last entry of the CDF (the one the table was made
     /// from, `len` entries read through `cdf`) at or below `u` in [0, 1),
     /// at most `len - 2`: pbrt's `FindInterval`.
     #[inline]
     pub fn find_interval(&self, len: usize, u: f32, cdf: impl Fn(usize) -> f32) -> usize {
         debug_assert!((0.0..1.0).contains(&u));
-        let j = (u * self.cells) as usize;
-        let (lo, hi) = (self.first[j] as usize, self.first[j + 1] as usize);
+        let (lo, hi) = self.cell(u);
         // The first index in [lo, hi] whose value exceeds u, by a bisection
         // whose steps are selects, not branches: a cell's few steps are
         // data-dependent coin flips that a branch predictor loses. The

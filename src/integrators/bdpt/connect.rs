@@ -8,7 +8,7 @@ use super::Ctx;
 use crate::geometry::{spawn_ray_to, Ray};
 use crate::integrators::volpath::transmittance;
 use crate::integrators::Scratch;
-use crate::lights::Light;
+use crate::lights::{EnvSample, Light};
 use crate::samplers::Sampler;
 use glam::{Vec2, Vec3};
 
@@ -47,6 +47,35 @@ fn g(c: &Ctx, v0: &Vertex, v1: &Vertex, sampler: &mut Sampler, scratch: &mut Scr
     g * tr(c, v0, v1, sampler, scratch)
 }
 
+/// The sample values of an s = 1 strategy: the light chosen (with its
+/// probability) and the 2D value of its sample; for an infinite light,
+/// possibly its sample already taken (`EnvMap::sample`, which does not
+/// depend on the vertex it is taken from).
+#[derive(Clone, Copy)]
+pub(crate) struct LightDraw {
+    pub chosen: Option<(u32, f32)>,
+    pub u: Vec2,
+    pub env: Option<Option<EnvSample>>,
+}
+
+/// Draws an s = 1 strategy's values as pbrt-v3 does: the light choice,
+/// then the light sample's 2D value.
+pub(super) fn draw_light(c: &Ctx, sampler: &mut Sampler) -> LightDraw {
+    let u = sampler.get_1d();
+    let chosen = c.lights.sample(
+        c.p_camera,
+        Vec3::ZERO,
+        u,
+        &c.scene.lights,
+        &c.scene.aggregate,
+    );
+    LightDraw {
+        chosen,
+        u: sampler.get_2d(),
+        env: None,
+    }
+}
+
 /// Strategy (s, t) over the subpaths `light` and `camera`. A strategy
 /// that samples a new endpoint (t = 1: a camera vertex, s = 1: a light
 /// vertex) builds it past the end of that subpath, which is as long as it
@@ -55,8 +84,8 @@ pub(crate) fn connect<'a>(
     c: &Ctx<'a>,
     light: &mut Vec<Vertex<'a>>,
     camera: &mut Vec<Vertex<'a>>,
-    s: usize,
-    t: usize,
+    (s, t): (usize, usize),
+    drawn: Option<LightDraw>,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
 ) -> Strategy {
@@ -115,17 +144,9 @@ pub(crate) fn connect<'a>(
     } else if s == 1 {
         let pt = &camera[t - 1];
         if pt.is_connectible(c) {
-            let u = sampler.get_1d();
-            let chosen = c.lights.sample(
-                c.p_camera,
-                Vec3::ZERO,
-                u,
-                &c.scene.lights,
-                &c.scene.aggregate,
-            );
-            let u2 = sampler.get_2d();
-            if let Some((i, pmf)) = chosen {
-                if let Some((shadow, wi)) = light_vertex(c, pt, i, pmf, u2, light) {
+            let d = drawn.unwrap_or_else(|| draw_light(c, sampler));
+            if let Some((i, pmf)) = d.chosen {
+                if let Some((shadow, wi)) = light_vertex(c, pt, (i, pmf), d, light) {
                     sampled = true;
                     let v = &light[light.len() - 1];
                     let (f, pdf) = pt.f(v, Mode::Radiance);
@@ -188,9 +209,8 @@ struct Densities {
 fn light_vertex<'a>(
     c: &Ctx<'a>,
     pt: &Vertex<'a>,
-    i: u32,
-    pmf: f32,
-    u: Vec2,
+    (i, pmf): (u32, f32),
+    d: LightDraw,
     path: &mut Vec<Vertex<'a>>,
 ) -> Option<(Ray, Vec3)> {
     let light = &c.scene.lights[i as usize];
@@ -201,9 +221,12 @@ fn light_vertex<'a>(
         ns: pt.ns,
     };
     let (ls, p, n) = match light {
-        Light::Diffuse(d) => d.sample_li_at(&r, u, &c.scene.aggregate)?,
+        Light::Diffuse(l) => l.sample_li_at(&r, d.u, &c.scene.aggregate)?,
         _ => {
-            let ls = light.sample_li(&r, u, &c.scene.aggregate)?;
+            let ls = match (light, d.env) {
+                (Light::Infinite(l), Some(env)) => l.sample_li_from(&r, env)?,
+                _ => light.sample_li(&r, d.u, &c.scene.aggregate)?,
+            };
             let p = if ls.shadow.t_max.is_finite() {
                 ls.shadow.o + ls.shadow.d
             } else {

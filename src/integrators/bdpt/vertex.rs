@@ -498,6 +498,7 @@ pub(crate) fn random_walk<'a>(
         } else {
             let Some(h) = hit.as_ref() else {
                 if mode == Mode::Radiance {
+                    c.prefetch_sky(ray.d);
                     push_at(path, Kind::Light, ray.o + ray.d, -ray.d, beta, (time, medium));
                     path[prev + 1].pdf_fwd = pdf_fwd;
                     bounces += 1;
