@@ -19,6 +19,7 @@ pub mod pixel;
 pub mod radical_fast;
 pub mod random;
 pub mod sobol;
+pub mod sobol_fast;
 pub mod sobolmatrices;
 pub mod stratified;
 pub mod zerotwosequence;

@@ -25,6 +25,8 @@ pub struct SobolMatrices {
     /// Column `j` of dimension `d` is `m32[d * SOBOL_MATRIX_SIZE + j]`: bit
     /// 31 is the first digit after the binary point.
     pub m32: Vec<u32>,
+    /// `m32` as tables per four bits of the index (speed only).
+    pub nibbles: super::sobol_fast::SobolNibbles,
     /// `vdc[m - 1][c]`: the first `m` digits of dimensions 0 and 1 (packed
     /// `x << m | y`) that index bit `2m + c` contributes (pbrt-v3's
     /// `VdCSobolMatrices`; zero where `2m + c` is past the 52 columns).
@@ -93,7 +95,7 @@ fn columns_52() -> Vec<[u64; SOBOL_MATRIX_SIZE]> {
 
 fn build() -> SobolMatrices {
     let dims = columns_52();
-    let m32 = dims
+    let m32: Vec<u32> = dims
         .iter()
         .flat_map(|d| d.iter().map(|&c| (c >> (SOBOL_MATRIX_SIZE - 32)) as u32))
         .collect();
@@ -111,7 +113,13 @@ fn build() -> SobolMatrices {
         vdc.push(v);
         vdc_inv.push(invert((0..2 * m).map(packed).collect()));
     }
-    SobolMatrices { m32, vdc, vdc_inv }
+    let nibbles = super::sobol_fast::SobolNibbles::new(&m32);
+    SobolMatrices {
+        m32,
+        nibbles,
+        vdc,
+        vdc_inv,
+    }
 }
 
 /// The inverse of the `n × n` GF(2) matrix whose column `j` is `cols[j]`,
@@ -182,9 +190,17 @@ pub fn sobol_interval_to_index(t: &SobolMatrices, m: u32, mut frame: u64, p: (u3
 }
 
 /// pbrt-v3's `SobolSampleFloat`: dimension `dim` (< 1024) of sample `a`,
-/// XOR-scrambled by `scramble`.
+/// XOR-scrambled by `scramble` (the columns of `a`'s set bits XORed,
+/// through the tables of `sobol_fast`).
 #[inline]
-pub fn sobol_sample(t: &SobolMatrices, mut a: u64, dim: usize, scramble: u32) -> f32 {
+pub fn sobol_sample(t: &SobolMatrices, a: u64, dim: usize, scramble: u32) -> f32 {
+    to_unit(t.nibbles.bits(a, dim, scramble))
+}
+
+/// pbrt-v3's `SobolSampleFloat`: dimension `dim` (< 1024) of sample `a`,
+/// XOR-scrambled by `scramble`.
+#[cfg(test)]
+pub fn sobol_sample_plain(t: &SobolMatrices, mut a: u64, dim: usize, scramble: u32) -> f32 {
     let mut v = scramble;
     let cols = &t.m32[dim * SOBOL_MATRIX_SIZE..(dim + 1) * SOBOL_MATRIX_SIZE];
     // One step per set bit (the same XORs as pbrt-v3's loop over all bits).
