@@ -1,6 +1,8 @@
-//! Environment-map micro-benchmark: ns per `sample`, `le` and `pdf` of an
-//! infinite light's map (an image file, scaled by 3), single-threaded, on
-//! uniformly random sample values and directions, three rounds. With
+//! Environment-map micro-benchmark: ns per `sample` (one at a time, and
+//! three at once through `EnvMap::sample_each`, as bdpt takes them), `le`
+//! and `pdf` of an infinite light's map (an image file, scaled by 3),
+//! single-threaded, on uniformly random sample values and directions,
+//! three rounds. With
 //! `ALIAS` set in the environment the map is sampled by its alias tables
 //! (`"string sampling" "alias"`) instead of pbrt-v3's CDF search.
 //!

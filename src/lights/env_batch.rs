@@ -17,9 +17,10 @@ use glam::Vec2;
 pub const SAMPLE_EACH_MAX: usize = 8;
 
 impl EnvMap {
-    /// Whether `sample` reads tables too large for the cache: a map of
-    /// more than one texel sampled by its distribution (so that
-    /// [`EnvMap::sample_each`] pays).
+    /// Whether `sample` reads the map's sampling tables and texels (a map
+    /// of more than one texel sampled by its distribution or alias tables):
+    /// what [`EnvMap::sample_each`] overlaps, tables larger than the cache
+    /// for a large map.
     pub fn samples_large_tables(&self) -> bool {
         self.constant.is_none() && self.sampling != EnvSampling::Uniform
     }

@@ -79,7 +79,8 @@ pub(super) fn draw_light(c: &Ctx, sampler: &mut Sampler) -> LightDraw {
 /// Strategy (s, t) over the subpaths `light` and `camera`. A strategy
 /// that samples a new endpoint (t = 1: a camera vertex, s = 1: a light
 /// vertex) builds it past the end of that subpath, which is as long as it
-/// was again when this returns.
+/// was again when this returns. `drawn`: an s = 1 strategy's values if
+/// they were drawn ahead (`draw_ahead`); without them it draws its own.
 pub(crate) fn connect<'a>(
     c: &Ctx<'a>,
     light: &mut Vec<Vertex<'a>>,

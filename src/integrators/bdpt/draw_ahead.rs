@@ -17,8 +17,8 @@ use glam::Vec2;
 /// Whether the s = 1 strategies of t ≥ 2 may draw their values before the
 /// strategies of t = 2 run ([`draw_ahead`]): nothing in between draws (the
 /// strategies of t ≥ 2 with s ≠ 1 draw only for transmittance through a
-/// grid medium), and there is an image-mapped infinite light whose
-/// samples read tables too large for the cache.
+/// grid medium), and there is an image-mapped infinite light sampled by
+/// its tables (`EnvMap::samples_large_tables`).
 pub(crate) fn draws_ahead(scene: &RenderScene) -> bool {
     let large = |&i: &u32| match &scene.lights[i as usize] {
         Light::Infinite(l) => l.map.samples_large_tables(),
