@@ -253,20 +253,28 @@ impl Level {
         self.texels[t * self.w + s]
     }
 
+    /// The four texels around `st` (indices at rows t0, t0 + 1 and
+    /// columns s0, s0 + 1, in that order: (t0, s0), (t0 + 1, s0),
+    /// (t0, s0 + 1), (t0 + 1, s0 + 1)) and the offsets (ds, dt) from the
+    /// first.
+    #[inline(always)]
+    fn corners(&self, st: Vec2) -> ([usize; 4], f32, f32) {
+        let s = st.x * self.w as f32 - 0.5;
+        let t = st.y * self.h as f32 - 0.5;
+        let (s0, t0) = (s.floor(), t.floor());
+        // The texels' columns and rows with the wrap applied (divisions
+        // only where a neighbour wraps).
+        let (sa, sb) = wrap_pair(s0 as i64, self.w);
+        let (ra, rb) = wrap_pair(t0 as i64, self.h);
+        let (ra, rb) = (ra * self.w, rb * self.w);
+        ([ra + sa, rb + sa, ra + sb, rb + sb], s - s0, t - t0)
+    }
+
     /// Asks for the cache lines `bilerp(st)` reads (a hint).
     #[inline]
     pub(super) fn prefetch(&self, st: Vec2) {
-        let s = st.x * self.w as f32 - 0.5;
-        let t = st.y * self.h as f32 - 0.5;
-        let (sa, sb) = wrap_pair(s.floor() as i64, self.w);
-        let (ra, rb) = wrap_pair(t.floor() as i64, self.h);
         let tx = self.texels.as_ptr();
-        for i in [
-            ra * self.w + sa,
-            ra * self.w + sb,
-            rb * self.w + sa,
-            rb * self.w + sb,
-        ] {
+        for i in self.corners(st).0 {
             crate::accel::prefetch(tx.wrapping_add(i));
         }
     }
@@ -274,20 +282,12 @@ impl Level {
     /// pbrt-v3's `triangle`: bilinear between the four nearest texel centres.
     #[inline]
     fn bilerp(&self, st: Vec2) -> Vec3 {
-        let s = st.x * self.w as f32 - 0.5;
-        let t = st.y * self.h as f32 - 0.5;
-        let (s0, t0) = (s.floor(), t.floor());
-        let (ds, dt) = (s - s0, t - t0);
-        // The texels' columns and rows with the wrap applied (divisions
-        // only where a neighbour wraps).
-        let (sa, sb) = wrap_pair(s0 as i64, self.w);
-        let (ra, rb) = wrap_pair(t0 as i64, self.h);
-        let (ra, rb) = (ra * self.w, rb * self.w);
+        let ([a, b, c, d], ds, dt) = self.corners(st);
         let tx = &self.texels;
-        (1.0 - ds) * (1.0 - dt) * tx[ra + sa]
-            + (1.0 - ds) * dt * tx[rb + sa]
-            + ds * (1.0 - dt) * tx[ra + sb]
-            + ds * dt * tx[rb + sb]
+        (1.0 - ds) * (1.0 - dt) * tx[a]
+            + (1.0 - ds) * dt * tx[b]
+            + ds * (1.0 - dt) * tx[c]
+            + ds * dt * tx[d]
     }
 }
 
