@@ -453,17 +453,15 @@ impl EnvMap {
         };
         if sampling != EnvSampling::Uniform {
             let (dw, dh) = (2 * w, 2 * h);
-            let fwidth = 0.5 / dw.min(dh) as f32;
-            let mut f = vec![0.0f32; dw * dh];
-            f.par_chunks_mut(dw).enumerate().for_each(|(v, row)| {
+            let level = map.filter_level(0.5 / dw.min(dh) as f32);
+            map.distribution = Distribution2D::from_rows(dw, dh, |v, row| {
                 let vp = (v as f32 + 0.5) / dh as f32;
                 let sin_theta = (PI * (v as f32 + 0.5) / dh as f32).sin();
                 for (u, out) in row.iter_mut().enumerate() {
                     let up = (u as f32 + 0.5) / dw as f32;
-                    *out = luminance(map.lookup(Vec2::new(up, vp), fwidth)) * sin_theta;
+                    *out = luminance(map.lookup_level(Vec2::new(up, vp), level)) * sin_theta;
                 }
             });
-            map.distribution = Distribution2D::new(&f, dw, dh);
             if sampling == EnvSampling::Alias {
                 map.alias = Some(Box::new(Alias2D::new(&map.distribution)));
             }
@@ -474,8 +472,18 @@ impl EnvMap {
     /// pbrt-v3's `MIPMap::Lookup(st, width)`: trilinear between the levels
     /// around the filter width's level.
     fn lookup(&self, st: Vec2, width: f32) -> Vec3 {
+        self.lookup_level(st, self.filter_level(width))
+    }
+
+    /// The (fractional) MIP level of a filter width, as `lookup` finds it.
+    fn filter_level(&self, width: f32) -> f32 {
+        (self.levels.len() - 1) as f32 + width.max(1e-8).log2()
+    }
+
+    /// `lookup` at the level `filter_level` gives.
+    #[inline]
+    fn lookup_level(&self, st: Vec2, level: f32) -> Vec3 {
         let n = self.levels.len();
-        let level = (n - 1) as f32 + width.max(1e-8).log2();
         if level < 0.0 {
             self.levels[0].bilerp(st)
         } else if level >= (n - 1) as f32 {

@@ -14,8 +14,6 @@ const PARALLEL_2D: usize = 1 << 16;
 /// Piecewise-constant distribution over `[0, 1)` with `count()` equal bins.
 #[derive(Clone, Debug)]
 pub struct Distribution1D {
-    /// Sanitised function values (finite, >= 0).
-    func: Vec<f32>,
     /// `count + 1` entries: the CDF (`[0].cdf == 0`, `[count].cdf == 1`)
     /// and each bin's density over `[0, 1]` (integrating to 1; the last
     /// entry's is 0 and unused), side by side, so that a sample's search
@@ -97,32 +95,36 @@ pub(crate) fn point_in_bin(offset: usize, du: f32, n: usize) -> f32 {
 impl Distribution1D {
     /// Builds the distribution. An empty slice behaves as a single zero bin.
     pub fn new(f: &[f32]) -> Self {
-        let func: Vec<f32> = if f.is_empty() {
-            vec![0.0]
+        let zero = [0.0f32];
+        let f = if f.is_empty() { &zero[..] } else { f };
+        let n = f.len();
+        // The CDF as `DiscreteCdf` defines it (f64 prefix sums over their
+        // total, so long distributions keep their precision), the sums made
+        // twice in the same order instead of stored.
+        let total = f.iter().fold(0.0f64, |acc, &v| acc + sanitise(v) as f64);
+        let func_int = (total / n as f64) as f32;
+        let mut bins = Vec::with_capacity(n + 1);
+        if total > 0.0 && total.is_finite() {
+            let inv = n as f64 / total;
+            let mut acc = 0.0f64;
+            bins.extend(f.iter().map(|&v| {
+                let v = sanitise(v) as f64;
+                let bin = Bin {
+                    cdf: (acc / total) as f32,
+                    pdf: (v * inv) as f32,
+                };
+                acc += v;
+                bin
+            }));
         } else {
-            f.iter().map(|&v| sanitise(v)).collect()
-        };
-        let n = func.len();
-        // The CDF as `DiscreteCdf` defines it (f64 sums, so long
-        // distributions keep their precision).
-        let sums = DiscreteCdf::new(&func);
-        let total = sums.total();
-        let func_int = sums.func_int();
-        let inv = n as f64 / total;
-        let uniform = !(total > 0.0 && total.is_finite());
-        let bins: Vec<Bin> = (0..=n)
-            .map(|i| Bin {
-                cdf: sums.cdf(i),
-                pdf: match func.get(i) {
-                    None => 0.0,
-                    Some(_) if uniform => 1.0,
-                    Some(&v) => (v as f64 * inv) as f32,
-                },
-            })
-            .collect();
+            bins.extend((0..n).map(|i| Bin {
+                cdf: i as f32 / n as f32,
+                pdf: 1.0,
+            }));
+        }
+        bins.push(Bin { cdf: 1.0, pdf: 0.0 });
         let guide = GuideTable::new(bins.len(), |i| bins[i].cdf);
         Self {
-            func,
             bins,
             func_int,
             guide,
@@ -151,7 +153,7 @@ impl Distribution1D {
     /// Number of bins.
     #[inline]
     pub fn count(&self) -> usize {
-        self.func.len()
+        self.bins.len() - 1
     }
 
     /// Integral of the function over `[0, 1]` (0 for an all-zero function, which
@@ -159,12 +161,6 @@ impl Distribution1D {
     #[inline]
     pub fn func_int(&self) -> f32 {
         self.func_int
-    }
-
-    /// The sanitised function values.
-    #[inline]
-    pub fn func(&self) -> &[f32] {
-        &self.func
     }
 
     /// Samples `x` in `[0,1)`; returns `(x, pdf(x), bin index)`.
@@ -292,14 +288,28 @@ pub struct Distribution2D {
 impl Distribution2D {
     /// `f` is row-major: `nv` rows of `nu` values (`f.len()` must be `nu * nv`).
     pub fn new(f: &[f32], nu: usize, nv: usize) -> Self {
-        assert!(nu > 0 && nv > 0, "Distribution2D needs at least one bin");
         assert_eq!(f.len(), nu * nv, "Distribution2D: f.len() != nu * nv");
+        Self::from_rows(nu, nv, |v, row| {
+            row.copy_from_slice(&f[v * nu..(v + 1) * nu])
+        })
+    }
+
+    /// The distribution of `nv` rows of `nu` values, row `v` written by
+    /// `fill(v, row)` (so that the whole function is never stored).
+    pub fn from_rows(nu: usize, nv: usize, fill: impl Fn(usize, &mut [f32]) + Sync) -> Self {
+        assert!(nu > 0 && nv > 0, "Distribution2D needs at least one bin");
+        let row = |buf: &mut Vec<f32>, v: usize| {
+            buf.resize(nu, 0.0);
+            fill(v, buf);
+            Distribution1D::new(buf)
+        };
         // Big ones (an environment map's) row by row on all threads; the
         // rows are independent, so the result is the same.
-        let conditional: Vec<Distribution1D> = if f.len() >= PARALLEL_2D {
-            f.par_chunks_exact(nu).map(Distribution1D::new).collect()
+        let conditional: Vec<Distribution1D> = if nu * nv >= PARALLEL_2D {
+            (0..nv).into_par_iter().map_init(Vec::new, row).collect()
         } else {
-            f.chunks_exact(nu).map(Distribution1D::new).collect()
+            let mut buf = Vec::new();
+            (0..nv).map(|v| row(&mut buf, v)).collect()
         };
         let marginal_func: Vec<f32> = conditional.iter().map(|d| d.func_int()).collect();
         let marginal = Distribution1D::new(&marginal_func);
@@ -359,5 +369,54 @@ impl Distribution2D {
 
     pub fn conditional(&self, v: usize) -> &Distribution1D {
         &self.conditional[v]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Pcg32;
+
+    /// The bins as `DiscreteCdf`'s stored prefix sums define them: the
+    /// construction that sums twice instead of storing gives the same bits.
+    #[test]
+    fn bins_equal_the_stored_sums() {
+        let mut rng = Pcg32::with_sequence(11);
+        let specials = [0.0, -1.0, f32::NAN, f32::INFINITY, f32::MAX, 1e-30];
+        for k in 0..400 {
+            let n = [0usize, 1, 2, 3, 17, 1000][k % 6];
+            let f: Vec<f32> = (0..n)
+                .map(|_| match k % 5 {
+                    0 => 0.0,
+                    1 => specials[rng.uniform_u32() as usize % specials.len()],
+                    _ if rng.uniform_f32() < 0.2 => 0.0,
+                    _ => rng.uniform_f32() * 1e3,
+                })
+                .collect();
+            let d = Distribution1D::new(&f);
+            let func: Vec<f32> = if f.is_empty() {
+                vec![0.0]
+            } else {
+                f.iter().map(|&v| sanitise(v)).collect()
+            };
+            let sums = DiscreteCdf::new(&func);
+            let (total, m) = (sums.total(), func.len());
+            let uniform = !(total > 0.0 && total.is_finite());
+            assert_eq!(d.count(), m);
+            assert_eq!(d.func_int().to_bits(), sums.func_int().to_bits());
+            for i in 0..=m {
+                let pdf = match func.get(i) {
+                    None => 0.0,
+                    Some(_) if uniform => 1.0,
+                    Some(&v) => (v as f64 * (m as f64 / total)) as f32,
+                };
+                assert_eq!(
+                    d.bins[i].cdf.to_bits(),
+                    sums.cdf(i).to_bits(),
+                    "{k} cdf {i}"
+                );
+                assert_eq!(d.bins[i].pdf.to_bits(), pdf.to_bits(), "{k} pdf {i}");
+            }
+        }
     }
 }
