@@ -140,8 +140,21 @@ impl Distribution1D {
     /// The search for the bin of `u` in `[0, 1)`: pbrt's `FindInterval`.
     #[inline]
     fn find(&self, u: f32) -> usize {
-        self.guide
-            .find_interval(self.bins.len(), u, |i| self.bins[i].cdf)
+        let n = self.bins.len();
+        // The bisection's probes are dependent loads: its cell's first,
+        // middle and last entries asked for together let the cache misses
+        // of a big distribution's (an environment map's) overlap.
+        self.guide.find_interval_with(
+            n,
+            u,
+            |i| self.bins[i].cdf,
+            |lo, hi| {
+                let bins = self.bins.as_ptr();
+                for i in [lo, (lo + hi) / 2, hi] {
+                    crate::accel::prefetch(bins.wrapping_add(i.min(n - 1)));
+                }
+            },
+        )
     }
 
     /// The CDF: `count() + 1` entries from 0 to 1.

@@ -79,8 +79,22 @@ impl GuideTable {
     /// at most `len - 2`: pbrt's `FindInterval`.
     #[inline]
     pub fn find_interval(&self, len: usize, u: f32, cdf: impl Fn(usize) -> f32) -> usize {
+        self.find_interval_with(len, u, cdf, |_, _| {})
+    }
+
+    /// `find_interval`, calling `ahead(lo, hi)` with the range of CDF
+    /// indices it will bisect before it reads any of them (for hints).
+    #[inline]
+    pub fn find_interval_with(
+        &self,
+        len: usize,
+        u: f32,
+        cdf: impl Fn(usize) -> f32,
+        ahead: impl FnOnce(usize, usize),
+    ) -> usize {
         debug_assert!((0.0..1.0).contains(&u));
         let (lo, hi) = self.cell(u);
+        ahead(lo, hi);
         // The first index in [lo, hi] whose value exceeds u, by a bisection
         // whose steps are selects, not branches: a cell's few steps are
         // data-dependent coin flips that a branch predictor loses. The
