@@ -40,7 +40,8 @@ impl EnvMap {
         }
         for &mut (m, u, _) in batch.iter_mut() {
             if searched(m) {
-                m.distribution.prefetch_sample_bins(u);
+                m.distribution
+                    .prefetch_sample_bins(u, |v, lo, hi| m.prefetch_texels(v, lo, hi));
             }
         }
         let mut at = [(Vec2::ZERO, 0.0f32); SAMPLE_EACH_MAX];

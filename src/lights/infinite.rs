@@ -279,6 +279,46 @@ impl Level {
         }
     }
 
+    /// The texel rows `t0 ..= t1` and columns `s0 ..= s1` (before
+    /// wrapping) that `bilerp` reads at points in row `v` of `nv` and
+    /// columns `lo ..= hi` of `nu` of a grid over the map.
+    #[inline]
+    fn span(&self, v: usize, nv: usize, lo: usize, hi: usize, nu: usize) -> [i64; 4] {
+        let (w, h) = (self.w as f32, self.h as f32);
+        // The first texel at the span's start, the second at its (open) end.
+        let at = |i: usize, n: usize, m: f32| (i as f32 / n as f32) * m - 0.5;
+        [
+            at(v, nv, h).floor() as i64,
+            at(v + 1, nv, h).ceil() as i64,
+            at(lo, nu, w).floor() as i64,
+            at(hi + 1, nu, w).ceil() as i64,
+        ]
+    }
+
+    /// Asks for the texels `bilerp` reads at points in row `v` of `nv`
+    /// and columns `lo ..= hi` of `nu` of a grid over the map (a hint):
+    /// for a sample of the map's distribution, once its row and the range
+    /// its column is in are known. Spans wider than a few cache lines are
+    /// left to the lookup.
+    #[inline]
+    pub(super) fn prefetch_bins(&self, v: usize, nv: usize, lo: usize, hi: usize, nu: usize) {
+        let [t0, t1, s0, s1] = self.span(v, nv, lo, hi, nu);
+        if t1 - t0 > 2 || s1 - s0 > 15 {
+            return;
+        }
+        let tx = self.texels.as_ptr();
+        for t in t0..=t1 {
+            let row = t.rem_euclid(self.h as i64) as usize * self.w;
+            // Every fifth texel (a cache line holds 5.3) and the last.
+            let mut s = s0;
+            while s <= s1 + 4 {
+                let col = s.min(s1).rem_euclid(self.w as i64) as usize;
+                crate::accel::prefetch(tx.wrapping_add(row + col));
+                s += 5;
+            }
+        }
+    }
+
     /// pbrt-v3's `triangle`: bilinear between the four nearest texel centres.
     #[inline]
     fn bilerp(&self, st: Vec2) -> Vec3 {
@@ -550,8 +590,18 @@ impl EnvMap {
         match (self.constant, &self.alias) {
             (Some(_), _) => (u, 1.0),
             (None, Some(alias)) => alias.sample_continuous(u),
-            (None, None) => self.distribution.sample_continuous(u),
+            (None, None) => self
+                .distribution
+                .sample_continuous_with(u, |v, lo, hi| self.prefetch_texels(v, lo, hi)),
         }
+    }
+
+    /// Asks for the texels that `sample_direction` reads at a point of the
+    /// distribution's row `v` in its bins `lo - 1 ..= hi` (a hint).
+    #[inline]
+    pub(super) fn prefetch_texels(&self, v: usize, lo: usize, hi: usize) {
+        let (nu, nv) = self.distribution.size();
+        self.levels[0].prefetch_bins(v, nv, lo.saturating_sub(1), hi, nu);
     }
 
     /// `sample`'s direction, radiance and density from its point in the map.
@@ -671,6 +721,43 @@ pub(super) mod tests {
                     "{w}x{h} st {st}"
                 );
             }
+        }
+    }
+
+    /// The texels a sample's hint asks for (`Level::span` of its row and
+    /// the bins its search bisects) are those `bilerp` reads at the point
+    /// it samples: else the hint would miss and the lookup wait.
+    #[test]
+    fn texel_hints_cover_the_sampled_point() {
+        let img = lumpy(64, 32);
+        let map = EnvMap::new(Some(&img), Vec3::ONE, rotated(), EnvSampling::Map);
+        let (nu, nv) = map.distribution.size();
+        let level = &map.levels[0];
+        let mut rng = crate::sampling::Pcg32::with_sequence(3);
+        for _ in 0..20000 {
+            let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+            let mut span = None;
+            let (uv, pdf) = map.distribution.sample_continuous_with(u, |v, lo, hi| {
+                span = Some(level.span(v, nv, lo.saturating_sub(1), hi, nu));
+            });
+            if pdf == 0.0 {
+                continue;
+            }
+            let [t0, t1, s0, s1] = span.unwrap();
+            let s = uv.x * level.w as f32 - 0.5;
+            let t = uv.y * level.h as f32 - 0.5;
+            let (sf, tf) = (s.floor() as i64, t.floor() as i64);
+            assert!(
+                t0 <= tf && tf < t1,
+                "rows {t0}..={t1}, read {tf} and {}",
+                tf + 1
+            );
+            assert!(
+                s0 <= sf && sf < s1,
+                "columns {s0}..={s1}, read {sf} and {}",
+                sf + 1
+            );
+            assert!(t1 - t0 <= 2, "a sample's rows span {t0}..={t1}");
         }
     }
 

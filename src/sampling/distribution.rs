@@ -140,6 +140,13 @@ impl Distribution1D {
     /// The search for the bin of `u` in `[0, 1)`: pbrt's `FindInterval`.
     #[inline]
     fn find(&self, u: f32) -> usize {
+        self.find_with(u, |_, _| {})
+    }
+
+    /// `find`, calling `ahead(lo, hi)` with the range of bins the search
+    /// bisects (the result is in `lo - 1 ..= hi`) before it reads them.
+    #[inline]
+    fn find_with(&self, u: f32, ahead: impl FnOnce(usize, usize)) -> usize {
         let n = self.bins.len();
         // The bisection's probes are dependent loads: its cell's first,
         // middle and last entries asked for together let the cache misses
@@ -153,6 +160,7 @@ impl Distribution1D {
                 for i in [lo, (lo + hi) / 2, hi] {
                     crate::accel::prefetch(bins.wrapping_add(i.min(n - 1)));
                 }
+                ahead(lo, hi);
             },
         )
     }
@@ -179,8 +187,20 @@ impl Distribution1D {
     /// Samples `x` in `[0,1)`; returns `(x, pdf(x), bin index)`.
     #[inline]
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        self.sample_continuous_with(u, |_, _| {})
+    }
+
+    /// `sample_continuous`, calling `ahead(lo, hi)` with the range of bins
+    /// the sample will be in (`lo - 1 ..= hi`) before the search reads them
+    /// (for hints about what the caller will read next).
+    #[inline]
+    pub fn sample_continuous_with(
+        &self,
+        u: f32,
+        ahead: impl FnOnce(usize, usize),
+    ) -> (f32, f32, usize) {
         let u = sanitise_u(u);
-        let offset = self.find(u);
+        let offset = self.find_with(u, ahead);
         let c0 = self.cdf_at(offset);
         let width = self.cdf_at(offset + 1) - c0;
         let mut du = u - c0;
@@ -335,9 +355,29 @@ impl Distribution2D {
     /// Samples a point; returns `(p, pdf(p))`.
     #[inline]
     pub fn sample_continuous(&self, u: Vec2) -> (Vec2, f32) {
+        self.sample_continuous_with(u, |_, _, _| {})
+    }
+
+    /// `sample_continuous`, calling `ahead(v, lo, hi)` once the row `v` is
+    /// chosen, with the range of its bins the point will be in (`lo - 1
+    /// ..= hi`), before the row's search reads them: so that the caller's
+    /// hints about what it reads at the point overlap the search's misses.
+    #[inline]
+    pub fn sample_continuous_with(
+        &self,
+        u: Vec2,
+        ahead: impl FnOnce(usize, usize, usize),
+    ) -> (Vec2, f32) {
         let (d1, pdf1, v) = self.marginal.sample_continuous(u.y);
-        let (d0, pdf0, _) = self.conditional[v].sample_continuous(u.x);
+        let (d0, pdf0, _) =
+            self.conditional[v].sample_continuous_with(u.x, |lo, hi| ahead(v, lo, hi));
         (Vec2::new(d0, d1), pdf0 * pdf1)
+    }
+
+    /// The number of columns and rows.
+    #[inline]
+    pub fn size(&self) -> (usize, usize) {
+        (self.conditional[0].count(), self.conditional.len())
     }
 
     /// Density at `p` in `[0,1]^2`.
@@ -365,15 +405,18 @@ impl Distribution2D {
     }
 
     /// The second hint (once the first's lines have arrived): asks for the
-    /// CDF entries the row's search reads.
+    /// CDF entries the row's search reads, and calls `ahead` as
+    /// `sample_continuous_with` would.
     #[inline]
-    pub fn prefetch_sample_bins(&self, u: Vec2) {
-        let row = &self.conditional[self.marginal.find(sanitise_u(u.y))];
+    pub fn prefetch_sample_bins(&self, u: Vec2, ahead: impl FnOnce(usize, usize, usize)) {
+        let v = self.marginal.find(sanitise_u(u.y));
+        let row = &self.conditional[v];
         let (lo, hi) = row.guide.cell(sanitise_u(u.x));
         let bins = row.bins.as_ptr();
         for i in [lo, (lo + hi) / 2, hi] {
             crate::accel::prefetch(bins.wrapping_add(i.min(row.bins.len() - 1)));
         }
+        ahead(v, lo, hi);
     }
 
     pub fn marginal(&self) -> &Distribution1D {
