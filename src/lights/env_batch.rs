@@ -40,14 +40,13 @@ impl EnvMap {
         }
         for &mut (m, u, _) in batch.iter_mut() {
             if searched(m) {
-                m.distribution
-                    .prefetch_sample_bins(u, |v, lo, hi| m.prefetch_texels(v, lo, hi));
+                m.distribution.prefetch_sample_bins(u);
             }
         }
         let mut at = [(Vec2::ZERO, 0.0f32); SAMPLE_EACH_MAX];
         for (&mut (m, u, _), a) in batch.iter_mut().zip(&mut at) {
             if m.sampling != EnvSampling::Uniform {
-                *a = m.sample_map(u);
+                *a = m.sample_map_with(u, false);
                 if m.constant.is_none() {
                     m.levels[0].prefetch(a.0);
                 }

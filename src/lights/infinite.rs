@@ -587,12 +587,21 @@ impl EnvMap {
     /// `sample`'s point in the map and its density there.
     #[inline]
     pub(super) fn sample_map(&self, u: Vec2) -> (Vec2, f32) {
+        self.sample_map_with(u, true)
+    }
+
+    /// `sample_map`, asking for the CDF entries and the texels around the
+    /// point while the search runs if `hints` (not when a batch has asked
+    /// for them).
+    #[inline]
+    pub(super) fn sample_map_with(&self, u: Vec2, hints: bool) -> (Vec2, f32) {
         match (self.constant, &self.alias) {
             (Some(_), _) => (u, 1.0),
             (None, Some(alias)) => alias.sample_continuous(u),
-            (None, None) => self
+            (None, None) if hints => self
                 .distribution
                 .sample_continuous_with(u, |v, lo, hi| self.prefetch_texels(v, lo, hi)),
+            (None, None) => self.distribution.sample_continuous_unhinted(u),
         }
     }
 

@@ -190,6 +190,17 @@ impl Distribution1D {
         self.sample_continuous_with(u, |_, _| {})
     }
 
+    /// `sample_continuous` without the search's hints (for callers that
+    /// asked for its CDF entries already).
+    #[inline]
+    pub fn sample_continuous_unhinted(&self, u: f32) -> (f32, f32, usize) {
+        let u = sanitise_u(u);
+        let offset = self
+            .guide
+            .find_interval(self.bins.len(), u, |i| self.bins[i].cdf);
+        self.point_of(u, offset)
+    }
+
     /// `sample_continuous`, calling `ahead(lo, hi)` with the range of bins
     /// the sample will be in (`lo - 1 ..= hi`) before the search reads them
     /// (for hints about what the caller will read next).
@@ -201,6 +212,12 @@ impl Distribution1D {
     ) -> (f32, f32, usize) {
         let u = sanitise_u(u);
         let offset = self.find_with(u, ahead);
+        self.point_of(u, offset)
+    }
+
+    /// The sample of `u` in bin `offset`: `(x, pdf(x), offset)`.
+    #[inline]
+    fn point_of(&self, u: f32, offset: usize) -> (f32, f32, usize) {
         let c0 = self.cdf_at(offset);
         let width = self.cdf_at(offset + 1) - c0;
         let mut du = u - c0;
@@ -368,9 +385,19 @@ impl Distribution2D {
         u: Vec2,
         ahead: impl FnOnce(usize, usize, usize),
     ) -> (Vec2, f32) {
-        let (d1, pdf1, v) = self.marginal.sample_continuous(u.y);
+        // (The marginal, one entry per row, stays in the caches: no hints.)
+        let (d1, pdf1, v) = self.marginal.sample_continuous_unhinted(u.y);
         let (d0, pdf0, _) =
             self.conditional[v].sample_continuous_with(u.x, |lo, hi| ahead(v, lo, hi));
+        (Vec2::new(d0, d1), pdf0 * pdf1)
+    }
+
+    /// `sample_continuous` without the searches' hints (for callers that
+    /// asked for the row's CDF entries already, as `prefetch_sample_bins`).
+    #[inline]
+    pub fn sample_continuous_unhinted(&self, u: Vec2) -> (Vec2, f32) {
+        let (d1, pdf1, v) = self.marginal.sample_continuous_unhinted(u.y);
+        let (d0, pdf0, _) = self.conditional[v].sample_continuous_unhinted(u.x);
         (Vec2::new(d0, d1), pdf0 * pdf1)
     }
 
@@ -405,18 +432,15 @@ impl Distribution2D {
     }
 
     /// The second hint (once the first's lines have arrived): asks for the
-    /// CDF entries the row's search reads, and calls `ahead` as
-    /// `sample_continuous_with` would.
+    /// CDF entries the row's search reads.
     #[inline]
-    pub fn prefetch_sample_bins(&self, u: Vec2, ahead: impl FnOnce(usize, usize, usize)) {
-        let v = self.marginal.find(sanitise_u(u.y));
-        let row = &self.conditional[v];
+    pub fn prefetch_sample_bins(&self, u: Vec2) {
+        let row = &self.conditional[self.marginal.find(sanitise_u(u.y))];
         let (lo, hi) = row.guide.cell(sanitise_u(u.x));
         let bins = row.bins.as_ptr();
         for i in [lo, (lo + hi) / 2, hi] {
             crate::accel::prefetch(bins.wrapping_add(i.min(row.bins.len() - 1)));
         }
-        ahead(v, lo, hi);
     }
 
     pub fn marginal(&self) -> &Distribution1D {
