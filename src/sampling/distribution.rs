@@ -143,8 +143,16 @@ impl Distribution1D {
         self.find_with(u, |_, _| {})
     }
 
+    /// `find` without hints (for distributions that stay in the caches, or
+    /// whose entries were asked for already).
+    #[inline]
+    fn find_unhinted(&self, u: f32) -> usize {
+        self.guide
+            .find_interval(self.bins.len(), u, |i| self.bins[i].cdf)
+    }
+
     /// `find`, calling `ahead(lo, hi)` with the range of bins the search
-    /// bisects (the result is in `lo - 1 ..= hi`) before it reads them.
+    /// bisects (the result is within `lo - 1 ..= hi`) before it reads them.
     #[inline]
     fn find_with(&self, u: f32, ahead: impl FnOnce(usize, usize)) -> usize {
         let n = self.bins.len();
@@ -195,14 +203,11 @@ impl Distribution1D {
     #[inline]
     pub fn sample_continuous_unhinted(&self, u: f32) -> (f32, f32, usize) {
         let u = sanitise_u(u);
-        let offset = self
-            .guide
-            .find_interval(self.bins.len(), u, |i| self.bins[i].cdf);
-        self.point_of(u, offset)
+        self.point_of(u, self.find_unhinted(u))
     }
 
     /// `sample_continuous`, calling `ahead(lo, hi)` with the range of bins
-    /// the sample will be in (`lo - 1 ..= hi`) before the search reads them
+    /// the sample will be within (`lo - 1 ..= hi`) before the search reads them
     /// (for hints about what the caller will read next).
     #[inline]
     pub fn sample_continuous_with(
@@ -427,7 +432,7 @@ impl Distribution2D {
     /// hints given together let their cache misses overlap.
     #[inline]
     pub fn prefetch_sample_row(&self, u: Vec2) {
-        let v = self.marginal.find(sanitise_u(u.y));
+        let v = self.marginal.find_unhinted(sanitise_u(u.y));
         self.conditional[v].guide.prefetch(sanitise_u(u.x));
     }
 
@@ -435,7 +440,7 @@ impl Distribution2D {
     /// CDF entries the row's search reads.
     #[inline]
     pub fn prefetch_sample_bins(&self, u: Vec2) {
-        let row = &self.conditional[self.marginal.find(sanitise_u(u.y))];
+        let row = &self.conditional[self.marginal.find_unhinted(sanitise_u(u.y))];
         let (lo, hi) = row.guide.cell(sanitise_u(u.x));
         let bins = row.bins.as_ptr();
         for i in [lo, (lo + hi) / 2, hi] {
