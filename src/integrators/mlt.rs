@@ -465,9 +465,7 @@ impl Mlt {
                 waiting[slot] = Some(group);
                 let ready = waiting.iter().take_while(|w| w.is_some()).count();
                 for group in waiting.drain(..ready).flatten() {
-                    for sp in &group.splats {
-                        film.add_splat(sp);
-                    }
+                    film.add_splats(&group.splats);
                     done.rays.add(&group.rays);
                     done.mutations += group.mutations;
                     done.accepted += group.accepted;

@@ -21,6 +21,9 @@ use glam::{DVec3, IVec2, Vec2, Vec3};
 pub const FILTER_TABLE_WIDTH: usize = 16;
 const TABLE_SIZE: usize = FILTER_TABLE_WIDTH * FILTER_TABLE_WIDTH;
 
+/// How many splats ahead `merge_tile` asks for a splat's pixel.
+const SPLAT_AHEAD: usize = 8;
+
 pub use crate::geometry::luminance;
 
 /// Running sums of one pixel.
@@ -183,9 +186,7 @@ impl Film {
     /// Adds a tile's sums into the film (plain additions: merge tiles in a
     /// fixed order for bit-identical images).
     pub fn merge_tile(&mut self, tile: FilmTile) {
-        for sp in &tile.splats {
-            self.add_splat(sp);
-        }
+        self.add_splats(&tile.splats);
         let fw = self.pixel_bounds.width() as usize;
         let tw = tile.pixel_bounds.width() as usize;
         if tw == 0 {
@@ -202,6 +203,35 @@ impl Film {
                 }
                 d.weight += s.weight;
             }
+        }
+    }
+
+    /// `add_splat` of each splat in order. Each lands anywhere in the
+    /// image: the pixel of the one `SPLAT_AHEAD` later is asked for (a
+    /// hint) while this one is added, so that their cache misses overlap
+    /// (the order of the additions, and so the sums, stay the same).
+    pub fn add_splats(&mut self, splats: &[Splat]) {
+        for (i, sp) in splats.iter().enumerate() {
+            if let Some(next) = splats.get(i + SPLAT_AHEAD) {
+                self.prefetch_splat(next);
+            }
+            self.add_splat(sp);
+        }
+    }
+
+    /// Asks for the cache line `add_splat(sp)` will add to (a hint; only
+    /// for the main splat image once it exists).
+    #[inline]
+    fn prefetch_splat(&self, sp: &Splat) {
+        if sp.layer != 0 || self.splats.is_empty() {
+            return;
+        }
+        let pi = sp.p_film.floor().as_ivec2();
+        let b = self.pixel_bounds;
+        if pi.x >= b.min.x && pi.x < b.max.x && pi.y >= b.min.y && pi.y < b.max.y {
+            let o = pi - b.min;
+            let k = (o.y * b.width() + o.x) as usize;
+            crate::accel::prefetch(self.splats.as_ptr().wrapping_add(k));
         }
     }
 
