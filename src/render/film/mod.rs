@@ -21,7 +21,7 @@ use glam::{DVec3, IVec2, Vec2, Vec3};
 pub const FILTER_TABLE_WIDTH: usize = 16;
 const TABLE_SIZE: usize = FILTER_TABLE_WIDTH * FILTER_TABLE_WIDTH;
 
-/// How many splats ahead `merge_tile` asks for a splat's pixel.
+/// How many splats ahead `add_splats` asks for a splat's pixel.
 const SPLAT_AHEAD: usize = 8;
 
 pub use crate::geometry::luminance;
@@ -226,13 +226,20 @@ impl Film {
         if sp.layer != 0 || self.splats.is_empty() {
             return;
         }
-        let pi = sp.p_film.floor().as_ivec2();
-        let b = self.pixel_bounds;
-        if pi.x >= b.min.x && pi.x < b.max.x && pi.y >= b.min.y && pi.y < b.max.y {
-            let o = pi - b.min;
-            let k = (o.y * b.width() + o.x) as usize;
+        if let Some(k) = self.splat_pixel(sp.p_film) {
             crate::accel::prefetch(self.splats.as_ptr().wrapping_add(k));
         }
+    }
+
+    /// The index (in the splat images) of the pixel `p_film` is in, if it
+    /// is inside the film's pixel bounds.
+    #[inline]
+    fn splat_pixel(&self, p_film: Vec2) -> Option<usize> {
+        let pi = p_film.floor().as_ivec2();
+        let b = self.pixel_bounds;
+        let inside = pi.x >= b.min.x && pi.x < b.max.x && pi.y >= b.min.y && pi.y < b.max.y;
+        let o = pi - b.min;
+        inside.then(|| (o.y * b.width() + o.x) as usize)
     }
 
     /// Adds a splat to the pixel its position is in (pbrt-v3's
@@ -244,11 +251,9 @@ impl Film {
         if v.is_nan() || y < 0.0 || y.is_infinite() {
             return;
         }
-        let pi = sp.p_film.floor().as_ivec2();
-        let b = self.pixel_bounds;
-        if !(pi.x >= b.min.x && pi.x < b.max.x && pi.y >= b.min.y && pi.y < b.max.y) {
+        let Some(k) = self.splat_pixel(sp.p_film) else {
             return;
-        }
+        };
         if y > self.max_sample_luminance {
             v *= self.max_sample_luminance / y;
         }
@@ -256,17 +261,16 @@ impl Film {
         let buf = if sp.layer == 0 {
             &mut self.splats
         } else {
-            let k = sp.layer as usize - 1;
-            if self.layers.len() <= k {
-                self.layers.resize_with(k + 1, Vec::new);
+            let layer = sp.layer as usize - 1;
+            if self.layers.len() <= layer {
+                self.layers.resize_with(layer + 1, Vec::new);
             }
-            &mut self.layers[k]
+            &mut self.layers[layer]
         };
         if buf.is_empty() {
             buf.resize(n, [0.0; 3]);
         }
-        let o = pi - b.min;
-        let d = &mut buf[(o.y * b.width() + o.x) as usize];
+        let d = &mut buf[k];
         d[0] += v.x as f64;
         d[1] += v.y as f64;
         d[2] += v.z as f64;
