@@ -580,19 +580,13 @@ impl EnvMap {
             let wi = uniform_sample_sphere(u);
             return Some((wi, self.le(wi), uniform_sphere_pdf()));
         }
-        let (uv, map_pdf) = self.sample_map(u);
+        let (uv, map_pdf) = self.sample_map_with(u, true);
         self.sample_direction(uv, map_pdf)
     }
 
-    /// `sample`'s point in the map and its density there.
-    #[inline]
-    pub(super) fn sample_map(&self, u: Vec2) -> (Vec2, f32) {
-        self.sample_map_with(u, true)
-    }
-
-    /// `sample_map`, asking for the CDF entries and the texels around the
-    /// point while the search runs if `hints` (not when a batch has asked
-    /// for them).
+    /// `sample`'s point in the map and its density there, asking for the
+    /// CDF entries and the texels around the point while the search runs
+    /// if `hints` (not when a batch has asked for them).
     #[inline]
     pub(super) fn sample_map_with(&self, u: Vec2, hints: bool) -> (Vec2, f32) {
         match (self.constant, &self.alias) {

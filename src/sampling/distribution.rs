@@ -143,6 +143,18 @@ impl Distribution1D {
         self.find_with(u, |_, _| {})
     }
 
+    /// Asks for the cache lines of the first, middle and last CDF entries
+    /// of the guide cell `lo ..= hi` (a hint): the bisection's probes are
+    /// dependent loads, so asked for together the cache misses of a big
+    /// distribution's (an environment map's) overlap.
+    #[inline]
+    fn prefetch_cell(&self, lo: usize, hi: usize) {
+        let bins = self.bins.as_ptr();
+        for i in [lo, (lo + hi) / 2, hi] {
+            crate::accel::prefetch(bins.wrapping_add(i.min(self.bins.len() - 1)));
+        }
+    }
+
     /// `find` without hints (for distributions that stay in the caches, or
     /// whose entries were asked for already).
     #[inline]
@@ -155,19 +167,12 @@ impl Distribution1D {
     /// bisects (the result is within `lo - 1 ..= hi`) before it reads them.
     #[inline]
     fn find_with(&self, u: f32, ahead: impl FnOnce(usize, usize)) -> usize {
-        let n = self.bins.len();
-        // The bisection's probes are dependent loads: its cell's first,
-        // middle and last entries asked for together let the cache misses
-        // of a big distribution's (an environment map's) overlap.
         self.guide.find_interval_with(
-            n,
+            self.bins.len(),
             u,
             |i| self.bins[i].cdf,
             |lo, hi| {
-                let bins = self.bins.as_ptr();
-                for i in [lo, (lo + hi) / 2, hi] {
-                    crate::accel::prefetch(bins.wrapping_add(i.min(n - 1)));
-                }
+                self.prefetch_cell(lo, hi);
                 ahead(lo, hi);
             },
         )
@@ -442,10 +447,7 @@ impl Distribution2D {
     pub fn prefetch_sample_bins(&self, u: Vec2) {
         let row = &self.conditional[self.marginal.find_unhinted(sanitise_u(u.y))];
         let (lo, hi) = row.guide.cell(sanitise_u(u.x));
-        let bins = row.bins.as_ptr();
-        for i in [lo, (lo + hi) / 2, hi] {
-            crate::accel::prefetch(bins.wrapping_add(i.min(row.bins.len() - 1)));
-        }
+        row.prefetch_cell(lo, hi);
     }
 
     pub fn marginal(&self) -> &Distribution1D {

@@ -62,16 +62,21 @@ impl GuideTable {
     /// The range of CDF indices a search for `u` in [0, 1) bisects.
     #[inline]
     pub fn cell(&self, u: f32) -> (usize, usize) {
-        let j = (u * self.cells) as usize;
+        let j = self.cell_index(u);
         (self.first[j] as usize, self.first[j + 1] as usize)
+    }
+
+    /// The guide cell `u` in [0, 1) falls in.
+    #[inline]
+    fn cell_index(&self, u: f32) -> usize {
+        (u * self.cells) as usize
     }
 
     /// Asks for the cache line of the table entries `find_interval(.., u,
     /// ..)` reads (a hint).
     #[inline]
     pub fn prefetch(&self, u: f32) {
-        let j = (u * self.cells) as usize;
-        crate::accel::prefetch(self.first.as_ptr().wrapping_add(j));
+        crate::accel::prefetch(self.first.as_ptr().wrapping_add(self.cell_index(u)));
     }
 
     /// The index of the last entry of the CDF (the one the table was made
