@@ -3,7 +3,7 @@
 //! that strategy against every other that could have made the same path
 //! (pbrt-v3's `MISWeight`, with its remapping of delta densities to 1).
 
-use super::vertex::{push_at, Kind, Mode, Vertex};
+use super::vertex::{push_at, Kind, Link, Mode, Vertex};
 use super::Ctx;
 use crate::geometry::{spawn_ray_to, Ray};
 use crate::integrators::volpath::transmittance;
@@ -32,17 +32,21 @@ fn tr(c: &Ctx, a: &Vertex, b: &Vertex, sampler: &mut Sampler, scratch: &mut Scra
     transmittance(c.scene, &ray, a.time, medium, sampler, scratch)
 }
 
-/// pbrt-v3's `G`: the geometry term between two vertices, with their
-/// transmittance.
-fn g(c: &Ctx, v0: &Vertex, v1: &Vertex, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
-    let d = v0.p - v1.p;
-    let mut g = 1.0 / d.length_squared();
-    let d = d * g.sqrt();
+/// pbrt-v3's `G`: the geometry term across the link from `v0` to `v1`,
+/// with their transmittance.
+fn g(
+    c: &Ctx,
+    (v0, v1): (&Vertex, &Vertex),
+    link: &Link,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Vec3 {
+    let mut g = link.inv;
     if v0.on_surface() {
-        g *= v0.ns.dot(d).abs();
+        g *= v0.ns.dot(link.dir).abs();
     }
     if v1.on_surface() {
-        g *= v1.ns.dot(d).abs();
+        g *= v1.ns.dot(link.dir).abs();
     }
     g * tr(c, v0, v1, sampler, scratch)
 }
@@ -108,6 +112,8 @@ pub(crate) fn connect<'a>(
     // The scattering densities the connection's BSDF values came with:
     // at qs towards pt and at pt towards qs (solid angle).
     let mut dens = Densities::default();
+    // The segment of an s, t ≥ 2 connection.
+    let mut link = None;
     if s == 0 {
         let pt = &camera[t - 1];
         if pt.is_light() {
@@ -166,20 +172,24 @@ pub(crate) fn connect<'a>(
     } else {
         let (qs, pt) = (&light[s - 1], &camera[t - 1]);
         if qs.is_connectible(c) && pt.is_connectible(c) {
-            let (fq, pdf_q) = qs.f(pt, Mode::Importance);
-            let (fp, pdf_p) = pt.f(qs, Mode::Radiance);
-            dens.at_qs = qs.scatters().then_some(pdf_q);
-            dens.at_pt = pt.scatters().then_some(pdf_p);
-            l = qs.beta * fq * fp * pt.beta;
-            if l != Vec3::ZERO {
-                l *= g(c, qs, pt, sampler, scratch);
+            // Coincident vertices: no BSDF value (as `Vertex::f`).
+            if let Some(ln) = Link::new(qs, pt) {
+                let (fq, pdf_q) = qs.f_towards(ln.wi, Mode::Importance);
+                let (fp, pdf_p) = pt.f_towards(-ln.wi, Mode::Radiance);
+                dens.at_qs = qs.scatters().then_some(pdf_q);
+                dens.at_pt = pt.scatters().then_some(pdf_p);
+                l = qs.beta * fq * fp * pt.beta;
+                if l != Vec3::ZERO {
+                    l *= g(c, (qs, pt), &ln, sampler, scratch);
+                }
+                link = Some(ln);
             }
         }
     }
     let weight = if l == Vec3::ZERO {
         0.0
     } else {
-        mis_weight(c, light, camera, sampled, dens, s, t)
+        mis_weight(c, light, camera, (sampled, link), dens, s, t)
     };
     // A sampled endpoint goes again (the one early return comes before
     // anything is pushed).
@@ -253,16 +263,19 @@ fn light_vertex<'a>(
     Some((ls.shadow, ls.wi))
 }
 
-/// pbrt-v3's `MISWeight`: the subpaths' reverse densities are set for
-/// this strategy (and a sampled endpoint, the last vertex of `camera` for
-/// t = 1 and of `light` for s = 1, put in place), the ratios of
-/// every other strategy's density to this one's summed, and the subpaths
-/// restored.
+/// pbrt-v3's `MISWeight`: the ratios of every other strategy's density
+/// to this one's summed, with the reverse densities this strategy sets at
+/// the two ends of each subpath (and their delta flags cleared) taken in
+/// place of the stored ones, and a sampled endpoint (the last vertex of
+/// `camera` for t = 1, of `light` for s = 1) in place of the subpath's
+/// first. pbrt-v3 writes these into the subpaths and restores them; the
+/// subpaths are only read here, in the same order of arithmetic. `link`:
+/// the segment of an s, t ≥ 2 connection.
 fn mis_weight<'a>(
     c: &Ctx<'a>,
-    light: &mut [Vertex<'a>],
-    camera: &mut [Vertex<'a>],
-    sampled: bool,
+    light: &[Vertex<'a>],
+    camera: &[Vertex<'a>],
+    (sampled, link): (bool, Option<Link>),
     dens: Densities,
     s: usize,
     t: usize,
@@ -270,87 +283,96 @@ fn mis_weight<'a>(
     if s + t == 2 {
         return 1.0;
     }
-    // The sampled endpoint replaces the subpath's.
-    if sampled {
-        swap_sampled_endpoint(if s == 1 { light } else { camera });
-    }
-    // The new reverse densities, computed before any is set.
+    // The vertices as this strategy sees them.
+    let first_cam = if sampled && s != 1 {
+        camera.len() - 1
+    } else {
+        0
+    };
+    let first_light = if sampled && s == 1 { light.len() - 1 } else { 0 };
+    let cam = |i: usize| &camera[if i == 0 { first_cam } else { i }];
+    let lig = |i: usize| &light[if i == 0 { first_light } else { i }];
+    // The new reverse densities.
     let (qs, pt) = (s.checked_sub(1), t - 1);
     let (qs_m, pt_m) = (s.checked_sub(2), t.checked_sub(2));
-    let pt_rev = match qs {
-        Some(q) => match dens.at_qs {
-            Some(pdf) => light[q].convert_density(pdf, &camera[pt], c),
-            None => light[q].pdf(c, qs_m.map(|i| &light[i]), &camera[pt]),
-        },
-        None => camera[pt].pdf_light_origin(c, &camera[pt_m.unwrap_or(0)]),
+    let (pt_rev, pt_m_rev, qs_rev, qs_m_rev) = match (link, dens, qs, pt_m, qs_m) {
+        // s, t ≥ 2 with both ends scattering: the link gives the
+        // directions between them.
+        (
+            Some(ln),
+            Densities {
+                at_qs: Some(pdf_q),
+                at_pt: Some(pdf_p),
+            },
+            Some(q),
+            Some(m),
+            Some(qm),
+        ) => {
+            let (pq, pp) = (lig(q), cam(pt));
+            (
+                pq.convert_density_across(pdf_q, pp, &ln, c),
+                pp.pdf_from(c, -ln.wi, cam(m)),
+                pp.convert_density_across(pdf_p, pq, &ln, c),
+                pq.pdf_from(c, ln.wi, lig(qm)),
+            )
+        }
+        _ => (
+            match qs {
+                Some(q) => match dens.at_qs {
+                    Some(pdf) => lig(q).convert_density(pdf, cam(pt), c),
+                    None => lig(q).pdf(c, qs_m.map(lig), cam(pt)),
+                },
+                None => cam(pt).pdf_light_origin(c, cam(pt_m.unwrap_or(0))),
+            },
+            pt_m.map_or(0.0, |m| match qs {
+                Some(q) => cam(pt).pdf(c, Some(lig(q)), cam(m)),
+                None => cam(pt).pdf_light(c, cam(m)),
+            }),
+            qs.map_or(0.0, |q| match dens.at_pt {
+                Some(pdf) => cam(pt).convert_density(pdf, lig(q), c),
+                None => cam(pt).pdf(c, pt_m.map(cam), lig(q)),
+            }),
+            qs_m.map_or(0.0, |m| lig(m + 1).pdf(c, Some(cam(pt)), lig(m))),
+        ),
     };
-    let pt_m_rev = pt_m.map(|m| match qs {
-        Some(q) => camera[pt].pdf(c, Some(&light[q]), &camera[m]),
-        None => camera[pt].pdf_light(c, &camera[m]),
-    });
-    let qs_rev = qs.map(|q| match dens.at_pt {
-        Some(pdf) => camera[pt].convert_density(pdf, &light[q], c),
-        None => camera[pt].pdf(c, pt_m.map(|i| &camera[i]), &light[q]),
-    });
-    let qs_m_rev = qs_m.map(|m| light[m + 1].pdf(c, Some(&camera[pt]), &light[m]));
-    // Set them (and clear the endpoints' delta flags), keeping the old.
-    let saved_pt = (camera[pt].pdf_rev, camera[pt].delta);
-    camera[pt].pdf_rev = pt_rev;
-    camera[pt].delta = false;
-    let saved_pt_m =
-        pt_m.map(|m| std::mem::replace(&mut camera[m].pdf_rev, pt_m_rev.unwrap_or(0.0)));
-    let saved_qs = qs.map(|q| {
-        let old = (light[q].pdf_rev, light[q].delta);
-        light[q].pdf_rev = qs_rev.unwrap_or(0.0);
-        light[q].delta = false;
-        old
-    });
-    let saved_qs_m =
-        qs_m.map(|m| std::mem::replace(&mut light[m].pdf_rev, qs_m_rev.unwrap_or(0.0)));
 
     let remap0 = |f: f32| if f != 0.0 { f } else { 1.0 };
     let mut sum_ri = 0.0f32;
     let mut ri = 1.0f32;
     for i in (1..t).rev() {
-        ri *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
-        if !camera[i].delta && !camera[i - 1].delta {
+        let v = cam(i);
+        let rev = if i == pt {
+            pt_rev
+        } else if Some(i) == pt_m {
+            pt_m_rev
+        } else {
+            v.pdf_rev
+        };
+        ri *= remap0(rev) / remap0(v.pdf_fwd);
+        // pt's delta flag is cleared; the one before it is never pt.
+        if !(v.delta && i != pt) && !cam(i - 1).delta {
             sum_ri += ri;
         }
     }
     ri = 1.0;
     for i in (0..s).rev() {
-        ri *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
-        let delta_light = if i > 0 {
-            light[i - 1].delta
+        let v = lig(i);
+        let rev = if Some(i) == qs {
+            qs_rev
+        } else if Some(i) == qs_m {
+            qs_m_rev
         } else {
-            light[0].is_delta_light(c)
+            v.pdf_rev
         };
-        if !light[i].delta && !delta_light {
+        ri *= remap0(rev) / remap0(v.pdf_fwd);
+        let delta_light = if i > 0 {
+            lig(i - 1).delta
+        } else {
+            v.is_delta_light(c)
+        };
+        if !(v.delta && Some(i) != qs) && !delta_light {
             sum_ri += ri;
         }
     }
-
-    // Restore.
-    (camera[pt].pdf_rev, camera[pt].delta) = saved_pt;
-    if let (Some(m), Some(v)) = (pt_m, saved_pt_m) {
-        camera[m].pdf_rev = v;
-    }
-    if let (Some(q), Some((r, d))) = (qs, saved_qs) {
-        light[q].pdf_rev = r;
-        light[q].delta = d;
-    }
-    if let (Some(m), Some(v)) = (qs_m, saved_qs_m) {
-        light[m].pdf_rev = v;
-    }
-    if sampled {
-        swap_sampled_endpoint(if s == 1 { light } else { camera });
-    }
     1.0 / (1.0 + sum_ri)
-}
-
-/// Exchanges a subpath's first vertex with the sampled endpoint at its end.
-fn swap_sampled_endpoint(path: &mut [Vertex]) {
-    let (first, rest) = path.split_at_mut(1);
-    let last = rest.last_mut().expect("a sampled endpoint past the first");
-    first[0].swap_endpoint(last);
 }

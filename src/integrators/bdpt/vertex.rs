@@ -127,47 +127,6 @@ pub(crate) struct Vertex<'a> {
 }
 
 impl<'a> Vertex<'a> {
-    /// Exchanges everything but the BSDF and phase function with `other`:
-    /// how a strategy's sampled camera or light vertex takes the place of
-    /// the subpath's endpoint (neither scatters, so they have neither)
-    /// without moving a BSDF's worth of bytes.
-    pub fn swap_endpoint(&mut self, other: &mut Vertex<'a>) {
-        use std::mem::swap;
-        // Written out in full, so that a new field must be placed here.
-        let Vertex {
-            kind,
-            beta,
-            p,
-            p_error,
-            n,
-            ns,
-            wo,
-            time,
-            medium,
-            media,
-            light,
-            bsdf: _,
-            phase: _,
-            delta,
-            pdf_fwd,
-            pdf_rev,
-        } = self;
-        swap(kind, &mut other.kind);
-        swap(beta, &mut other.beta);
-        swap(p, &mut other.p);
-        swap(p_error, &mut other.p_error);
-        swap(n, &mut other.n);
-        swap(ns, &mut other.ns);
-        swap(wo, &mut other.wo);
-        swap(time, &mut other.time);
-        swap(medium, &mut other.medium);
-        swap(media, &mut other.media);
-        swap(light, &mut other.light);
-        swap(delta, &mut other.delta);
-        swap(pdf_fwd, &mut other.pdf_fwd);
-        swap(pdf_rev, &mut other.pdf_rev);
-    }
-
     #[inline]
     pub fn on_surface(&self) -> bool {
         self.n != Vec3::ZERO
@@ -243,7 +202,13 @@ impl<'a> Vertex<'a> {
         if wi.length_squared() == 0.0 {
             return (Vec3::ZERO, 0.0);
         }
-        let wi = wi.normalize();
+        self.f_towards(wi.normalize(), mode)
+    }
+
+    /// [`Vertex::f`] towards the unit direction `wi` (the next vertex's,
+    /// normalized as `f` normalizes it).
+    #[inline]
+    pub fn f_towards(&self, wi: Vec3, mode: Mode) -> (Vec3, f32) {
         match self.kind {
             Kind::Surface => {
                 let (f, pdf) = self.bsdf.f_pdf(self.wo, wi, BxdfFlags::ALL);
@@ -309,6 +274,20 @@ impl<'a> Vertex<'a> {
         pdf * inv
     }
 
+    /// [`Vertex::convert_density`] across a [`Link`] from this vertex to
+    /// `next` (or from `next` to this one: the terms are the same).
+    #[inline]
+    pub fn convert_density_across(&self, pdf: f32, next: &Vertex, link: &Link, c: &Ctx) -> f32 {
+        if next.is_infinite_light(c) {
+            return pdf;
+        }
+        let mut pdf = pdf;
+        if next.on_surface() {
+            pdf *= next.n.dot(link.dir).abs();
+        }
+        pdf * link.inv
+    }
+
     /// pbrt-v3's `Vertex::Pdf`: the density of sampling `next` from this
     /// vertex, arrived at from `prev` (none for the camera), by area.
     pub fn pdf(&self, c: &Ctx, prev: Option<&Vertex>, next: &Vertex) -> f32 {
@@ -330,6 +309,27 @@ impl<'a> Vertex<'a> {
             }
             None => Vec3::ZERO,
         };
+        self.pdf_dirs(c, wp, wn, next)
+    }
+
+    /// [`Vertex::pdf`] with the unit direction towards the previous vertex
+    /// known (`wp`, normalized as `pdf` normalizes it, from a distinct
+    /// point).
+    pub fn pdf_from(&self, c: &Ctx, wp: Vec3, next: &Vertex) -> f32 {
+        if self.kind == Kind::Light {
+            return self.pdf_light(c, next);
+        }
+        let wn = next.p - self.p;
+        if wn.length_squared() == 0.0 {
+            return 0.0;
+        }
+        self.pdf_dirs(c, wp, wn.normalize(), next)
+    }
+
+    /// The rest of [`Vertex::pdf`], from the unit directions towards the
+    /// previous vertex and the next.
+    #[inline]
+    fn pdf_dirs(&self, c: &Ctx, wp: Vec3, wn: Vec3, next: &Vertex) -> f32 {
         let pdf = match self.kind {
             Kind::Camera => c.camera.pdf_we(self.p, wn, self.time).1,
             Kind::Surface => self.bsdf.pdf(wp, wn, BxdfFlags::ALL),
@@ -402,6 +402,37 @@ impl<'a> Vertex<'a> {
             Some(i) => c.scene.lights[i as usize].emitted(self.n, w),
             None => Vec3::ZERO,
         }
+    }
+}
+
+/// The segment between a light subpath's vertex qs and a camera
+/// subpath's pt that a strategy connects, with what its BSDF values,
+/// geometry term and densities share: computed once, with the bits each
+/// of them would compute on its own.
+pub(crate) struct Link {
+    /// From qs towards pt, normalized as [`Vertex::f`] normalizes it.
+    pub wi: Vec3,
+    /// 1 / squared distance.
+    pub inv: f32,
+    /// From qs towards pt as `G` and `ConvertDensity` normalize it.
+    pub dir: Vec3,
+}
+
+impl Link {
+    /// The link from `qs` to `pt`; `None` if they are the same point.
+    #[inline]
+    pub fn new(qs: &Vertex, pt: &Vertex) -> Option<Link> {
+        let w = pt.p - qs.p;
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let inv = 1.0 / d2;
+        Some(Link {
+            wi: w.normalize(),
+            inv,
+            dir: w * inv.sqrt(),
+        })
     }
 }
 
