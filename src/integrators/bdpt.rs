@@ -49,7 +49,7 @@ use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
 use crate::shapes::SurfacePoint;
 use glam::{Vec2, Vec3};
-use vertex::{push_at, random_walk, Kind, Mode, Vertex, Walk};
+use vertex::{push_at, finish_subpath, random_walk, Kind, Mode, Vertex, Walk};
 
 pub const PARAMS: &[ParamSpec] = &[
     MAX_DEPTH,
@@ -433,7 +433,9 @@ pub(super) fn camera_subpath<'a>(
         time,
         mode: Mode::Radiance,
     };
-    1 + random_walk(c, walk, bounces, cam, sampler, scratch) as usize
+    let n = 1 + random_walk(c, walk, bounces, cam, sampler, scratch) as usize;
+    finish_subpath(c, cam);
+    n
 }
 
 /// The light subpath (pbrt-v3's GenerateLightSubpath): the light vertex
@@ -490,5 +492,6 @@ pub(super) fn light_subpath<'a>(
         }
         path[0].pdf_fwd = c.infinite_light_density(e.ray.d);
     }
+    finish_subpath(c, path);
     n + 1
 }

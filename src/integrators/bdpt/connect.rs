@@ -3,7 +3,7 @@
 //! that strategy against every other that could have made the same path
 //! (pbrt-v3's `MISWeight`, with its remapping of delta densities to 1).
 
-use super::vertex::{push_at, Kind, Link, Mode, Vertex};
+use super::vertex::{push_at, remap0, Kind, Link, Mode, Vertex};
 use super::Ctx;
 use crate::geometry::{spawn_ray_to, Ray};
 use crate::integrators::volpath::transmittance;
@@ -263,6 +263,14 @@ fn light_vertex<'a>(
     Some((ls.shadow, ls.wi))
 }
 
+/// The unit direction from `v` to `to` as [`Vertex::pdf`] normalizes it;
+/// `None` if they coincide.
+#[inline]
+fn towards(v: &Vertex, to: &Vertex) -> Option<Vec3> {
+    let w = to.p - v.p;
+    (w.length_squared() != 0.0).then(|| w.normalize())
+}
+
 /// pbrt-v3's `MISWeight`: the ratios of every other strategy's density
 /// to this one's summed, with the reverse densities this strategy sets at
 /// the two ends of each subpath (and their delta flags cleared) taken in
@@ -305,15 +313,15 @@ fn mis_weight<'a>(
                 at_pt: Some(pdf_p),
             },
             Some(q),
-            Some(m),
-            Some(qm),
+            Some(_),
+            Some(_),
         ) => {
             let (pq, pp) = (lig(q), cam(pt));
             (
                 pq.convert_density_across(pdf_q, pp, &ln, c),
-                pp.pdf_from(c, -ln.wi, cam(m)),
+                pp.pdf_back(c, -ln.wi),
                 pp.convert_density_across(pdf_p, pq, &ln, c),
-                pq.pdf_from(c, ln.wi, lig(qm)),
+                pq.pdf_back(c, ln.wi),
             )
         }
         _ => (
@@ -325,53 +333,70 @@ fn mis_weight<'a>(
                 None => cam(pt).pdf_light_origin(c, cam(pt_m.unwrap_or(0))),
             },
             pt_m.map_or(0.0, |m| match qs {
-                Some(q) => cam(pt).pdf(c, Some(lig(q)), cam(m)),
+                Some(q) => towards(cam(pt), lig(q)).map_or(0.0, |wp| cam(pt).pdf_back(c, wp)),
                 None => cam(pt).pdf_light(c, cam(m)),
             }),
             qs.map_or(0.0, |q| match dens.at_pt {
                 Some(pdf) => cam(pt).convert_density(pdf, lig(q), c),
                 None => cam(pt).pdf(c, pt_m.map(cam), lig(q)),
             }),
-            qs_m.map_or(0.0, |m| lig(m + 1).pdf(c, Some(cam(pt)), lig(m))),
+            qs_m.map_or(0.0, |m| {
+                towards(lig(m + 1), cam(pt)).map_or(0.0, |wp| lig(m + 1).pdf_back(c, wp))
+            }),
         ),
     };
 
-    let remap0 = |f: f32| if f != 0.0 { f } else { 1.0 };
+    // Each subpath's ratios from its connecting end back: the two
+    // vertices whose reverse densities this strategy sets, then the
+    // stored ratios.
     let mut sum_ri = 0.0f32;
-    let mut ri = 1.0f32;
-    for i in (1..t).rev() {
-        let v = cam(i);
-        let rev = if i == pt {
-            pt_rev
-        } else if Some(i) == pt_m {
-            pt_m_rev
-        } else {
-            v.pdf_rev
-        };
-        ri *= remap0(rev) / remap0(v.pdf_fwd);
-        // pt's delta flag is cleared; the one before it is never pt.
-        if !(v.delta && i != pt) && !cam(i - 1).delta {
+    let mut ri = remap0(pt_rev) / remap0(cam(pt).pdf_fwd);
+    if pt >= 1 {
+        // pt's delta flag is cleared.
+        if !cam(pt - 1).delta {
             sum_ri += ri;
         }
+        if let Some(m) = pt_m.filter(|&m| m >= 1) {
+            let v = cam(m);
+            ri *= remap0(pt_m_rev) / remap0(v.pdf_fwd);
+            if !v.delta && !cam(m - 1).delta {
+                sum_ri += ri;
+            }
+            for i in (1..m).rev() {
+                let v = cam(i);
+                ri *= v.ratio;
+                if !v.delta && !cam(i - 1).delta {
+                    sum_ri += ri;
+                }
+            }
+        }
     }
-    ri = 1.0;
-    for i in (0..s).rev() {
-        let v = lig(i);
-        let rev = if Some(i) == qs {
-            qs_rev
-        } else if Some(i) == qs_m {
-            qs_m_rev
-        } else {
-            v.pdf_rev
+    if let Some(q) = qs {
+        let delta_before = |i: usize| {
+            if i > 0 {
+                lig(i - 1).delta
+            } else {
+                lig(0).is_delta_light(c)
+            }
         };
-        ri *= remap0(rev) / remap0(v.pdf_fwd);
-        let delta_light = if i > 0 {
-            lig(i - 1).delta
-        } else {
-            v.is_delta_light(c)
-        };
-        if !(v.delta && Some(i) != qs) && !delta_light {
+        // qs's delta flag is cleared.
+        ri = remap0(qs_rev) / remap0(lig(q).pdf_fwd);
+        if !delta_before(q) {
             sum_ri += ri;
+        }
+        if let Some(m) = qs_m {
+            let v = lig(m);
+            ri *= remap0(qs_m_rev) / remap0(v.pdf_fwd);
+            if !v.delta && !delta_before(m) {
+                sum_ri += ri;
+            }
+            for i in (0..m).rev() {
+                let v = lig(i);
+                ri *= v.ratio;
+                if !v.delta && !delta_before(i) {
+                    sum_ri += ri;
+                }
+            }
         }
     }
     1.0 / (1.0 + sum_ri)

@@ -53,6 +53,8 @@ pub(crate) fn push_at<'a>(
             delta: _,
             pdf_fwd: _,
             pdf_rev: _,
+            ratio: _,
+            back: _,
         } = v;
     };
     // SAFETY: `reserve` made slot `len` exist; every field of the vertex
@@ -74,6 +76,8 @@ pub(crate) fn push_at<'a>(
         addr_of_mut!((*v).delta).write(false);
         addr_of_mut!((*v).pdf_fwd).write(0.0);
         addr_of_mut!((*v).pdf_rev).write(0.0);
+        addr_of_mut!((*v).ratio).write(0.0);
+        addr_of_mut!((*v).back).write(None);
         path.set_len(len + 1);
     }
 }
@@ -124,6 +128,75 @@ pub(crate) struct Vertex<'a> {
     pub delta: bool,
     pub pdf_fwd: f32,
     pub pdf_rev: f32,
+    /// The MIS weight's ratio of the vertex's reverse density to its
+    /// forward one, each 0 taken as 1 (pbrt-v3's `remap0`), set by
+    /// [`finish_subpath`] once the subpath is complete.
+    pub ratio: f32,
+    /// The way back to the previous vertex of the subpath (`None`: none,
+    /// or coincident), set by [`finish_subpath`].
+    pub back: Option<Back>,
+}
+
+/// What the density of scattering from a vertex back to its predecessor
+/// on the subpath needs that does not depend on where the vertex was
+/// arrived at from (pbrt-v3 recomputes it in each strategy's MIS weight):
+/// the direction, normalized as [`Vertex::pdf`] normalizes it, and
+/// [`Vertex::convert_density`]'s factors.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Back {
+    pub wn: Vec3,
+    /// |cos| at the predecessor (1 off surfaces and at infinity).
+    pub cos: f32,
+    /// 1 / squared distance (1 to a light at infinity).
+    pub inv: f32,
+}
+
+impl Back {
+    fn new(c: &Ctx, v: &Vertex, prev: &Vertex) -> Option<Back> {
+        let w = prev.p - v.p;
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let wn = w.normalize();
+        if prev.is_infinite_light(c) {
+            return Some(Back {
+                wn,
+                cos: 1.0,
+                inv: 1.0,
+            });
+        }
+        let inv = 1.0 / d2;
+        let cos = if prev.on_surface() {
+            prev.n.dot(w * inv.sqrt()).abs()
+        } else {
+            1.0
+        };
+        Some(Back { wn, cos, inv })
+    }
+}
+
+/// pbrt-v3's `remap0`: a density of 0 (a delta bounce) counts as 1 in
+/// the MIS weight.
+#[inline]
+pub(crate) fn remap0(f: f32) -> f32 {
+    if f != 0.0 {
+        f
+    } else {
+        1.0
+    }
+}
+
+/// Sets what the MIS weights of all the strategies through a complete
+/// subpath's vertices share, once: each one's [`Vertex::ratio`] and
+/// [`Vertex::back`].
+pub(crate) fn finish_subpath(c: &Ctx, path: &mut [Vertex]) {
+    for i in 0..path.len() {
+        let (before, rest) = path.split_at_mut(i);
+        let v = &mut rest[0];
+        v.ratio = remap0(v.pdf_rev) / remap0(v.pdf_fwd);
+        v.back = before.last().and_then(|prev| Back::new(c, v, prev));
+    }
 }
 
 impl<'a> Vertex<'a> {
@@ -312,18 +385,20 @@ impl<'a> Vertex<'a> {
         self.pdf_dirs(c, wp, wn, next)
     }
 
-    /// [`Vertex::pdf`] with the unit direction towards the previous vertex
-    /// known (`wp`, normalized as `pdf` normalizes it, from a distinct
-    /// point).
-    pub fn pdf_from(&self, c: &Ctx, wp: Vec3, next: &Vertex) -> f32 {
-        if self.kind == Kind::Light {
-            return self.pdf_light(c, next);
-        }
-        let wn = next.p - self.p;
-        if wn.length_squared() == 0.0 {
+    /// [`Vertex::pdf`] of scattering back to the subpath's previous vertex
+    /// (by [`Vertex::back`]), arrived at from the unit direction `wp`.
+    #[inline]
+    pub fn pdf_back(&self, c: &Ctx, wp: Vec3) -> f32 {
+        let Some(b) = self.back else {
             return 0.0;
-        }
-        self.pdf_dirs(c, wp, wn.normalize(), next)
+        };
+        let pdf = match self.kind {
+            Kind::Camera => c.camera.pdf_we(self.p, b.wn, self.time).1,
+            Kind::Surface => self.bsdf.pdf(wp, b.wn, BxdfFlags::ALL),
+            Kind::Medium => self.phase.p(wp, b.wn),
+            Kind::Light => 0.0,
+        };
+        pdf * b.cos * b.inv
     }
 
     /// The rest of [`Vertex::pdf`], from the unit directions towards the
