@@ -349,6 +349,9 @@ impl Bdpt {
         let max_depth = self.settings.max_depth;
         let n_camera = camera_subpath(c, (ray, time, diff), max_depth + 1, cam, sampler, scratch);
         let n_light = light_subpath(c, time, max_depth, light, sampler, scratch);
+        // Every vertex is a connection's end in some strategy.
+        finish_subpath(c, cam, 0);
+        finish_subpath(c, light, 0);
         let p_film = if self.settings.visualizes() {
             c.camera.we(ray.o, ray.d, time).1
         } else {
@@ -433,9 +436,7 @@ pub(super) fn camera_subpath<'a>(
         time,
         mode: Mode::Radiance,
     };
-    let n = 1 + random_walk(c, walk, bounces, cam, sampler, scratch) as usize;
-    finish_subpath(c, cam);
-    n
+    1 + random_walk(c, walk, bounces, cam, sampler, scratch) as usize
 }
 
 /// The light subpath (pbrt-v3's GenerateLightSubpath): the light vertex
@@ -492,6 +493,5 @@ pub(super) fn light_subpath<'a>(
         }
         path[0].pdf_fwd = c.infinite_light_density(e.ray.d);
     }
-    finish_subpath(c, path);
     n + 1
 }

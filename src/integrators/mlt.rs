@@ -35,6 +35,7 @@
 //! in chain order, so the image is the same for any thread count. A
 //! nonzero `--seed` changes every sequence number (seed 0 is pbrt-v3's).
 
+use super::bdpt::vertex::finish_subpath;
 use super::bdpt::{camera_subpath, connect, light_subpath, recycle, Ctx};
 use super::common::light_sampler;
 use super::{max_depth_bidirectional, Integrate, IntegratorKind, IntegratorSettings, RayCounts, Scratch, Splat};
@@ -570,6 +571,9 @@ impl PathMaker<'_, '_> {
                 light_subpath(&c, time, s as u32 - 1, &mut light, sampler, scratch)
             };
             if n_light == s {
+                // The one strategy connects the subpaths' last vertices.
+                finish_subpath(&c, &mut cam, t - 1);
+                finish_subpath(&c, &mut light, s.saturating_sub(1));
                 mlt(sampler).start_stream(CONNECTION_STREAM);
                 let st = connect::connect(&c, &mut light, &mut cam, (s, t), None, sampler, scratch);
                 let p = if t == 1 {

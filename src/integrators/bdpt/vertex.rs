@@ -187,15 +187,20 @@ pub(crate) fn remap0(f: f32) -> f32 {
     }
 }
 
-/// Sets what the MIS weights of all the strategies through a complete
-/// subpath's vertices share, once: each one's [`Vertex::ratio`] and
-/// [`Vertex::back`].
-pub(crate) fn finish_subpath(c: &Ctx, path: &mut [Vertex]) {
+/// Sets what the MIS weights of the strategies through a complete
+/// subpath's vertices share, once: each one's [`Vertex::ratio`], and
+/// [`Vertex::back`] for those from `first_end` on, the ones that end a
+/// connection (every vertex for bdpt, the last for one mlt strategy).
+pub(crate) fn finish_subpath(c: &Ctx, path: &mut [Vertex], first_end: usize) {
     for i in 0..path.len() {
         let (before, rest) = path.split_at_mut(i);
         let v = &mut rest[0];
         v.ratio = remap0(v.pdf_rev) / remap0(v.pdf_fwd);
-        v.back = before.last().and_then(|prev| Back::new(c, v, prev));
+        v.back = if i >= first_end {
+            before.last().and_then(|prev| Back::new(c, v, prev))
+        } else {
+            None
+        };
     }
 }
 
