@@ -306,3 +306,21 @@ fn a_light_in_a_medium_emits_into_it() {
     assert!(scene.light_media[0].is_some(), "{:?}", scene.light_media);
     assert_eq!(scene.light_media[1], None);
 }
+
+#[test]
+fn shared_mis_weights_give_the_plain_image() {
+    // `mis_shared` (each vertex's density ratio and way back computed once
+    // per subpath) against pbrt-v3's MISWeight as it computes it: a
+    // diffuse box with an area light, glass under a point light (delta
+    // light, specular vertices), fog (medium vertices) and a sky at
+    // infinity with fog.
+    for (file, spp) in [
+        ("scenes/bdpt/cornell.pbrt", 4),
+        ("scenes/bdpt/caustic.pbrt", 8),
+        ("scenes/bdpt/fog.pbrt", 4),
+        ("scenes/bdpt/sky-fog.pbrt", 4),
+    ] {
+        let d = sized(load(file), 24, 24, spp);
+        common::assert_fast_is_scalar(&d, file);
+    }
+}

@@ -167,3 +167,21 @@ fn farm_parts_are_refused() {
         assert!(!path.exists(), "a part was written");
     }
 }
+
+#[test]
+fn shared_mis_weights_give_the_plain_image() {
+    // mlt's one strategy per path with `mis_shared`'s weights (the way
+    // back found for the two connected vertices only) against pbrt-v3's
+    // MISWeight as it computes it.
+    for file in ["scenes/mlt/caustic.pbrt", "scenes/mlt/cornell.pbrt"] {
+        let mut d = load(file);
+        d.film.xresolution = 12;
+        d.film.yresolution = 12;
+        if let IntegratorSettings::Mlt(m) = &mut d.integrator {
+            m.mutations_per_pixel = 16;
+            m.bootstrap_samples = 4096;
+            m.chains = 16;
+        }
+        common::assert_fast_is_scalar(&d, file);
+    }
+}

@@ -34,6 +34,7 @@
 
 pub(super) mod connect;
 mod draw_ahead;
+pub(crate) mod mis_shared;
 pub(crate) mod vertex;
 
 use super::common::light_sampler;
@@ -49,7 +50,8 @@ use crate::scene::kind::{Report, Support};
 use crate::scene::{LightSampleStrategy, ParamSpec, ParamValues};
 use crate::shapes::SurfacePoint;
 use glam::{Vec2, Vec3};
-use vertex::{push_at, finish_subpath, random_walk, Kind, Mode, Vertex, Walk};
+use mis_shared::finish_subpath;
+use vertex::{push_at, random_walk, Kind, Mode, Vertex, Walk};
 
 pub const PARAMS: &[ParamSpec] = &[
     MAX_DEPTH,
@@ -204,6 +206,8 @@ pub struct Bdpt {
     /// (`draw_ahead::draw_ahead`, where `draw_ahead::draws_ahead`; not in the
     /// scalar loop, the tests' plain reference).
     draw_ahead: bool,
+    /// The plain MIS weights ([`Ctx::plain`]).
+    plain: bool,
     settings: BdptSettings,
     lights: LightSampler,
     sample_bounds: Option<Bounds2i>,
@@ -214,6 +218,7 @@ impl Bdpt {
     pub fn new(settings: &BdptSettings, scene: &RenderScene, scalar: bool) -> Bdpt {
         Bdpt {
             draw_ahead: !scalar && draw_ahead::draws_ahead(scene),
+            plain: scalar,
             settings: *settings,
             lights: light_sampler(settings.light_sample_strategy, scene),
             sample_bounds: None,
@@ -232,6 +237,9 @@ pub(crate) struct Ctx<'a> {
     pub p_camera: Vec3,
     pub camera_medium: Option<u32>,
     pub scene_radius: f32,
+    /// The plain code (`RenderOptions::scalar`, the tests' reference):
+    /// pbrt-v3's MIS weights computed as it computes them.
+    pub plain: bool,
 }
 
 impl Ctx<'_> {
@@ -317,6 +325,7 @@ impl Integrate for Bdpt {
                 scene.camera_medium
             },
             scene_radius: self.scene_radius,
+            plain: self.plain,
         };
         let mut cam = recycle(std::mem::take(&mut scratch.bdpt.camera));
         let mut light = recycle(std::mem::take(&mut scratch.bdpt.light));
@@ -349,9 +358,11 @@ impl Bdpt {
         let max_depth = self.settings.max_depth;
         let n_camera = camera_subpath(c, (ray, time, diff), max_depth + 1, cam, sampler, scratch);
         let n_light = light_subpath(c, time, max_depth, light, sampler, scratch);
-        // Every vertex is a connection's end in some strategy.
-        finish_subpath(c, cam, 0);
-        finish_subpath(c, light, 0);
+        if !c.plain {
+            // Every vertex is a connection's end in some strategy.
+            finish_subpath(c, cam, 0);
+            finish_subpath(c, light, 0);
+        }
         let p_film = if self.settings.visualizes() {
             c.camera.we(ray.o, ray.d, time).1
         } else {

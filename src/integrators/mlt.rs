@@ -35,7 +35,7 @@
 //! in chain order, so the image is the same for any thread count. A
 //! nonzero `--seed` changes every sequence number (seed 0 is pbrt-v3's).
 
-use super::bdpt::vertex::finish_subpath;
+use super::bdpt::mis_shared::finish_subpath;
 use super::bdpt::{camera_subpath, connect, light_subpath, recycle, Ctx};
 use super::common::light_sampler;
 use super::{max_depth_bidirectional, Integrate, IntegratorKind, IntegratorSettings, RayCounts, Scratch, Splat};
@@ -218,6 +218,9 @@ pub struct Mlt {
     lights: LightSampler,
     sample_bounds: Option<Bounds2i>,
     scene_radius: f32,
+    /// The plain MIS weights (`RenderOptions::scalar`, the tests'
+    /// reference).
+    plain: bool,
 }
 
 /// What [`Mlt::render`] renders with.
@@ -281,8 +284,9 @@ fn acceptance(ratio: f32) -> f32 {
 }
 
 impl Mlt {
-    pub fn new(settings: &MltSettings, scene: &RenderScene, _scalar: bool) -> Mlt {
+    pub fn new(settings: &MltSettings, scene: &RenderScene, scalar: bool) -> Mlt {
         Mlt {
+            plain: scalar,
             settings: *settings,
             lights: light_sampler(LightSampleStrategy::Power, scene),
             sample_bounds: None,
@@ -328,6 +332,7 @@ impl Mlt {
                 scene.camera_medium
             },
             scene_radius: self.scene_radius,
+            plain: self.plain,
         };
         let paths = PathMaker {
             base: &base,
@@ -572,8 +577,10 @@ impl PathMaker<'_, '_> {
             };
             if n_light == s {
                 // The one strategy connects the subpaths' last vertices.
-                finish_subpath(&c, &mut cam, t - 1);
-                finish_subpath(&c, &mut light, s.saturating_sub(1));
+                if !c.plain {
+                    finish_subpath(&c, &mut cam, t - 1);
+                    finish_subpath(&c, &mut light, s.saturating_sub(1));
+                }
                 mlt(sampler).start_stream(CONNECTION_STREAM);
                 let st = connect::connect(&c, &mut light, &mut cam, (s, t), None, sampler, scratch);
                 let p = if t == 1 {

@@ -3,7 +3,8 @@
 //! that strategy against every other that could have made the same path
 //! (pbrt-v3's `MISWeight`, with its remapping of delta densities to 1).
 
-use super::vertex::{push_at, remap0, Kind, Link, Mode, Vertex};
+use super::mis_shared;
+use super::vertex::{push_at, Kind, Link, Mode, Vertex};
 use super::Ctx;
 use crate::geometry::{spawn_ray_to, Ray};
 use crate::integrators::volpath::transmittance;
@@ -188,8 +189,10 @@ pub(crate) fn connect<'a>(
     }
     let weight = if l == Vec3::ZERO {
         0.0
+    } else if c.plain {
+        mis_weight_plain(c, light, camera, sampled, dens, s, t)
     } else {
-        mis_weight(c, light, camera, (sampled, link), dens, s, t)
+        mis_shared::mis_weight(c, light, camera, (sampled, link), dens, s, t)
     };
     // A sampled endpoint goes again (the one early return comes before
     // anything is pushed).
@@ -205,12 +208,12 @@ pub(crate) fn connect<'a>(
 /// Solid-angle densities of scattering across the connection, where the
 /// connection's BSDF evaluations gave them.
 #[derive(Clone, Copy, Default)]
-struct Densities {
+pub(super) struct Densities {
     /// At the light subpath's end (qs) towards the camera subpath's (pt),
     /// arriving from qs's predecessor.
-    at_qs: Option<f32>,
+    pub at_qs: Option<f32>,
     /// At pt towards qs, arriving from pt's predecessor.
-    at_pt: Option<f32>,
+    pub at_pt: Option<f32>,
 }
 
 /// The light vertex of the s = 1 strategy, pushed onto `path`: light `i`
@@ -263,27 +266,17 @@ fn light_vertex<'a>(
     Some((ls.shadow, ls.wi))
 }
 
-/// The unit direction from `v` to `to` as [`Vertex::pdf`] normalizes it;
-/// `None` if they coincide.
-#[inline]
-fn towards(v: &Vertex, to: &Vertex) -> Option<Vec3> {
-    let w = to.p - v.p;
-    (w.length_squared() != 0.0).then(|| w.normalize())
-}
-
-/// pbrt-v3's `MISWeight`: the ratios of every other strategy's density
-/// to this one's summed, with the reverse densities this strategy sets at
-/// the two ends of each subpath (and their delta flags cleared) taken in
-/// place of the stored ones, and a sampled endpoint (the last vertex of
-/// `camera` for t = 1, of `light` for s = 1) in place of the subpath's
-/// first. pbrt-v3 writes these into the subpaths and restores them; the
-/// subpaths are only read here, in the same order of arithmetic. `link`:
-/// the segment of an s, t ≥ 2 connection.
-fn mis_weight<'a>(
+/// pbrt-v3's `MISWeight` as it computes it, the plain code that
+/// [`mis_shared::mis_weight`] is tested against: the subpaths' reverse densities are set for
+/// this strategy (and a sampled endpoint, the last vertex of `camera` for
+/// t = 1 and of `light` for s = 1, put in place), the ratios of
+/// every other strategy's density to this one's summed, and the subpaths
+/// restored.
+fn mis_weight_plain<'a>(
     c: &Ctx<'a>,
-    light: &[Vertex<'a>],
-    camera: &[Vertex<'a>],
-    (sampled, link): (bool, Option<Link>),
+    light: &mut [Vertex<'a>],
+    camera: &mut [Vertex<'a>],
+    sampled: bool,
     dens: Densities,
     s: usize,
     t: usize,
@@ -291,113 +284,87 @@ fn mis_weight<'a>(
     if s + t == 2 {
         return 1.0;
     }
-    // The vertices as this strategy sees them.
-    let first_cam = if sampled && s != 1 {
-        camera.len() - 1
-    } else {
-        0
-    };
-    let first_light = if sampled && s == 1 { light.len() - 1 } else { 0 };
-    let cam = |i: usize| &camera[if i == 0 { first_cam } else { i }];
-    let lig = |i: usize| &light[if i == 0 { first_light } else { i }];
-    // The new reverse densities.
+    // The sampled endpoint replaces the subpath's.
+    if sampled {
+        swap_sampled_endpoint(if s == 1 { light } else { camera });
+    }
+    // The new reverse densities, computed before any is set.
     let (qs, pt) = (s.checked_sub(1), t - 1);
     let (qs_m, pt_m) = (s.checked_sub(2), t.checked_sub(2));
-    let (pt_rev, pt_m_rev, qs_rev, qs_m_rev) = match (link, dens, qs, pt_m, qs_m) {
-        // s, t ≥ 2 with both ends scattering: the link gives the
-        // directions between them.
-        (
-            Some(ln),
-            Densities {
-                at_qs: Some(pdf_q),
-                at_pt: Some(pdf_p),
-            },
-            Some(q),
-            Some(_),
-            Some(_),
-        ) => {
-            let (pq, pp) = (lig(q), cam(pt));
-            (
-                pq.convert_density_across(pdf_q, pp, &ln, c),
-                pp.pdf_back(c, -ln.wi),
-                pp.convert_density_across(pdf_p, pq, &ln, c),
-                pq.pdf_back(c, ln.wi),
-            )
-        }
-        _ => (
-            match qs {
-                Some(q) => match dens.at_qs {
-                    Some(pdf) => lig(q).convert_density(pdf, cam(pt), c),
-                    None => lig(q).pdf(c, qs_m.map(lig), cam(pt)),
-                },
-                None => cam(pt).pdf_light_origin(c, cam(pt_m.unwrap_or(0))),
-            },
-            pt_m.map_or(0.0, |m| match qs {
-                Some(q) => towards(cam(pt), lig(q)).map_or(0.0, |wp| cam(pt).pdf_back(c, wp)),
-                None => cam(pt).pdf_light(c, cam(m)),
-            }),
-            qs.map_or(0.0, |q| match dens.at_pt {
-                Some(pdf) => cam(pt).convert_density(pdf, lig(q), c),
-                None => cam(pt).pdf(c, pt_m.map(cam), lig(q)),
-            }),
-            qs_m.map_or(0.0, |m| {
-                towards(lig(m + 1), cam(pt)).map_or(0.0, |wp| lig(m + 1).pdf_back(c, wp))
-            }),
-        ),
+    let pt_rev = match qs {
+        Some(q) => match dens.at_qs {
+            Some(pdf) => light[q].convert_density(pdf, &camera[pt], c),
+            None => light[q].pdf(c, qs_m.map(|i| &light[i]), &camera[pt]),
+        },
+        None => camera[pt].pdf_light_origin(c, &camera[pt_m.unwrap_or(0)]),
     };
+    let pt_m_rev = pt_m.map(|m| match qs {
+        Some(q) => camera[pt].pdf(c, Some(&light[q]), &camera[m]),
+        None => camera[pt].pdf_light(c, &camera[m]),
+    });
+    let qs_rev = qs.map(|q| match dens.at_pt {
+        Some(pdf) => camera[pt].convert_density(pdf, &light[q], c),
+        None => camera[pt].pdf(c, pt_m.map(|i| &camera[i]), &light[q]),
+    });
+    let qs_m_rev = qs_m.map(|m| light[m + 1].pdf(c, Some(&camera[pt]), &light[m]));
+    // Set them (and clear the endpoints' delta flags), keeping the old.
+    let saved_pt = (camera[pt].pdf_rev, camera[pt].delta);
+    camera[pt].pdf_rev = pt_rev;
+    camera[pt].delta = false;
+    let saved_pt_m =
+        pt_m.map(|m| std::mem::replace(&mut camera[m].pdf_rev, pt_m_rev.unwrap_or(0.0)));
+    let saved_qs = qs.map(|q| {
+        let old = (light[q].pdf_rev, light[q].delta);
+        light[q].pdf_rev = qs_rev.unwrap_or(0.0);
+        light[q].delta = false;
+        old
+    });
+    let saved_qs_m =
+        qs_m.map(|m| std::mem::replace(&mut light[m].pdf_rev, qs_m_rev.unwrap_or(0.0)));
 
-    // Each subpath's ratios from its connecting end back: the two
-    // vertices whose reverse densities this strategy sets, then the
-    // stored ratios.
+    let remap0 = |f: f32| if f != 0.0 { f } else { 1.0 };
     let mut sum_ri = 0.0f32;
-    let mut ri = remap0(pt_rev) / remap0(cam(pt).pdf_fwd);
-    if pt >= 1 {
-        // pt's delta flag is cleared.
-        if !cam(pt - 1).delta {
+    let mut ri = 1.0f32;
+    for i in (1..t).rev() {
+        ri *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
+        if !camera[i].delta && !camera[i - 1].delta {
             sum_ri += ri;
-        }
-        if let Some(m) = pt_m.filter(|&m| m >= 1) {
-            let v = cam(m);
-            ri *= remap0(pt_m_rev) / remap0(v.pdf_fwd);
-            if !v.delta && !cam(m - 1).delta {
-                sum_ri += ri;
-            }
-            for i in (1..m).rev() {
-                let v = cam(i);
-                ri *= v.ratio;
-                if !v.delta && !cam(i - 1).delta {
-                    sum_ri += ri;
-                }
-            }
         }
     }
-    if let Some(q) = qs {
-        let delta_before = |i: usize| {
-            if i > 0 {
-                lig(i - 1).delta
-            } else {
-                lig(0).is_delta_light(c)
-            }
+    ri = 1.0;
+    for i in (0..s).rev() {
+        ri *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
+        let delta_light = if i > 0 {
+            light[i - 1].delta
+        } else {
+            light[0].is_delta_light(c)
         };
-        // qs's delta flag is cleared.
-        ri = remap0(qs_rev) / remap0(lig(q).pdf_fwd);
-        if !delta_before(q) {
+        if !light[i].delta && !delta_light {
             sum_ri += ri;
         }
-        if let Some(m) = qs_m {
-            let v = lig(m);
-            ri *= remap0(qs_m_rev) / remap0(v.pdf_fwd);
-            if !v.delta && !delta_before(m) {
-                sum_ri += ri;
-            }
-            for i in (0..m).rev() {
-                let v = lig(i);
-                ri *= v.ratio;
-                if !v.delta && !delta_before(i) {
-                    sum_ri += ri;
-                }
-            }
-        }
+    }
+
+    // Restore.
+    (camera[pt].pdf_rev, camera[pt].delta) = saved_pt;
+    if let (Some(m), Some(v)) = (pt_m, saved_pt_m) {
+        camera[m].pdf_rev = v;
+    }
+    if let (Some(q), Some((r, d))) = (qs, saved_qs) {
+        light[q].pdf_rev = r;
+        light[q].delta = d;
+    }
+    if let (Some(m), Some(v)) = (qs_m, saved_qs_m) {
+        light[m].pdf_rev = v;
+    }
+    if sampled {
+        swap_sampled_endpoint(if s == 1 { light } else { camera });
     }
     1.0 / (1.0 + sum_ri)
+}
+
+/// Exchanges a subpath's first vertex with the sampled endpoint at its end.
+fn swap_sampled_endpoint(path: &mut [Vertex]) {
+    let (first, rest) = path.split_at_mut(1);
+    let last = rest.last_mut().expect("a sampled endpoint past the first");
+    first[0].swap_endpoint(last);
 }

@@ -5,6 +5,7 @@
 //! direction, and the random walk that makes a subpath (pbrt-v3's
 //! `RandomWalk`), with media sampled along its segments.
 
+use super::mis_shared::Back;
 use super::Ctx;
 use crate::geometry::{spawn_ray, Ray, RayDiff};
 use crate::integrators::common::{escaped, shade};
@@ -130,50 +131,13 @@ pub(crate) struct Vertex<'a> {
     pub pdf_rev: f32,
     /// The MIS weight's ratio of the vertex's reverse density to its
     /// forward one, each 0 taken as 1 (pbrt-v3's `remap0`), set by
-    /// [`finish_subpath`] once the subpath is complete.
+    /// [`finish_subpath`](super::mis_shared::finish_subpath) once the
+    /// subpath is complete.
     pub ratio: f32,
     /// The way back to the previous vertex of the subpath (`None`: none,
-    /// or coincident), set by [`finish_subpath`].
+    /// or coincident), set by
+    /// [`finish_subpath`](super::mis_shared::finish_subpath).
     pub back: Option<Back>,
-}
-
-/// What the density of scattering from a vertex back to its predecessor
-/// on the subpath needs that does not depend on where the vertex was
-/// arrived at from (pbrt-v3 recomputes it in each strategy's MIS weight):
-/// the direction, normalized as [`Vertex::pdf`] normalizes it, and
-/// [`Vertex::convert_density`]'s factors.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Back {
-    pub wn: Vec3,
-    /// |cos| at the predecessor (1 off surfaces and at infinity).
-    pub cos: f32,
-    /// 1 / squared distance (1 to a light at infinity).
-    pub inv: f32,
-}
-
-impl Back {
-    fn new(c: &Ctx, v: &Vertex, prev: &Vertex) -> Option<Back> {
-        let w = prev.p - v.p;
-        let d2 = w.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wn = w.normalize();
-        if prev.is_infinite_light(c) {
-            return Some(Back {
-                wn,
-                cos: 1.0,
-                inv: 1.0,
-            });
-        }
-        let inv = 1.0 / d2;
-        let cos = if prev.on_surface() {
-            prev.n.dot(w * inv.sqrt()).abs()
-        } else {
-            1.0
-        };
-        Some(Back { wn, cos, inv })
-    }
 }
 
 /// pbrt-v3's `remap0`: a density of 0 (a delta bounce) counts as 1 in
@@ -187,24 +151,53 @@ pub(crate) fn remap0(f: f32) -> f32 {
     }
 }
 
-/// Sets what the MIS weights of the strategies through a complete
-/// subpath's vertices share, once: each one's [`Vertex::ratio`], and
-/// [`Vertex::back`] for those from `first_end` on, the ones that end a
-/// connection (every vertex for bdpt, the last for one mlt strategy).
-pub(crate) fn finish_subpath(c: &Ctx, path: &mut [Vertex], first_end: usize) {
-    for i in 0..path.len() {
-        let (before, rest) = path.split_at_mut(i);
-        let v = &mut rest[0];
-        v.ratio = remap0(v.pdf_rev) / remap0(v.pdf_fwd);
-        v.back = if i >= first_end {
-            before.last().and_then(|prev| Back::new(c, v, prev))
-        } else {
-            None
-        };
-    }
-}
 
 impl<'a> Vertex<'a> {
+    /// Exchanges everything but the BSDF and phase function with `other`:
+    /// how a strategy's sampled camera or light vertex takes the place of
+    /// the subpath's endpoint (neither scatters, so they have neither)
+    /// without moving a BSDF's worth of bytes.
+    pub fn swap_endpoint(&mut self, other: &mut Vertex<'a>) {
+        use std::mem::swap;
+        // Written out in full, so that a new field must be placed here.
+        let Vertex {
+            kind,
+            beta,
+            p,
+            p_error,
+            n,
+            ns,
+            wo,
+            time,
+            medium,
+            media,
+            light,
+            bsdf: _,
+            phase: _,
+            delta,
+            pdf_fwd,
+            pdf_rev,
+            ratio,
+            back,
+        } = self;
+        swap(kind, &mut other.kind);
+        swap(beta, &mut other.beta);
+        swap(p, &mut other.p);
+        swap(p_error, &mut other.p_error);
+        swap(n, &mut other.n);
+        swap(ns, &mut other.ns);
+        swap(wo, &mut other.wo);
+        swap(time, &mut other.time);
+        swap(medium, &mut other.medium);
+        swap(media, &mut other.media);
+        swap(light, &mut other.light);
+        swap(delta, &mut other.delta);
+        swap(pdf_fwd, &mut other.pdf_fwd);
+        swap(pdf_rev, &mut other.pdf_rev);
+        swap(ratio, &mut other.ratio);
+        swap(back, &mut other.back);
+    }
+
     #[inline]
     pub fn on_surface(&self) -> bool {
         self.n != Vec3::ZERO
@@ -388,22 +381,6 @@ impl<'a> Vertex<'a> {
             None => Vec3::ZERO,
         };
         self.pdf_dirs(c, wp, wn, next)
-    }
-
-    /// [`Vertex::pdf`] of scattering back to the subpath's previous vertex
-    /// (by [`Vertex::back`]), arrived at from the unit direction `wp`.
-    #[inline]
-    pub fn pdf_back(&self, c: &Ctx, wp: Vec3) -> f32 {
-        let Some(b) = self.back else {
-            return 0.0;
-        };
-        let pdf = match self.kind {
-            Kind::Camera => c.camera.pdf_we(self.p, b.wn, self.time).1,
-            Kind::Surface => self.bsdf.pdf(wp, b.wn, BxdfFlags::ALL),
-            Kind::Medium => self.phase.p(wp, b.wn),
-            Kind::Light => 0.0,
-        };
-        pdf * b.cos * b.inv
     }
 
     /// The rest of [`Vertex::pdf`], from the unit directions towards the
