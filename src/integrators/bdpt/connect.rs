@@ -4,7 +4,7 @@
 //! (pbrt-v3's `MISWeight`, with its remapping of delta densities to 1).
 
 use super::mis_shared;
-use super::vertex::{push_at, Kind, Link, Mode, Vertex};
+use super::vertex::{push_at, remap0, Kind, Link, Mode, Vertex};
 use super::Ctx;
 use crate::geometry::{spawn_ray_to, Ray};
 use crate::integrators::volpath::transmittance;
@@ -267,11 +267,11 @@ fn light_vertex<'a>(
 }
 
 /// pbrt-v3's `MISWeight` as it computes it, the plain code that
-/// [`mis_shared::mis_weight`] is tested against: the subpaths' reverse densities are set for
-/// this strategy (and a sampled endpoint, the last vertex of `camera` for
-/// t = 1 and of `light` for s = 1, put in place), the ratios of
-/// every other strategy's density to this one's summed, and the subpaths
-/// restored.
+/// [`mis_shared::mis_weight`] is tested against: the subpaths' reverse
+/// densities are set for this strategy (and a sampled endpoint, the last
+/// vertex of `camera` for t = 1 and of `light` for s = 1, put in place),
+/// the ratios of every other strategy's density to this one's summed, and
+/// the subpaths restored.
 fn mis_weight_plain<'a>(
     c: &Ctx<'a>,
     light: &mut [Vertex<'a>],
@@ -322,7 +322,6 @@ fn mis_weight_plain<'a>(
     let saved_qs_m =
         qs_m.map(|m| std::mem::replace(&mut light[m].pdf_rev, qs_m_rev.unwrap_or(0.0)));
 
-    let remap0 = |f: f32| if f != 0.0 { f } else { 1.0 };
     let mut sum_ri = 0.0f32;
     let mut ri = 1.0f32;
     for i in (1..t).rev() {

@@ -11,9 +11,8 @@
 //! evaluates one density each for those two.
 
 use super::connect::Densities;
-use super::vertex::{remap0, Kind, Link, Vertex};
+use super::vertex::{remap0, Link, Vertex};
 use super::Ctx;
-use crate::materials::BxdfFlags;
 use glam::Vec3;
 
 /// What the density of scattering from a vertex back to its predecessor
@@ -80,15 +79,8 @@ impl Vertex<'_> {
         let Some(b) = self.back else {
             return 0.0;
         };
-        let pdf = match self.kind {
-            Kind::Camera => c.camera.pdf_we(self.p, b.wn, self.time).1,
-            Kind::Surface => self.bsdf.pdf(wp, b.wn, BxdfFlags::ALL),
-            Kind::Medium => self.phase.p(wp, b.wn),
-            Kind::Light => 0.0,
-        };
-        pdf * b.cos * b.inv
+        self.pdf_dirs(c, wp, b.wn) * b.cos * b.inv
     }
-
 }
 
 /// The unit direction from `v` to `to` as [`Vertex::pdf`] normalizes it;

@@ -151,7 +151,6 @@ pub(crate) fn remap0(f: f32) -> f32 {
     }
 }
 
-
 impl<'a> Vertex<'a> {
     /// Exchanges everything but the BSDF and phase function with `other`:
     /// how a strategy's sampled camera or light vertex takes the place of
@@ -380,20 +379,19 @@ impl<'a> Vertex<'a> {
             }
             None => Vec3::ZERO,
         };
-        self.pdf_dirs(c, wp, wn, next)
+        self.convert_density(self.pdf_dirs(c, wp, wn), next, c)
     }
 
-    /// The rest of [`Vertex::pdf`], from the unit directions towards the
-    /// previous vertex and the next.
+    /// [`Vertex::pdf`] by solid angle, from the unit directions towards
+    /// the previous vertex and the next.
     #[inline]
-    fn pdf_dirs(&self, c: &Ctx, wp: Vec3, wn: Vec3, next: &Vertex) -> f32 {
-        let pdf = match self.kind {
+    pub fn pdf_dirs(&self, c: &Ctx, wp: Vec3, wn: Vec3) -> f32 {
+        match self.kind {
             Kind::Camera => c.camera.pdf_we(self.p, wn, self.time).1,
             Kind::Surface => self.bsdf.pdf(wp, wn, BxdfFlags::ALL),
             Kind::Medium => self.phase.p(wp, wn),
             Kind::Light => 0.0,
-        };
-        self.convert_density(pdf, next, c)
+        }
     }
 
     /// The light of a light vertex or an emitting surface.
