@@ -30,27 +30,27 @@ pub(crate) struct Back {
 }
 
 impl Back {
+    /// The link from `v` back to `prev`, with `ConvertDensity`'s factors
+    /// at `prev`.
     fn new(c: &Ctx, v: &Vertex, prev: &Vertex) -> Option<Back> {
-        let w = prev.p - v.p;
-        let d2 = w.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wn = w.normalize();
+        let link = Link::new(v, prev)?;
         if prev.is_infinite_light(c) {
             return Some(Back {
-                wn,
+                wn: link.wi,
                 cos: 1.0,
                 inv: 1.0,
             });
         }
-        let inv = 1.0 / d2;
         let cos = if prev.on_surface() {
-            prev.n.dot(w * inv.sqrt()).abs()
+            prev.n.dot(link.dir).abs()
         } else {
             1.0
         };
-        Some(Back { wn, cos, inv })
+        Some(Back {
+            wn: link.wi,
+            cos,
+            inv: link.inv,
+        })
     }
 }
 

@@ -474,7 +474,8 @@ pub(crate) struct Link {
 }
 
 impl Link {
-    /// The link from `qs` to `pt`; `None` if they are the same point.
+    /// The link from `qs` to `pt` (or from any vertex to another); `None`
+    /// if they are the same point.
     #[inline]
     pub fn new(qs: &Vertex, pt: &Vertex) -> Option<Link> {
         let w = pt.p - qs.p;
