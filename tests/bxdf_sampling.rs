@@ -10,7 +10,7 @@ use pbrs::geometry::Frame;
 mod common;
 
 use common::material_bsdf;
-use pbrs::bxdf::{Bxdf, FresnelSpecular};
+use pbrs::bxdf::{Bxdf, BxdfModel, FresnelSpecular, LambertianReflection};
 use pbrs::materials::{Bsdf, BxdfFlags};
 use pbrs::sampling::chi2::{chi2_sphere, sidak_significance, Chi2Config};
 use pbrs::sampling::Pcg32;
@@ -117,6 +117,55 @@ fn lambertian_chi2_and_f() {
         let w = s.f * s.wi.z.abs() / s.pdf;
         assert!((w - kd).abs().max_element() < 1e-5, "{w:?}");
     }
+}
+
+/// `Bsdf` evaluates and samples a Lambertian reflection lobe from the
+/// cosines alone: the values are, bit for bit, the lobe's own from the
+/// whole local directions, in tilted frames whose geometric normal differs
+/// from the shading one (so the sides by `ng` and by the frame disagree at
+/// grazing angles), from both sides.
+#[test]
+fn lambertian_from_cosines_is_the_lobe_from_local_directions() {
+    let kd = Vec3::new(0.5, 0.25, 0.8);
+    let lobe = LambertianReflection { r: kd };
+    let mut rng = Pcg32::with_sequence(7);
+    let unit = |rng: &mut Pcg32| {
+        let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+        pbrs::sampling::warps::uniform_sample_sphere(u)
+    };
+    let (mut nonzero, mut zero) = (0, 0);
+    for _ in 0..20_000 {
+        let n = unit(&mut rng);
+        let ng = (n + 0.3 * unit(&mut rng)).normalize();
+        let frame = Frame::from_normal(n);
+        let mut b = Bsdf::new(frame, ng, 1.0);
+        b.add(lobe);
+        let (wo_w, wi_w) = (unit(&mut rng), unit(&mut rng));
+        let (wo, wi) = (frame.to_local(wo_w), frame.to_local(wi_w));
+        let reflect = wi_w.dot(ng) * wo_w.dot(ng) > 0.0;
+        let f = if wo.z == 0.0 || !reflect {
+            Vec3::ZERO
+        } else {
+            lobe.f(wo, wi)
+        };
+        let pdf = if wo.z == 0.0 { 0.0 } else { lobe.pdf(wo, wi) };
+        assert_eq!(b.f_pdf(wo_w, wi_w, BxdfFlags::ALL), (f, pdf));
+        assert_eq!(b.pdf(wo_w, wi_w, BxdfFlags::ALL).to_bits(), pdf.to_bits());
+        if f == Vec3::ZERO {
+            zero += 1;
+        } else {
+            nonzero += 1;
+        }
+        let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
+        let s = b.sample(wo_w, u, BxdfFlags::ALL).expect("a sample");
+        let e = lobe.sample_f(wo, u).expect("a sample");
+        let e_wi = frame.from_local(e.wi);
+        let side = e_wi.dot(ng) * wo_w.dot(ng) > 0.0;
+        assert_eq!(s.wi, e_wi);
+        assert_eq!(s.pdf.to_bits(), e.pdf.to_bits());
+        assert_eq!(s.f, if side { e.f } else { Vec3::ZERO });
+    }
+    assert!(nonzero > 5_000 && zero > 5_000, "{nonzero} {zero}");
 }
 
 /// Oren–Nayar written from its definition with angles (f64), independently

@@ -6,7 +6,7 @@
 //! the density is the average of the matching lobes' densities and the value
 //! their sum.
 
-use super::{Bxdf, BxdfFlags, BxdfModel, BxdfSample};
+use super::{Bxdf, BxdfFlags, BxdfModel};
 use crate::geometry::Frame;
 use crate::sampling::ONE_MINUS_EPSILON;
 use arrayvec::ArrayVec;
@@ -219,18 +219,23 @@ impl<'a> Bsdf<'a> {
     /// pbrt-v3's `BSDF::Pdf(wo, wi, flags)`.
     #[inline]
     pub fn pdf(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> f32 {
-        let wo = self.frame.to_local(wo_w);
-        if wo.z == 0.0 || self.lobes.is_empty() {
+        let wo_z = wo_w.dot(self.frame.n);
+        if wo_z == 0.0 || self.lobes.is_empty() {
             return 0.0;
         }
-        let wi = self.frame.to_local(wi_w);
         if let [l] = self.lobes.as_slice() {
             // One lobe (the common case): the same value as the sum.
             if !l.flags.matches(flags) {
                 return 0.0;
             }
-            return lambertian_inline_pdf(&l.bxdf, wo, wi);
+            return match &l.bxdf {
+                Bxdf::LambertianReflection(b) => {
+                    b.pdf(cosine(wo_z), cosine(wi_w.dot(self.frame.n)))
+                }
+                b => b.pdf(self.frame.to_local(wo_w), self.frame.to_local(wi_w)),
+            };
         }
+        let (wo, wi) = (self.frame.to_local(wo_w), self.frame.to_local(wi_w));
         let mut pdf = 0.0;
         let mut matching = 0u32;
         for l in &self.lobes {
@@ -329,11 +334,14 @@ impl<'a> Bsdf<'a> {
         if !lobe.flags.matches(flags) {
             return None;
         }
-        let wo = self.frame.to_local(wo_w);
-        if wo.z == 0.0 {
+        let wo_z = wo_w.dot(self.frame.n);
+        if wo_z == 0.0 {
             return None;
         }
-        let s = lambertian_inline_sample_f(&lobe.bxdf, wo, u)?;
+        let s = match &lobe.bxdf {
+            Bxdf::LambertianReflection(l) => l.sample_f(cosine(wo_z), u),
+            b => b.sample_f(self.frame.to_local(wo_w), u),
+        }?;
         if s.pdf == 0.0 || s.pdf.is_nan() {
             return None;
         }
@@ -389,21 +397,24 @@ fn f_pdf_of(
     wi_w: Vec3,
     flags: BxdfFlags,
 ) -> (Vec3, f32) {
-    let wo = frame.to_local(wo_w);
-    if wo.z == 0.0 {
+    let wo_z = wo_w.dot(frame.n);
+    if wo_z == 0.0 {
         return (Vec3::ZERO, 0.0);
     }
-    let wi = frame.to_local(wi_w);
     let reflect = wi_w.dot(ng) * wo_w.dot(ng) > 0.0;
     if let [l] = lobes {
         // One lobe (the common case): no sums, the same values.
         if !l.flags.matches(flags) {
             return (Vec3::ZERO, 0.0);
         }
-        let (lobe_f, lobe_pdf) = lambertian_inline_f_pdf(&l.bxdf, wo, wi);
+        let (lobe_f, lobe_pdf) = match &l.bxdf {
+            Bxdf::LambertianReflection(b) => b.f_pdf(cosine(wo_z), cosine(wi_w.dot(frame.n))),
+            b => b.f_pdf(frame.to_local(wo_w), frame.to_local(wi_w)),
+        };
         let side = (reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission());
         return (if side { lobe_f * l.scale } else { Vec3::ZERO }, lobe_pdf);
     }
+    let (wo, wi) = (frame.to_local(wo_w), frame.to_local(wi_w));
     let mut f = Vec3::ZERO;
     let mut pdf = 0.0;
     let mut matching = 0u32;
@@ -427,32 +438,10 @@ fn f_pdf_of(
     (f, pdf)
 }
 
-/// `b.f_pdf` with Lambertian reflection, the most common lobe, inline; every
-/// other lobe through the enum's dispatch, which is too large to inline.
+/// A local direction standing for one whose cosine (`to_local`'s z) is
+/// `z`: Lambertian reflection, the most common lobe, reads nothing else,
+/// so its calls skip the rest of the local frame (and stay inline).
 #[inline(always)]
-fn lambertian_inline_f_pdf(b: &Bxdf, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-    match b {
-        Bxdf::LambertianReflection(l) => l.f_pdf(wo, wi),
-        _ => b.f_pdf(wo, wi),
-    }
-}
-
-/// `b.pdf` with Lambertian reflection inline (see
-/// [`lambertian_inline_f_pdf`]).
-#[inline(always)]
-fn lambertian_inline_pdf(b: &Bxdf, wo: Vec3, wi: Vec3) -> f32 {
-    match b {
-        Bxdf::LambertianReflection(l) => l.pdf(wo, wi),
-        _ => b.pdf(wo, wi),
-    }
-}
-
-/// `b.sample_f` with Lambertian reflection inline (see
-/// [`lambertian_inline_f_pdf`]).
-#[inline(always)]
-fn lambertian_inline_sample_f(b: &Bxdf, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
-    match b {
-        Bxdf::LambertianReflection(l) => l.sample_f(wo, u),
-        _ => b.sample_f(wo, u),
-    }
+fn cosine(z: f32) -> Vec3 {
+    Vec3::new(0.0, 0.0, z)
 }
