@@ -397,24 +397,50 @@ fn f_pdf_of(
     wi_w: Vec3,
     flags: BxdfFlags,
 ) -> (Vec3, f32) {
+    // One Lambertian reflection lobe (the common case) inline, from the
+    // cosines; everything else out of line, so that callers stay small.
+    let [l @ Lobe {
+        bxdf: Bxdf::LambertianReflection(b),
+        ..
+    }] = lobes
+    else {
+        return f_pdf_lobes(frame, ng, lobes, wo_w, wi_w, flags);
+    };
     let wo_z = wo_w.dot(frame.n);
-    if wo_z == 0.0 {
+    if wo_z == 0.0 || !l.flags.matches(flags) {
         return (Vec3::ZERO, 0.0);
     }
     let reflect = wi_w.dot(ng) * wo_w.dot(ng) > 0.0;
+    let (lobe_f, lobe_pdf) = b.f_pdf(cosine(wo_z), cosine(wi_w.dot(frame.n)));
+    let side = (reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission());
+    (if side { lobe_f * l.scale } else { Vec3::ZERO }, lobe_pdf)
+}
+
+/// [`f_pdf_of`] for any lobes.
+#[inline(never)]
+fn f_pdf_lobes(
+    frame: &Frame,
+    ng: Vec3,
+    lobes: &[Lobe],
+    wo_w: Vec3,
+    wi_w: Vec3,
+    flags: BxdfFlags,
+) -> (Vec3, f32) {
+    let wo = frame.to_local(wo_w);
+    if wo.z == 0.0 {
+        return (Vec3::ZERO, 0.0);
+    }
+    let wi = frame.to_local(wi_w);
+    let reflect = wi_w.dot(ng) * wo_w.dot(ng) > 0.0;
     if let [l] = lobes {
-        // One lobe (the common case): no sums, the same values.
+        // One lobe: no sums, the same values.
         if !l.flags.matches(flags) {
             return (Vec3::ZERO, 0.0);
         }
-        let (lobe_f, lobe_pdf) = match &l.bxdf {
-            Bxdf::LambertianReflection(b) => b.f_pdf(cosine(wo_z), cosine(wi_w.dot(frame.n))),
-            b => b.f_pdf(frame.to_local(wo_w), frame.to_local(wi_w)),
-        };
+        let (lobe_f, lobe_pdf) = l.bxdf.f_pdf(wo, wi);
         let side = (reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission());
         return (if side { lobe_f * l.scale } else { Vec3::ZERO }, lobe_pdf);
     }
-    let (wo, wi) = (frame.to_local(wo_w), frame.to_local(wi_w));
     let mut f = Vec3::ZERO;
     let mut pdf = 0.0;
     let mut matching = 0u32;
