@@ -172,20 +172,23 @@ pub(super) fn mis_weight<'a>(
     let mut sum_ri = 0.0f32;
     let mut ri = remap0(pt_rev) / remap0(cam(pt).pdf_fwd);
     if pt >= 1 {
+        // t ≥ 2: the camera subpath as it is (only t = 1 samples its first
+        // vertex anew), read without `cam`'s choice.
+        let cv = &camera[..t];
         // pt's delta flag is cleared.
-        if !cam(pt - 1).delta {
+        if !cv[pt - 1].delta {
             sum_ri += ri;
         }
         if let Some(m) = pt_m.filter(|&m| m >= 1) {
-            let v = cam(m);
+            let v = &cv[m];
             ri *= remap0(pt_m_rev) / remap0(v.pdf_fwd);
-            if !v.delta && !cam(m - 1).delta {
+            if !v.delta && !cv[m - 1].delta {
                 sum_ri += ri;
             }
-            for i in (1..m).rev() {
-                let v = cam(i);
-                ri *= v.ratio;
-                if !v.delta && !cam(i - 1).delta {
+            // Vertex i with its predecessor, for i = m − 1 down to 1.
+            for w in cv[..m].windows(2).rev() {
+                ri *= w[1].ratio;
+                if !w[1].delta && !w[0].delta {
                     sum_ri += ri;
                 }
             }
@@ -205,15 +208,25 @@ pub(super) fn mis_weight<'a>(
             sum_ri += ri;
         }
         if let Some(m) = qs_m {
-            let v = lig(m);
+            // s ≥ 2: the light subpath as it is (only s = 1 samples its
+            // first vertex anew).
+            let lv = &light[..s];
+            let v = &lv[m];
             ri *= remap0(qs_m_rev) / remap0(v.pdf_fwd);
             if !v.delta && !delta_before(m) {
                 sum_ri += ri;
             }
-            for i in (0..m).rev() {
-                let v = lig(i);
-                ri *= v.ratio;
-                if !v.delta && !delta_before(i) {
+            // Vertex i with its predecessor, for i = m − 1 down to 1, then
+            // the light's own vertex.
+            for w in lv[..m].windows(2).rev() {
+                ri *= w[1].ratio;
+                if !w[1].delta && !w[0].delta {
+                    sum_ri += ri;
+                }
+            }
+            if m >= 1 {
+                ri *= lv[0].ratio;
+                if !lv[0].delta && !lv[0].is_delta_light(c) {
                     sum_ri += ri;
                 }
             }

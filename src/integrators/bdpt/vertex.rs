@@ -496,6 +496,18 @@ impl Link {
 /// (|wo·ng||wi·ns|).
 #[inline]
 fn correct_shading_normal(v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
+    if v.ns == v.n {
+        // Numerator and denominator are the same product: 1, or 0 where it
+        // is 0 (and NaN where it is not finite), without the division.
+        let d = wo.dot(v.n).abs() * wi.dot(v.n).abs();
+        return if d == 0.0 {
+            0.0
+        } else if d.is_finite() {
+            1.0
+        } else {
+            f32::NAN
+        };
+    }
     let num = wo.dot(v.ns).abs() * wi.dot(v.n).abs();
     let denom = wo.dot(v.n).abs() * wi.dot(v.ns).abs();
     if denom == 0.0 {
