@@ -105,88 +105,22 @@ pub(crate) fn connect<'a>(
     if t > 1 && s != 0 && camera[t - 1].kind == Kind::Light {
         return none;
     }
-    // A sampled endpoint was pushed (onto `camera` for t = 1, else onto
-    // `light`), to take the place of the subpath's own for the MIS weight.
-    let mut sampled = false;
-    let mut p_raster = None;
-    let mut l = Vec3::ZERO;
-    // The scattering densities the connection's BSDF values came with:
-    // at qs towards pt and at pt towards qs (solid angle).
-    let mut dens = Densities::default();
-    // The segment of an s, t ≥ 2 connection.
-    let mut link = None;
-    if s == 0 {
-        let pt = &camera[t - 1];
-        if pt.is_light() {
-            l = pt.le(c, &camera[t - 2]) * pt.beta;
-        }
+    let e = if s == 0 {
+        emitted(c, &camera[t - 1], &camera[t.saturating_sub(2)])
     } else if t == 1 {
-        let qs = &light[s - 1];
-        if qs.is_connectible(c) {
-            let u = sampler.get_2d();
-            if let Some(is) = c.camera.sample_wi(qs.p, u, qs.time) {
-                p_raster = Some(is.p_raster);
-                if is.pdf > 0.0 && is.we != Vec3::ZERO {
-                    push_at(
-                        camera,
-                        Kind::Camera,
-                        is.p_lens,
-                        is.n,
-                        is.we / is.pdf,
-                        (qs.time, c.camera_medium),
-                    );
-                    sampled = true;
-                    let v = &camera[camera.len() - 1];
-                    let (f, pdf) = qs.f(v, Mode::Importance);
-                    dens.at_qs = qs.scatters().then_some(pdf);
-                    l = qs.beta * f * v.beta;
-                    if qs.on_surface() {
-                        l *= is.wi.dot(qs.ns).abs();
-                    }
-                    if l != Vec3::ZERO {
-                        l *= tr(c, qs, v, sampler, scratch);
-                    }
-                }
-            }
-        }
+        to_camera(c, &light[s - 1], camera, sampler, scratch)
     } else if s == 1 {
-        let pt = &camera[t - 1];
-        if pt.is_connectible(c) {
-            let d = drawn.unwrap_or_else(|| draw_light(c, sampler));
-            if let Some((i, pmf)) = d.chosen {
-                if let Some((shadow, wi)) = light_vertex(c, pt, (i, pmf), d, light) {
-                    sampled = true;
-                    let v = &light[light.len() - 1];
-                    let (f, pdf) = pt.f(v, Mode::Radiance);
-                    dens.at_pt = pt.scatters().then_some(pdf);
-                    l = pt.beta * f * v.beta;
-                    if pt.on_surface() {
-                        l *= wi.dot(pt.ns).abs();
-                    }
-                    if l != Vec3::ZERO {
-                        let medium = pt.medium_towards(wi);
-                        l *= transmittance(c.scene, &shadow, pt.time, medium, sampler, scratch);
-                    }
-                }
-            }
-        }
+        to_light(c, &camera[t - 1], light, drawn, sampler, scratch)
     } else {
-        let (qs, pt) = (&light[s - 1], &camera[t - 1]);
-        if qs.is_connectible(c) && pt.is_connectible(c) {
-            // Coincident vertices: no BSDF value (as `Vertex::f`).
-            if let Some(ln) = Link::new(qs, pt) {
-                let (fq, pdf_q) = qs.f_towards(ln.wi, Mode::Importance);
-                let (fp, pdf_p) = pt.f_towards(-ln.wi, Mode::Radiance);
-                dens.at_qs = qs.scatters().then_some(pdf_q);
-                dens.at_pt = pt.scatters().then_some(pdf_p);
-                l = qs.beta * fq * fp * pt.beta;
-                if l != Vec3::ZERO {
-                    l *= g(c, (qs, pt), &ln, sampler, scratch);
-                }
-                link = Some(ln);
-            }
-        }
-    }
+        between(c, &light[s - 1], &camera[t - 1], sampler, scratch)
+    };
+    let Ends {
+        l,
+        sampled,
+        p_raster,
+        dens,
+        link,
+    } = e;
     let weight = if l == Vec3::ZERO {
         0.0
     } else if c.plain {
@@ -203,6 +137,145 @@ pub(crate) fn connect<'a>(
         weight,
         p_raster,
     }
+}
+
+/// What a strategy's connection found: its unweighted contribution
+/// `l`, whether a sampled endpoint was pushed (onto `camera` for t = 1,
+/// else onto `light`, to take the place of the subpath's own for the MIS
+/// weight), the film position of a t = 1 strategy, the scattering
+/// densities the connection's BSDF values came with (at qs towards pt and
+/// at pt towards qs, solid angle) and the segment of an s, t ≥ 2
+/// connection.
+#[derive(Default)]
+struct Ends {
+    l: Vec3,
+    sampled: bool,
+    p_raster: Option<Vec2>,
+    dens: Densities,
+    link: Option<Link>,
+}
+
+/// s = 0: the camera subpath's last vertex `pt` (reached from `prev`)
+/// if it emits.
+#[inline(never)]
+fn emitted(c: &Ctx, pt: &Vertex, prev: &Vertex) -> Ends {
+    let mut e = Ends::default();
+    if pt.is_light() {
+        e.l = pt.le(c, prev) * pt.beta;
+    }
+    e
+}
+
+/// t = 1: the light subpath's last vertex `qs` seen by a camera vertex
+/// sampled from it (pushed onto `camera`).
+#[inline(never)]
+fn to_camera<'a>(
+    c: &Ctx<'a>,
+    qs: &Vertex<'a>,
+    camera: &mut Vec<Vertex<'a>>,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Ends {
+    let mut e = Ends::default();
+    if !qs.is_connectible(c) {
+        return e;
+    }
+    let u = sampler.get_2d();
+    let Some(is) = c.camera.sample_wi(qs.p, u, qs.time) else {
+        return e;
+    };
+    e.p_raster = Some(is.p_raster);
+    if is.pdf > 0.0 && is.we != Vec3::ZERO {
+        push_at(
+            camera,
+            Kind::Camera,
+            is.p_lens,
+            is.n,
+            is.we / is.pdf,
+            (qs.time, c.camera_medium),
+        );
+        e.sampled = true;
+        let v = &camera[camera.len() - 1];
+        let (f, pdf) = qs.f(v, Mode::Importance);
+        e.dens.at_qs = qs.scatters().then_some(pdf);
+        let mut l = qs.beta * f * v.beta;
+        if qs.on_surface() {
+            l *= is.wi.dot(qs.ns).abs();
+        }
+        if l != Vec3::ZERO {
+            l *= tr(c, qs, v, sampler, scratch);
+        }
+        e.l = l;
+    }
+    e
+}
+
+/// s = 1: the camera subpath's last vertex `pt` lit by a light vertex
+/// sampled from it (pushed onto `light`), from `drawn` or drawn here.
+#[inline(never)]
+fn to_light<'a>(
+    c: &Ctx<'a>,
+    pt: &Vertex<'a>,
+    light: &mut Vec<Vertex<'a>>,
+    drawn: Option<LightDraw>,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Ends {
+    let mut e = Ends::default();
+    if !pt.is_connectible(c) {
+        return e;
+    }
+    let d = drawn.unwrap_or_else(|| draw_light(c, sampler));
+    let Some((i, pmf)) = d.chosen else {
+        return e;
+    };
+    let Some((shadow, wi)) = light_vertex(c, pt, (i, pmf), d, light) else {
+        return e;
+    };
+    e.sampled = true;
+    let v = &light[light.len() - 1];
+    let (f, pdf) = pt.f(v, Mode::Radiance);
+    e.dens.at_pt = pt.scatters().then_some(pdf);
+    let mut l = pt.beta * f * v.beta;
+    if pt.on_surface() {
+        l *= wi.dot(pt.ns).abs();
+    }
+    if l != Vec3::ZERO {
+        let medium = pt.medium_towards(wi);
+        l *= transmittance(c.scene, &shadow, pt.time, medium, sampler, scratch);
+    }
+    e.l = l;
+    e
+}
+
+/// s, t ≥ 2: the subpaths' last vertices `qs` and `pt` joined.
+#[inline(always)]
+fn between(
+    c: &Ctx,
+    qs: &Vertex,
+    pt: &Vertex,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> Ends {
+    let mut e = Ends::default();
+    if !(qs.is_connectible(c) && pt.is_connectible(c)) {
+        return e;
+    }
+    // Coincident vertices: no BSDF value (as `Vertex::f`).
+    let Some(ln) = Link::new(qs, pt) else {
+        return e;
+    };
+    let (fq, pdf_q) = qs.f_towards(ln.wi, Mode::Importance);
+    let (fp, pdf_p) = pt.f_towards(-ln.wi, Mode::Radiance);
+    e.dens.at_qs = qs.scatters().then_some(pdf_q);
+    e.dens.at_pt = pt.scatters().then_some(pdf_p);
+    let mut l = qs.beta * fq * fp * pt.beta;
+    if l != Vec3::ZERO {
+        l *= g(c, (qs, pt), &ln, sampler, scratch);
+    }
+    e.l = l;
+    e.link = Some(ln);
+    e
 }
 
 /// Solid-angle densities of scattering across the connection, where the
@@ -272,6 +345,8 @@ fn light_vertex<'a>(
 /// vertex of `camera` for t = 1 and of `light` for s = 1, put in place),
 /// the ratios of every other strategy's density to this one's summed, and
 /// the subpaths restored.
+#[cold]
+#[inline(never)]
 fn mis_weight_plain<'a>(
     c: &Ctx<'a>,
     light: &mut [Vertex<'a>],
