@@ -49,6 +49,9 @@ pub struct ImportanceSample {
     /// The lens point and the camera's viewing direction (its normal).
     pub p_lens: Vec3,
     pub n: Vec3,
+    /// `pdf_we(p_lens, -wi).1`: the density by solid angle of the camera
+    /// ray from the lens point back along `wi` (0 where `we` is 0).
+    pub pdf_dir: f32,
 }
 
 impl<'c> CameraImportance<'c> {
@@ -159,15 +162,26 @@ impl<'c> CameraImportance<'c> {
         inside.then_some((r, cos))
     }
 
+    /// `We` of a ray at cosine `cos` with the viewing direction.
+    #[inline]
+    fn we_at(&self, cos: f32) -> f32 {
+        let c2 = cos * cos;
+        1.0 / (self.area * self.lens_area * c2 * c2)
+    }
+
+    /// `Pdf_We`'s density by solid angle of a ray at cosine `cos` with the
+    /// viewing direction.
+    #[inline]
+    fn pdf_dir_at(&self, cos: f32) -> f32 {
+        1.0 / (self.area * cos * cos * cos)
+    }
+
     /// pbrt-v3's `We`: the importance the camera emits along the ray from
     /// `o` in direction `d`, and the film position it maps to.
     #[inline]
     pub fn we(&self, o: Vec3, d: Vec3, time: f32) -> (f32, Vec2) {
         match self.raster(o, d, time) {
-            Some((r, cos)) => {
-                let c2 = cos * cos;
-                (1.0 / (self.area * self.lens_area * c2 * c2), r)
-            }
+            Some((r, cos)) => (self.we_at(cos), r),
             None => (0.0, Vec2::ZERO),
         }
     }
@@ -177,7 +191,7 @@ impl<'c> CameraImportance<'c> {
     #[inline]
     pub fn pdf_we(&self, o: Vec3, d: Vec3, time: f32) -> (f32, f32) {
         match self.raster(o, d, time) {
-            Some((_, cos)) => (1.0 / self.lens_area, 1.0 / (self.area * cos * cos * cos)),
+            Some((_, cos)) => (1.0 / self.lens_area, self.pdf_dir_at(cos)),
             None => (0.0, 0.0),
         }
     }
@@ -195,9 +209,15 @@ impl<'c> CameraImportance<'c> {
         if dist == 0.0 || dist.is_nan() {
             return None;
         }
-        let wi = v / dist;
+        // pbrt-v3 divides by multiplying by the reciprocal (as `normalize`).
+        let wi = v * (1.0 / dist);
         let pdf = dist * dist / (n.dot(wi).abs() * self.lens_area);
-        let (we, p_raster) = self.we(p_lens, -wi, time);
+        // `we` and `pdf_we` of the ray back from the lens from one film
+        // position.
+        let (we, p_raster, pdf_dir) = match self.raster(p_lens, -wi, time) {
+            Some((r, cos)) => (self.we_at(cos), r, self.pdf_dir_at(cos)),
+            None => (0.0, Vec2::ZERO, 0.0),
+        };
         Some(ImportanceSample {
             we: Vec3::splat(we),
             wi,
@@ -205,6 +225,7 @@ impl<'c> CameraImportance<'c> {
             p_raster,
             p_lens,
             n,
+            pdf_dir,
         })
     }
 }

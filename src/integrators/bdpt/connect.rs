@@ -198,6 +198,9 @@ fn to_camera<'a>(
         let v = &camera[camera.len() - 1];
         let (f, pdf) = qs.f(v, Mode::Importance);
         e.dens.at_qs = qs.scatters().then_some(pdf);
+        // The camera's density towards qs, as `Vertex::pdf` would find it
+        // (its direction, normalized, is -wi to the bit).
+        e.dens.at_pt = Some(is.pdf_dir);
         let mut l = qs.beta * f * v.beta;
         if qs.on_surface() {
             l *= is.wi.dot(qs.ns).abs();
@@ -279,7 +282,8 @@ fn between(
 }
 
 /// Solid-angle densities of scattering across the connection, where the
-/// connection's BSDF evaluations gave them.
+/// connection's BSDF evaluations gave them (or, for the camera vertex a
+/// t = 1 strategy samples, its importance sample).
 #[derive(Clone, Copy, Default)]
 pub(super) struct Densities {
     /// At the light subpath's end (qs) towards the camera subpath's (pt),
