@@ -142,9 +142,8 @@ pub(crate) fn connect<'a>(
 /// What a strategy's connection found: its unweighted contribution
 /// `l`, whether a sampled endpoint was pushed (onto `camera` for t = 1,
 /// else onto `light`, to take the place of the subpath's own for the MIS
-/// weight), the film position of a t = 1 strategy, the scattering
-/// densities the connection's BSDF values came with (at qs towards pt and
-/// at pt towards qs, solid angle) and the segment of an s, t ≥ 2
+/// weight), the film position of a t = 1 strategy, the densities across
+/// the connection ([`Densities`]) and the segment of an s, t ≥ 2
 /// connection.
 #[derive(Default)]
 struct Ends {
