@@ -195,7 +195,9 @@ fn to_camera<'a>(
         );
         e.sampled = true;
         let v = &camera[camera.len() - 1];
-        let (f, pdf) = qs.f(v, Mode::Importance);
+        // `wi` is the direction `Vertex::f` would normalize towards the
+        // lens point, to the bit.
+        let (f, pdf) = qs.f_towards(is.wi, Mode::Importance);
         e.dens.at_qs = qs.scatters().then_some(pdf);
         // The camera's density towards qs, as `Vertex::pdf` would find it
         // (its direction, normalized, is -wi to the bit).

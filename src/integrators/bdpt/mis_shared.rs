@@ -226,7 +226,7 @@ pub(super) fn mis_weight<'a>(
             }
             if m >= 1 {
                 ri *= lv[0].ratio;
-                if !lv[0].delta && !lv[0].is_delta_light(c) {
+                if !lv[0].delta && !delta_before(0) {
                     sum_ri += ri;
                 }
             }
