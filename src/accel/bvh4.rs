@@ -78,10 +78,10 @@ pub(super) struct Node {
 /// `triangles` marks the lanes that are triangles (their vertices in `v`).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Leaf {
-    v: TrianglePack,
-    first: u32,
-    count: u32,
-    triangles: u32,
+    pub(super) v: TrianglePack,
+    pub(super) first: u32,
+    pub(super) count: u32,
+    pub(super) triangles: u32,
 }
 
 /// What a closest-hit query found.
@@ -98,21 +98,23 @@ pub(super) enum Closest {
 }
 
 pub(super) struct Bvh4 {
-    nodes: Vec<Node>,
-    leaves: Vec<Leaf>,
+    pub(super) nodes: Vec<Node>,
+    pub(super) leaves: Vec<Leaf>,
     /// Traversal stack entries the deepest path can need.
-    stack_need: usize,
+    pub(super) stack_need: usize,
+    /// Every primitive is a triangle (tested in the leaves' lanes).
+    pub(super) only_triangles: bool,
 }
 
 /// The per-ray constants of the box test.
-struct BoxRay {
+pub(super) struct BoxRay {
     o: [Vec4; 3],
     inv: [Vec4; 3],
 }
 
 impl BoxRay {
     #[inline(always)]
-    fn new(ray: &Ray) -> BoxRay {
+    pub(super) fn new(ray: &Ray) -> BoxRay {
         let d = Vec3A::from(ray.d);
         let tiny = d.abs().cmplt(Vec3A::splat(1e-30));
         let big = Vec3A::select(
@@ -134,7 +136,7 @@ impl BoxRay {
     /// Entry distances and the lanes of children whose box the ray meets
     /// within `[0, t_max]`.
     #[inline(always)]
-    fn test(&self, n: &Node, t_max: f32) -> (Vec4, BVec4A) {
+    pub(super) fn test(&self, n: &Node, t_max: f32) -> (Vec4, BVec4A) {
         // Slab distances of both planes; the near one is the smaller (the
         // same values as picking planes by the direction's sign).
         let xa = (n.b[0] - self.o[0]) * self.inv[0];
@@ -209,6 +211,7 @@ impl Bvh4 {
         let b = binned::build(refs, triangle);
         (
             Bvh4 {
+                only_triangles: only_triangles(&b.leaves),
                 nodes: b.nodes,
                 leaves: b.leaves,
                 stack_need: 3 * b.depth + 4,
@@ -344,6 +347,7 @@ impl Bvh4 {
         debug_assert_eq!(order.len(), bvh2.primitive_indices.len());
         (
             Bvh4 {
+                only_triangles: only_triangles(&leaves),
                 nodes,
                 leaves,
                 // Three entries per level, and room for the branch-free
@@ -448,13 +452,20 @@ impl Bvh4 {
         mut hint: impl FnMut(u32),
         stack: &mut [MaybeUninit<(u32, f32)>],
     ) -> Closest {
+        // The closest triangle is kept, equal distances going to the lower
+        // position, and boxes and triangles are tested a little past the
+        // closest so far ([`reach`]): which triangle is found does not
+        // depend on the order leaves are visited in (so a packet of rays,
+        // `packet`, finds each ray's).
+        let t_limit = t_max;
+        let mut best_pos = u32::MAX;
         let mut found = Closest::Nothing;
         let mut sp = 0usize;
         let mut cur = 0u32;
         loop {
             if cur & LEAF == 0 {
                 let n = &self.nodes[cur as usize];
-                let (t0, hit_box) = br.test(n, t_max);
+                let (t0, hit_box) = br.test(n, reach(t_max));
                 let mask = hit_box.bitmask();
                 if mask != 0 {
                     // The nearest child next; the others stacked without
@@ -505,12 +516,16 @@ impl Bvh4 {
             } else {
                 let leaf = &self.leaves[(cur & !LEAF) as usize];
                 if leaf.triangles != 0 {
-                    if let Some((lane, t, b)) = tr.intersect4::<KZ>(&leaf.v, t_max, leaf.triangles)
+                    if let Some((lane, t, b)) =
+                        tr.intersect4::<KZ>(&leaf.v, lane_limit(t_max, t_limit), leaf.triangles)
                     {
                         let pos = leaf.first + lane;
-                        t_max = t;
-                        hint(pos);
-                        found = Closest::Triangle { pos, t, b };
+                        if closer(t, pos, t_max, best_pos) {
+                            t_max = t;
+                            best_pos = pos;
+                            hint(pos);
+                            found = Closest::Triangle { pos, t, b };
+                        }
                     }
                 }
                 let others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
@@ -519,6 +534,7 @@ impl Bvh4 {
                     let pos = leaf.first + m.trailing_zeros();
                     if let Some(t) = other(pos, t_max) {
                         t_max = t;
+                        best_pos = u32::MAX;
                         found = Closest::Other;
                     }
                     m &= m - 1;
@@ -533,7 +549,7 @@ impl Bvh4 {
                 // SAFETY: entries below the stack pointer were written
                 // (the pointer only moves past written entries).
                 let (c, t0) = unsafe { stack[sp].assume_init() };
-                if t0 <= t_max {
+                if t0 <= reach(t_max) {
                     cur = c;
                     break;
                 }
@@ -631,6 +647,38 @@ impl Bvh4 {
             cur = unsafe { stack[sp].assume_init() };
         }
     }
+}
+
+/// Whether every leaf holds triangles only.
+fn only_triangles(leaves: &[Leaf]) -> bool {
+    leaves.iter().all(|l| l.triangles == (1 << l.count) - 1)
+}
+
+/// How far a closest-hit query still looks for boxes when the closest hit
+/// so far is at `t_max`: a little farther, so that a triangle as near as
+/// that hit (which may win by the tie rule) is not lost to its box's
+/// entry distance rounding to more than the triangle's own distance (both
+/// are within far less than this margin of the exact distances, which are
+/// in that order). The boxes visited then do not depend on the order of
+/// the hits found before.
+#[inline(always)]
+pub(super) fn reach(t_max: f32) -> f32 {
+    t_max * (1.0 + 1.0 / 65536.0)
+}
+
+/// The distance a leaf's triangles are tested up to when the closest hit
+/// so far is at `t_max` and the query's limit is `t_limit`: every triangle
+/// as near as that hit passes, and none beyond the limit.
+#[inline(always)]
+pub(super) fn lane_limit(t_max: f32, t_limit: f32) -> f32 {
+    reach(t_max).min(t_limit)
+}
+
+/// Whether a triangle hit at `t`, BVH position `pos`, replaces the closest
+/// so far (at `t_max`, position `best_pos`): nearer, or as near and lower.
+#[inline(always)]
+pub(super) fn closer(t: f32, pos: u32, t_max: f32, best_pos: u32) -> bool {
+    t < t_max || (t == t_max && pos < best_pos)
 }
 
 /// The leaf of BVH positions `first .. first + count` (`order` maps them to

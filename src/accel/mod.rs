@@ -15,9 +15,11 @@
 
 mod binned;
 mod bvh4;
+mod packet;
 mod split;
 
 pub use bvh4::BuildWork;
+pub use packet::PACKET_MAX;
 
 use crate::geometry::{gamma, next_float_down, next_float_up, Bounds3, Ray};
 use crate::scene::AnimatedTransform;
@@ -958,6 +960,42 @@ impl Aggregate {
     #[inline(never)]
     pub fn intersect_into(&self, ray: &Ray, time: f32, out: &mut Option<Hit>) {
         *out = self.closest_at(ray, time);
+    }
+
+    /// The closest hits of `rays` (at scene times `times`) in `out`, each
+    /// [`Aggregate::intersect_into`]'s: traced as one packet
+    /// ([`packet`]) when the scene is triangles only (no instances, no
+    /// analytic shapes, no alpha masks) and there are at most
+    /// [`PACKET_MAX`], else ray by ray. For coherent rays (a pixel's
+    /// camera rays).
+    #[inline(never)]
+    pub fn intersect_packet(&self, rays: &[Ray], times: &[f32], out: &mut [Option<Hit>]) {
+        let n = rays.len();
+        match self.top.bvh.as_ref() {
+            Some(bvh) if bvh.traces_packets() && n <= PACKET_MAX => {
+                let mut found = [None; PACKET_MAX];
+                bvh.closest_packet(rays, &mut found[..n]);
+                for (o, f) in out[..n].iter_mut().zip(&found[..n]) {
+                    *o = f.map(|(pos, t, b)| {
+                        let prim = self.top.prims[pos as usize];
+                        if let Some(m) = self.meshes.get(prim.mesh as usize) {
+                            prefetch(m.indices.as_ptr().wrapping_add(3 * prim.index as usize));
+                        }
+                        Hit {
+                            t,
+                            prim,
+                            instance: NO_INSTANCE,
+                            local: HitLocal::Bary(b),
+                        }
+                    });
+                }
+            }
+            _ => {
+                for ((r, &time), o) in rays.iter().zip(times).zip(out.iter_mut()) {
+                    self.intersect_into(r, time, o);
+                }
+            }
+        }
     }
 
     #[inline(always)]

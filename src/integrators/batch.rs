@@ -9,7 +9,7 @@ use super::direct_lanes::DirectLanes;
 use super::path::{path_step, NoMedium, PathMedium, PathParams, PathSettings, PathState};
 use super::volpath::RayMedium;
 use super::Scratch;
-use crate::accel::Hit;
+use crate::accel::{Hit, PACKET_MAX};
 use crate::geometry::{Ray, RayDiff};
 use crate::integrators::RenderScene;
 use crate::lights::LightSampler;
@@ -106,15 +106,23 @@ pub(super) fn trace_paths<M: PathMedium>(
         }
     }
     let mut bsdf = Bsdf::empty();
+    // The camera rays of the batch (one pixel's) are coherent: traced as
+    // one packet.
+    let mut camera_rays = true;
     while !b.active.is_empty() {
-        for &j in &b.active {
-            let j = j as usize;
-            scratch.counts.closest += 1;
-            let ray = &states[j].ray;
-            scene
-                .aggregate
-                .intersect_into(ray, b.times[j], &mut b.hits[j]);
+        scratch.counts.closest += b.active.len() as u64;
+        if camera_rays && b.active.len() <= PACKET_MAX {
+            closest_of_lanes(b, |j| states[j].ray, scene);
+        } else {
+            for &j in &b.active {
+                let j = j as usize;
+                let ray = &states[j].ray;
+                scene
+                    .aggregate
+                    .intersect_into(ray, b.times[j], &mut b.hits[j]);
+            }
         }
+        camera_rays = false;
         let mut kept = 0;
         for k in 0..b.active.len() {
             let j = b.active[k] as usize;
@@ -140,10 +148,41 @@ pub(super) fn trace_paths<M: PathMedium>(
 /// The camera rays of a batch traced (lanes of weight > 0), their hits in
 /// `b.hits` (directlighting and whitted).
 pub(super) fn trace_camera_rays(b: &mut Batch, scene: &RenderScene) {
+    b.active.clear();
     for j in 0..b.len {
         if b.weights[j] > 0.0 {
-            let hit = &mut b.hits[j];
-            scene.aggregate.intersect_into(&b.rays[j], b.times[j], hit);
+            b.active.push(j as u32);
         }
+    }
+    if b.active.len() <= PACKET_MAX {
+        let rays = std::mem::take(&mut b.rays);
+        closest_of_lanes(b, |j| rays[j], scene);
+        b.rays = rays;
+    } else {
+        for j in 0..b.len {
+            if b.weights[j] > 0.0 {
+                let hit = &mut b.hits[j];
+                scene.aggregate.intersect_into(&b.rays[j], b.times[j], hit);
+            }
+        }
+    }
+}
+
+/// The closest hits of the active lanes' rays (`ray(lane)`, at most
+/// [`PACKET_MAX`] lanes) in `b.hits`, traced as one packet.
+fn closest_of_lanes(b: &mut Batch, ray: impl Fn(usize) -> Ray, scene: &RenderScene) {
+    let n = b.active.len();
+    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET_MAX];
+    let mut times = [0f32; PACKET_MAX];
+    for (k, &j) in b.active.iter().enumerate() {
+        rays[k] = ray(j as usize);
+        times[k] = b.times[j as usize];
+    }
+    let mut hits = [None; PACKET_MAX];
+    scene
+        .aggregate
+        .intersect_packet(&rays[..n], &times[..n], &mut hits[..n]);
+    for (k, &j) in b.active.iter().enumerate() {
+        b.hits[j as usize] = hits[k];
     }
 }
