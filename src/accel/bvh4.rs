@@ -867,7 +867,7 @@ fn subtree_counts(bvh2: &Bvh2, weights: &[u32]) -> Vec<u32> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
     use crate::shapes::intersect_triangle;
@@ -888,7 +888,8 @@ mod tests {
             .collect()
     }
 
-    fn build(tris: &[[Vec3; 3]], others: &[Aabb]) -> (Bvh4, Vec<u32>) {
+    /// A tree over triangles and other primitives' boxes (and the order).
+    pub(in crate::accel) fn build(tris: &[[Vec3; 3]], others: &[Aabb]) -> (Bvh4, Vec<u32>) {
         let mut aabbs: Vec<Aabb> = tris
             .iter()
             .map(|t| {

@@ -160,26 +160,11 @@ impl Bvh4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::bvh4::tests::build;
     use crate::accel::bvh4::Closest;
     use crate::sampling::rng::Pcg32;
     use crate::shapes::intersect_triangle;
     use glam::Vec3;
-    use obvhs::aabb::Aabb;
-    use obvhs::BvhBuildParams;
-
-    fn build(tris: &[[Vec3; 3]]) -> Bvh4 {
-        let aabbs: Vec<Aabb> = tris
-            .iter()
-            .map(|t| {
-                let mut a = Aabb::empty();
-                for p in t {
-                    a.extend((*p).into());
-                }
-                a
-            })
-            .collect();
-        Bvh4::build_counted(&aabbs, BvhBuildParams::medium_build(), |i| Some(tris[i])).0
-    }
 
     fn point(rng: &mut Pcg32, s: f32) -> Vec3 {
         Vec3::new(
@@ -248,7 +233,7 @@ mod tests {
         let mut ties = 0;
         for n in [4, 20, 300, 3000] {
             let tris = scene(&mut rng, n);
-            let bvh = build(&tris);
+            let (bvh, _) = build(&tris, &[]);
             assert!(bvh.traces_packets());
             for _ in 0..400 {
                 let len = 1 + rng.uniform_u32_below(PACKET_MAX as u32) as usize;
