@@ -9,9 +9,10 @@
 //! independent of each other within a step, so their tests overlap, and
 //! rays that follow the same way share its choices. Each ray of the packet
 //! finds what [`Bvh4::closest_hinted`] finds for it alone: the same box and
-//! triangle arithmetic, triangles tested against the ray's own limit, and
-//! the closest kept by the same order-independent rule (nearer, or as near
-//! and at a lower position), checked ray by ray in the tests below and in
+//! triangle arithmetic, boxes and triangles tested a little past the ray's
+//! closest hit so far (never past its own limit), and the closest kept by
+//! the same order-independent rule (nearer, or as near and at a lower
+//! position), checked ray by ray in the tests below and in
 //! `tests/render_batch.rs`.
 
 use super::bvh4::{closer, lane_limit, reach, BoxRay, Bvh4, LEAF};
