@@ -161,6 +161,13 @@ impl<'a> Bsdf<'a> {
         self.lobes.iter().filter(|l| l.flags.matches(flags)).count()
     }
 
+    /// Whether `num_components(flags) > 0`, stopping at the first lobe that
+    /// matches.
+    #[inline]
+    pub fn has_component(&self, flags: BxdfFlags) -> bool {
+        self.lobes.iter().any(|l| l.flags.matches(flags))
+    }
+
     /// True if the BSDF has a lobe that light sampling can use.
     #[inline]
     pub fn has_non_specular(&self) -> bool {

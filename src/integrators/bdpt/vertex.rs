@@ -248,12 +248,12 @@ impl<'a> Vertex<'a> {
                 !(l.is_delta() && l.at_infinity())
             }),
             Kind::Surface => {
-                self.bsdf.num_components(BxdfFlags(
+                self.bsdf.has_component(BxdfFlags(
                     BxdfFlags::DIFFUSE.0
                         | BxdfFlags::GLOSSY.0
                         | BxdfFlags::REFLECTION.0
                         | BxdfFlags::TRANSMISSION.0,
-                )) > 0
+                ))
             }
         }
     }
