@@ -481,6 +481,28 @@ impl Level {
 /// of a mesh without alpha masks. Those with masks are left to the leaf's
 /// callbacks (like quadrics and instances), so that only they pay for the
 /// test.
+/// Asks for the vertex indices of triangle `p` (if it is one of `meshes`):
+/// surface reconstruction reads them first, behind the primitive
+/// reference, once a closest hit is known.
+#[inline(always)]
+fn prefetch_indices(meshes: &[TriangleMesh], p: PrimRef) {
+    if let Some(m) = meshes.get(p.mesh as usize) {
+        prefetch(m.indices.as_ptr().wrapping_add(3 * p.index as usize));
+    }
+}
+
+/// The hit of triangle `prim` of a level's own meshes at distance `t`,
+/// barycentrics `b`.
+#[inline(always)]
+fn triangle_hit(prim: PrimRef, t: f32, b: [f32; 3]) -> Hit {
+    Hit {
+        t,
+        prim,
+        instance: NO_INSTANCE,
+        local: HitLocal::Bary(b),
+    }
+}
+
 fn packed_vertices(meshes: &[TriangleMesh], p: PrimRef) -> Option<[Vec3; 3]> {
     let tagged = matches!(p.mesh, QUADRIC_TAG | INSTANCE_TAG | MOVING_TAG);
     (!tagged && meshes[p.mesh as usize].alpha.is_none())
@@ -676,14 +698,7 @@ impl Shapes<'_> {
         let mut other: Option<Hit> = None;
         let prims = &self.level.prims;
         let meshes = self.meshes;
-        let hint = |pos: u32| {
-            // The hit triangle's vertex indices: surface reconstruction
-            // reads them first, behind the primitive reference.
-            let p = prims[pos as usize];
-            if let Some(m) = meshes.get(p.mesh as usize) {
-                prefetch(m.indices.as_ptr().wrapping_add(3 * p.index as usize));
-            }
-        };
+        let hint = |pos: u32| prefetch_indices(meshes, prims[pos as usize]);
         let found = bvh.closest_hinted(
             ray,
             ray.t_max,
@@ -711,12 +726,7 @@ impl Shapes<'_> {
         );
         match found {
             Closest::Nothing => None,
-            Closest::Triangle { pos, t, b } => Some(Hit {
-                t,
-                prim: prims[pos as usize],
-                instance: NO_INSTANCE,
-                local: HitLocal::Bary(b),
-            }),
+            Closest::Triangle { pos, t, b } => Some(triangle_hit(prims[pos as usize], t, b)),
             Closest::Other => other,
         }
     }
@@ -978,15 +988,8 @@ impl Aggregate {
                 for (o, f) in out[..n].iter_mut().zip(&found[..n]) {
                     *o = f.map(|(pos, t, b)| {
                         let prim = self.top.prims[pos as usize];
-                        if let Some(m) = self.meshes.get(prim.mesh as usize) {
-                            prefetch(m.indices.as_ptr().wrapping_add(3 * prim.index as usize));
-                        }
-                        Hit {
-                            t,
-                            prim,
-                            instance: NO_INSTANCE,
-                            local: HitLocal::Bary(b),
-                        }
+                        prefetch_indices(&self.meshes, prim);
+                        triangle_hit(prim, t, b)
                     });
                 }
             }

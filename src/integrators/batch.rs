@@ -107,12 +107,12 @@ pub(super) fn trace_paths<M: PathMedium>(
     }
     let mut bsdf = Bsdf::empty();
     // The camera rays of the batch (one pixel's) are coherent: traced as
-    // one packet.
+    // packets.
     let mut camera_rays = true;
     while !b.active.is_empty() {
         scratch.counts.closest += b.active.len() as u64;
-        if camera_rays && b.active.len() <= PACKET_MAX {
-            closest_of_lanes(b, |j| states[j].ray, scene);
+        if camera_rays {
+            closest_of_lanes(&b.active, |j| states[j].ray, &b.times, &mut b.hits, scene);
         } else {
             for &j in &b.active {
                 let j = j as usize;
@@ -154,35 +154,33 @@ pub(super) fn trace_camera_rays(b: &mut Batch, scene: &RenderScene) {
             b.active.push(j as u32);
         }
     }
-    if b.active.len() <= PACKET_MAX {
-        let rays = std::mem::take(&mut b.rays);
-        closest_of_lanes(b, |j| rays[j], scene);
-        b.rays = rays;
-    } else {
-        for j in 0..b.len {
-            if b.weights[j] > 0.0 {
-                let hit = &mut b.hits[j];
-                scene.aggregate.intersect_into(&b.rays[j], b.times[j], hit);
-            }
-        }
-    }
+    closest_of_lanes(&b.active, |j| b.rays[j], &b.times, &mut b.hits, scene);
 }
 
-/// The closest hits of the active lanes' rays (`ray(lane)`, at most
-/// [`PACKET_MAX`] lanes) in `b.hits`, traced as one packet.
-fn closest_of_lanes(b: &mut Batch, ray: impl Fn(usize) -> Ray, scene: &RenderScene) {
-    let n = b.active.len();
-    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET_MAX];
-    let mut times = [0f32; PACKET_MAX];
-    for (k, &j) in b.active.iter().enumerate() {
-        rays[k] = ray(j as usize);
-        times[k] = b.times[j as usize];
-    }
-    let mut hits = [None; PACKET_MAX];
-    scene
-        .aggregate
-        .intersect_packet(&rays[..n], &times[..n], &mut hits[..n]);
-    for (k, &j) in b.active.iter().enumerate() {
-        b.hits[j as usize] = hits[k];
+/// The closest hits of lanes `active`'s rays (`ray(lane)`, at times
+/// `times[lane]`) in `hits[lane]`, traced as packets of up to
+/// [`PACKET_MAX`] lanes.
+fn closest_of_lanes(
+    active: &[u32],
+    ray: impl Fn(usize) -> Ray,
+    times: &[f32],
+    hits: &mut [Option<Hit>],
+    scene: &RenderScene,
+) {
+    for lanes in active.chunks(PACKET_MAX) {
+        let n = lanes.len();
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET_MAX];
+        let mut at = [0f32; PACKET_MAX];
+        for (k, &j) in lanes.iter().enumerate() {
+            rays[k] = ray(j as usize);
+            at[k] = times[j as usize];
+        }
+        let mut found = [None; PACKET_MAX];
+        scene
+            .aggregate
+            .intersect_packet(&rays[..n], &at[..n], &mut found[..n]);
+        for (&j, &h) in lanes.iter().zip(&found[..n]) {
+            hits[j as usize] = h;
+        }
     }
 }
