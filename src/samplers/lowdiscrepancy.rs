@@ -489,6 +489,19 @@ struct BlockLanes {
     perm: [i32; LANES_LEN],
 }
 
+/// A lane set's constants for `scrambled_lanes_avx2`: base, base²,
+/// their reciprocals, the zero-digit tail (four lanes each in `.0`, four
+/// in `.1`) and the offset of the pair table or permutation.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+struct LaneConsts {
+    b: (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d),
+    b2: (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d),
+    ib: (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d),
+    ib2: (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d),
+    tail: (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d),
+    off: (std::arch::x86_64::__m128i, std::arch::x86_64::__m128i),
+}
+
 /// Entries of each `BlockLanes` array.
 const LANES_LEN: usize = BLOCK_DIM_END + BLOCK_LANES;
 
@@ -660,6 +673,34 @@ impl PermutationTables {
         }
     }
 
+    /// `scrambled(dims[k / 4], a[k])` for `k < BLOCK_LANES` into `out[k]`,
+    /// bit for bit, with the indices in SIMD lanes (four entries of a
+    /// sample array, both of its dimensions); `dims` in `2..BLOCK_DIM_END`.
+    #[inline]
+    pub fn scrambled_indices(
+        &self,
+        dims: [usize; 2],
+        a: &[u32; BLOCK_LANES],
+        out: &mut [f32; BLOCK_LANES],
+    ) {
+        assert!(dims.iter().all(|d| (2..BLOCK_DIM_END).contains(d)));
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        // SAFETY: AVX2 is enabled at compile time; `dims` are block
+        // dimensions, whose constants are inside `lanes` and whose gathers
+        // stay inside their pair tables or permutations (as the block's).
+        unsafe {
+            if dims[0].max(dims[1]) < PAIR_BLOCK_DIM_END {
+                self.scrambled_indices_avx2::<true>(dims, a, out)
+            } else {
+                self.scrambled_indices_avx2::<false>(dims, a, out)
+            }
+        }
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        for (k, (v, &a)) in out.iter_mut().zip(a).enumerate() {
+            *v = self.scrambled(dims[k / 4], a as u64);
+        }
+    }
+
     /// `scrambled_radical_inverse_pairs` in eight lanes: the same steps
     /// per lane (two digits while `a >= base²`, then one or two), the
     /// reversed digits held exactly in f64 (below 2^41), quotients by
@@ -679,17 +720,79 @@ impl PermutationTables {
         use std::arch::x86_64::*;
         let l = &self.lanes;
         let ld = |v: &[f64; LANES_LEN], k: usize| _mm256_loadu_pd(v.as_ptr().add(first + k));
-        let (b_lo, b_hi) = (ld(&l.base, 0), ld(&l.base, 4));
-        let (b2_lo, b2_hi) = (ld(&l.base2, 0), ld(&l.base2, 4));
-        let (ib_lo, ib_hi) = (ld(&l.inv_base, 0), ld(&l.inv_base, 4));
-        let (ib2_lo, ib2_hi) = (ld(&l.inv_base2, 0), ld(&l.inv_base2, 4));
-        let (offsets, table) = if PAIRS {
-            (&l.pairs, self.pairs.as_ptr() as *const i32)
-        } else {
-            (&l.perm, self.perms.as_ptr() as *const i32)
+        let offsets = if PAIRS { &l.pairs } else { &l.perm };
+        let c = LaneConsts {
+            b: (ld(&l.base, 0), ld(&l.base, 4)),
+            b2: (ld(&l.base2, 0), ld(&l.base2, 4)),
+            ib: (ld(&l.inv_base, 0), ld(&l.inv_base, 4)),
+            ib2: (ld(&l.inv_base2, 0), ld(&l.inv_base2, 4)),
+            tail: (ld(&l.tail, 0), ld(&l.tail, 4)),
+            off: (
+                _mm_loadu_si128(offsets.as_ptr().add(first) as *const __m128i),
+                _mm_loadu_si128(offsets.as_ptr().add(first + 4) as *const __m128i),
+            ),
         };
-        let off_lo = _mm_loadu_si128(offsets.as_ptr().add(first) as *const __m128i);
-        let off_hi = _mm_loadu_si128(offsets.as_ptr().add(first + 4) as *const __m128i);
+        let a = _mm256_set1_pd(a as f64);
+        self.scrambled_lanes_avx2::<PAIRS>(&c, (a, a), out)
+    }
+
+    /// `scrambled(dims[k / 4], a[k])` for the eight indices `a` into
+    /// `out[k]`, bit for bit (the block's lanes with one dimension's
+    /// constants in each half and an index of their own); `dims` in
+    /// `2..BLOCK_DIM_END`.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    #[inline]
+    unsafe fn scrambled_indices_avx2<const PAIRS: bool>(
+        &self,
+        [lo, hi]: [usize; 2],
+        a: &[u32; BLOCK_LANES],
+        out: &mut [f32; BLOCK_LANES],
+    ) {
+        use std::arch::x86_64::*;
+        let l = &self.lanes;
+        let sp = |v: &[f64; LANES_LEN]| (_mm256_set1_pd(v[lo]), _mm256_set1_pd(v[hi]));
+        let offsets = if PAIRS { &l.pairs } else { &l.perm };
+        let c = LaneConsts {
+            b: sp(&l.base),
+            b2: sp(&l.base2),
+            ib: sp(&l.inv_base),
+            ib2: sp(&l.inv_base2),
+            tail: sp(&l.tail),
+            off: (_mm_set1_epi32(offsets[lo]), _mm_set1_epi32(offsets[hi])),
+        };
+        let a_lo = _mm256_cvtepi32_pd(_mm_loadu_si128(a.as_ptr() as *const __m128i));
+        let a_hi = _mm256_cvtepi32_pd(_mm_loadu_si128(a.as_ptr().add(4) as *const __m128i));
+        // The indices are unsigned: those past i32::MAX read as negative.
+        let wrap = |x: __m256d| {
+            let neg = _mm256_cmp_pd::<_CMP_LT_OQ>(x, _mm256_setzero_pd());
+            _mm256_add_pd(x, _mm256_and_pd(neg, _mm256_set1_pd(4_294_967_296.0)))
+        };
+        self.scrambled_lanes_avx2::<PAIRS>(&c, (wrap(a_lo), wrap(a_hi)), out)
+    }
+
+    /// The eight lanes of `scrambled_block_avx2` and
+    /// `scrambled_indices_avx2`: lane `k` (of `lo` for k < 4, else `hi`)
+    /// is the scrambled radical inverse of index `a` with the base,
+    /// reciprocals, tail and table offset in the lanes of `c`.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    #[inline(always)]
+    unsafe fn scrambled_lanes_avx2<const PAIRS: bool>(
+        &self,
+        c: &LaneConsts,
+        (a_lo, a_hi): (std::arch::x86_64::__m256d, std::arch::x86_64::__m256d),
+        out: &mut [f32; BLOCK_LANES],
+    ) {
+        use std::arch::x86_64::*;
+        let (b_lo, b_hi) = c.b;
+        let (b2_lo, b2_hi) = c.b2;
+        let (ib_lo, ib_hi) = c.ib;
+        let (ib2_lo, ib2_hi) = c.ib2;
+        let (off_lo, off_hi) = c.off;
+        let table = if PAIRS {
+            self.pairs.as_ptr() as *const i32
+        } else {
+            self.perms.as_ptr() as *const i32
+        };
         let low16 = _mm_set1_epi32(0xffff);
         // Entry `i` of a dimension's pair table or permutation, for 4 lanes.
         let gather = |i: __m256d, off: __m128i| {
@@ -734,8 +837,7 @@ impl PermutationTables {
                 _mm256_blendv_pd(inv, _mm256_mul_pd(inv, inv_mul), mask),
             )
         };
-        let mut a_lo = _mm256_set1_pd(a as f64);
-        let mut a_hi = a_lo;
+        let (mut a_lo, mut a_hi) = (a_lo, a_hi);
         let mut rev_lo = _mm256_setzero_pd();
         let mut rev_hi = rev_lo;
         let mut inv_lo = _mm256_set1_pd(1.0);
@@ -790,8 +892,8 @@ impl PermutationTables {
         let im_hi = _mm256_blendv_pd(ib_hi, ib2_hi, two_hi);
         (rev_lo, inv_lo) = push(rev_lo, inv_lo, d_lo, mul_lo, im_lo, nz_lo);
         (rev_hi, inv_hi) = push(rev_hi, inv_hi, d_hi, mul_hi, im_hi, nz_hi);
-        let v_lo = _mm256_mul_pd(inv_lo, _mm256_add_pd(rev_lo, ld(&l.tail, 0)));
-        let v_hi = _mm256_mul_pd(inv_hi, _mm256_add_pd(rev_hi, ld(&l.tail, 4)));
+        let v_lo = _mm256_mul_pd(inv_lo, _mm256_add_pd(rev_lo, c.tail.0));
+        let v_hi = _mm256_mul_pd(inv_hi, _mm256_add_pd(rev_hi, c.tail.1));
         let cap = _mm_set1_ps(ONE_MINUS_EPSILON);
         let f_lo = _mm_min_ps(_mm256_cvtpd_ps(v_lo), cap);
         let f_hi = _mm_min_ps(_mm256_cvtpd_ps(v_hi), cap);
@@ -964,6 +1066,38 @@ mod tests {
             check(a >> 40);
         }
         check(u64::MAX);
+    }
+
+    #[test]
+    fn lanes_of_indices_are_bit_identical() {
+        for seed in [0u64, 9] {
+            let t = PermutationTables::shared(seed);
+            let mut r = Pcg32::with_sequence(17);
+            let mut out = [0f32; BLOCK_LANES];
+            for dim in 2..BLOCK_DIM_END {
+                let dims = [dim, (dim * 7 + 3) % (BLOCK_DIM_END - 2) + 2];
+                for k in 0..400u32 {
+                    // Small, random, near the top of u32 (past i32::MAX)
+                    // and arithmetic progressions (a sample array's).
+                    let a: [u32; BLOCK_LANES] = std::array::from_fn(|j| match k % 4 {
+                        0 => k * 8 + j as u32,
+                        1 => r.uniform_u32(),
+                        2 => u32::MAX - k - j as u32,
+                        _ => (k * 1_000_003).wrapping_add(j as u32 * 373_248),
+                    });
+                    t.scrambled_indices(dims, &a, &mut out);
+                    for (j, &v) in out.iter().enumerate() {
+                        let d = dims[j / 4];
+                        assert_eq!(
+                            v.to_bits(),
+                            t.scrambled(d, a[j] as u64).to_bits(),
+                            "dim {d} a {}",
+                            a[j]
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]
