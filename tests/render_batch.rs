@@ -11,6 +11,7 @@
 
 mod common;
 
+use pbrs::integrators::AmbientOcclusionSettings;
 use pbrs::scene::{IntegratorSettings, SamplerKind, SceneDescription};
 
 fn both_ways(mut desc: SceneDescription, res: u32, spp: u32, what: &str) {
@@ -133,6 +134,56 @@ WorldEnd
         let desc = common::load_text(&scene(max_depth)).scene;
         both_ways(desc, 24, 13, &format!("lanes, maxdepth {max_depth}"));
     }
+}
+
+/// ambientocclusion: the batch's camera rays as packets, each hemisphere's
+/// shadow rays in groups traced as packets (a triangles-only scene) or
+/// ray by ray (spheres, a `Material "none"` sheet crossed), against the
+/// scalar loop's rays one by one; sample counts that leave a group
+/// part-full (1, 5, 16, 37).
+#[test]
+fn ambientocclusion_packets() {
+    for n in [1, 5, 16, 37] {
+        let mut desc = common::load("scenes/cornell-path.pbrt");
+        desc.integrator = IntegratorSettings::AmbientOcclusion(AmbientOcclusionSettings {
+            cos_sample: n != 5,
+            n_samples: n,
+        });
+        both_ways(
+            desc,
+            24,
+            5,
+            &format!("ambientocclusion cornell, nsamples {n}"),
+        );
+    }
+    let text = r#"
+LookAt 0 1 4  0 0.8 0  0 1 0
+Camera "perspective" "float fov" [45]
+Sampler "halton" "integer pixelsamples" [16]
+Integrator "ambientocclusion" "integer nsamples" [12] "bool cossample" "false"
+WorldBegin
+Material "matte"
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point P" [-2 0 -2  2 0 -2  2 0 2  -2 0 2]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point P" [-2 0 -2  2 0 -2  2 2 -2  -2 2 -2]
+AttributeBegin
+  Translate -0.5 0.35 0
+  Shape "sphere" "float radius" [0.35]
+AttributeEnd
+AttributeBegin
+  Material "none"
+  Shape "trianglemesh" "integer indices" [0 1 2]
+    "point P" [-1 0.1 1.5  0 0.1 1.5  -1 1.1 1.5]
+AttributeEnd
+WorldEnd
+"#;
+    both_ways(
+        common::load_text(text).scene,
+        24,
+        7,
+        "ambientocclusion, spheres",
+    );
 }
 
 /// volpath's batch: homogeneous and heterogeneous media, the camera in a

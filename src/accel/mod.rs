@@ -1001,6 +1001,28 @@ impl Aggregate {
         }
     }
 
+    /// Whether something blocks each of `rays` (at scene times `times`)
+    /// before its `t_max`, in `out`, each [`Aggregate::occluded_at`]'s
+    /// answer: traced as one packet when the scene is triangles only (as
+    /// [`Aggregate::intersect_packet`]) and there are at most
+    /// [`PACKET_MAX`], else ray by ray. For rays from one point.
+    #[inline(never)]
+    pub fn occluded_packet(&self, rays: &[Ray], times: &[f32], out: &mut [bool]) {
+        match self.top.bvh.as_ref() {
+            Some(bvh) if bvh.traces_packets() && rays.len() <= PACKET_MAX => {
+                let blocked = bvh.any_packet(rays);
+                for (i, o) in out[..rays.len()].iter_mut().enumerate() {
+                    *o = blocked >> i & 1 == 1;
+                }
+            }
+            _ => {
+                for ((r, &time), o) in rays.iter().zip(times).zip(out.iter_mut()) {
+                    *o = self.occluded_at(r, time);
+                }
+            }
+        }
+    }
+
     #[inline(always)]
     fn closest_at(&self, ray: &Ray, time: f32) -> Option<Hit> {
         self.shapes().intersect(

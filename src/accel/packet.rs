@@ -158,6 +158,95 @@ impl Bvh4 {
     }
 }
 
+impl Bvh4 {
+    /// Whether something blocks each of `rays` (at most [`PACKET_MAX`])
+    /// with `t <= ray.t_max`: bit `i` for `rays[i]`, each [`Bvh4::any`]'s
+    /// answer for the ray alone (whether any triangle is hit in that range
+    /// does not depend on the order nodes are visited in). For rays from
+    /// one point (ambient occlusion's). Only where
+    /// [`Bvh4::traces_packets`].
+    pub(super) fn any_packet(&self, rays: &[Ray]) -> u32 {
+        let n = rays.len();
+        assert!(n <= PACKET_MAX && self.traces_packets());
+        if n == 0 {
+            return 0;
+        }
+        let mut boxes = [const { MaybeUninit::<BoxRay>::uninit() }; PACKET_MAX];
+        let mut tris = [const { MaybeUninit::<TriangleRay4>::uninit() }; PACKET_MAX];
+        let mut t_max = [0f32; PACKET_MAX];
+        for (i, r) in rays.iter().enumerate() {
+            boxes[i].write(BoxRay::new(r));
+            tris[i].write(TriangleRay4::new(r.o, r.d));
+            t_max[i] = r.t_max;
+        }
+        // SAFETY (here and below): the first `n` entries were written, and
+        // only rays of masks within `(1 << n) - 1` are read.
+        let boxes = |i: usize| unsafe { boxes[i].assume_init_ref() };
+        let tris = |i: usize| unsafe { tris[i].assume_init_ref() };
+        // Entries: (child, the rays that met its box).
+        let mut stack = [(0u32, 0u32); STACK];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        let mut active: u32 = (1 << n) - 1;
+        let mut blocked = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let mut masks = [0u32; 4];
+                each(active, |i| {
+                    let bits = boxes(i).test(node, t_max[i]).1.bitmask();
+                    for (c, m) in masks.iter_mut().enumerate() {
+                        *m |= ((bits >> c) & 1) << i;
+                    }
+                });
+                // The first child met next, the others stacked.
+                let mut next = None;
+                for (c, &m) in masks.iter().enumerate() {
+                    if m == 0 {
+                        continue;
+                    }
+                    if next.is_none() {
+                        next = Some(c);
+                    } else {
+                        stack[sp] = (node.child[c], m);
+                        sp += 1;
+                    }
+                }
+                if let Some(c) = next {
+                    cur = node.child[c];
+                    active = masks[c];
+                    continue;
+                }
+            } else {
+                let leaf = &self.leaves[(cur & !LEAF) as usize];
+                each(active, |i| {
+                    let tr = tris(i);
+                    let hit = match tr.kz() {
+                        0 => tr.any4::<0>(&leaf.v, t_max[i], leaf.triangles),
+                        1 => tr.any4::<1>(&leaf.v, t_max[i], leaf.triangles),
+                        _ => tr.any4::<2>(&leaf.v, t_max[i], leaf.triangles),
+                    };
+                    blocked |= u32::from(hit) << i;
+                });
+            }
+            // Next: a stacked child with rays not yet blocked.
+            loop {
+                if sp == 0 {
+                    return blocked;
+                }
+                sp -= 1;
+                let (child, mask) = stack[sp];
+                let open = mask & !blocked;
+                if open != 0 {
+                    cur = child;
+                    active = open;
+                    break;
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -225,6 +314,42 @@ mod tests {
                 r
             })
             .collect()
+    }
+
+    #[test]
+    fn each_ray_of_a_packet_gets_its_own_occlusion() {
+        let mut rng = Pcg32::with_sequence(11);
+        let (mut blocked, mut open) = (0, 0);
+        for n in [4, 20, 300, 3000] {
+            let tris = scene(&mut rng, n);
+            let (bvh, _) = build(&tris, &[]);
+            for _ in 0..400 {
+                let len = 1 + rng.uniform_u32_below(PACKET_MAX as u32) as usize;
+                let mut rays = packet(&mut rng, len);
+                // Shadow rays of limited reach too, some ending on the
+                // grid (at a vertex or edge) or just short of it.
+                for r in rays.iter_mut() {
+                    if rng.uniform_u32_below(2) == 0 {
+                        r.t_max = rng.uniform_f32() * 8.0;
+                    }
+                }
+                let got = bvh.any_packet(&rays);
+                for (i, r) in rays.iter().enumerate() {
+                    let alone = bvh.any(r, r.t_max, |_| unreachable!("triangles only"));
+                    assert_eq!(got >> i & 1 == 1, alone, "ray {r:?}");
+                    if alone {
+                        blocked += 1;
+                    } else {
+                        open += 1;
+                    }
+                }
+                assert_eq!(got >> len, 0, "bits past the packet");
+            }
+        }
+        assert!(
+            blocked > 2000 && open > 2000,
+            "{blocked} blocked, {open} open"
+        );
     }
 
     #[test]

@@ -15,7 +15,9 @@
 //! As pbrt-v3, the hemisphere's frame is (dp/du normalised, n × dp/du, n
 //! turned towards the camera), from the surface's geometric dp/du and normal.
 
-use super::{Integrate, IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH, PIXEL_BOUNDS};
+use super::batch::trace_camera_rays;
+use super::{Batch, Integrate, IntegratorKind, IntegratorSettings, Scratch, MAX_PASS_THROUGH, PIXEL_BOUNDS};
+use crate::accel::{Hit, PACKET_MAX};
 use crate::geometry::{face_forward, spawn_ray, Ray, RayDiff};
 use crate::integrators::RenderScene;
 use crate::samplers::Sampler;
@@ -96,18 +98,26 @@ impl AmbientOcclusionSettings {
     }
 }
 
+/// Hemisphere directions made together before their shadow rays, which
+/// are traced as one packet.
+const GROUP: usize = PACKET_MAX;
+
 /// The runtime `ambientocclusion`: its settings and the size of its
 /// sampler array.
 pub struct AmbientOcclusion {
     settings: AmbientOcclusionSettings,
     n: u32,
+    /// Shadow rays one by one (the plain code the packets are checked
+    /// against).
+    scalar: bool,
 }
 
 impl AmbientOcclusion {
-    pub fn new(settings: &AmbientOcclusionSettings, _scene: &RenderScene, _scalar: bool) -> Self {
+    pub fn new(settings: &AmbientOcclusionSettings, _scene: &RenderScene, scalar: bool) -> Self {
         AmbientOcclusion {
             settings: *settings,
             n: settings.n_samples,
+            scalar,
         }
     }
 }
@@ -121,17 +131,51 @@ impl Integrate for AmbientOcclusion {
 
     fn li(
         &self,
-        mut ray: Ray,
+        ray: Ray,
         time: f32,
         _diff: Option<RayDiff>,
         scene: &RenderScene,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
     ) -> Vec3 {
+        scratch.counts.closest += 1;
+        let first = scene.aggregate.intersect_at(&ray, time);
+        self.occlusion(ray, time, first, scene, sampler, scratch)
+    }
+
+    /// The batch's camera rays traced together (as packets, one pixel's
+    /// rays being coherent), then each lane's hemisphere from its hit:
+    /// lane by lane `li`'s values.
+    fn li_batch(&self, b: &mut Batch, scene: &RenderScene, scratch: &mut Scratch) {
+        trace_camera_rays(b, scene);
+        for j in 0..b.len {
+            b.l[j] = if b.weights[j] > 0.0 {
+                scratch.counts.closest += 1;
+                let (ray, time, first) = (b.rays[j], b.times[j], b.hits[j]);
+                self.occlusion(ray, time, first, scene, &mut b.samplers[j], scratch)
+            } else {
+                Vec3::ZERO
+            };
+        }
+    }
+}
+
+impl AmbientOcclusion {
+    /// The occlusion seen along camera ray `ray`, whose closest hit is
+    /// `first`.
+    fn occlusion(
+        &self,
+        mut ray: Ray,
+        time: f32,
+        first: Option<Hit>,
+        scene: &RenderScene,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
         let mut crossed = 0;
+        let mut next = first;
         let (hit, s) = loop {
-            scratch.counts.closest += 1;
-            let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
+            let Some(hit) = next else {
                 return Vec3::ZERO;
             };
             let s = scene.aggregate.surface_at(&hit, time);
@@ -143,6 +187,8 @@ impl Integrate for AmbientOcclusion {
                 return Vec3::ZERO;
             }
             ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            scratch.counts.closest += 1;
+            next = scene.aggregate.intersect_at(&ray, time);
         };
         let n = face_forward(s.point.n, -ray.d);
         let dpdu = scene.aggregate.diff_geom(&hit, &s).dpdu;
@@ -153,22 +199,44 @@ impl Integrate for AmbientOcclusion {
         };
         let count = self.n as f32;
         let mut l = 0.0f32;
-        for &u in u {
-            let (w, pdf) = if self.settings.cos_sample {
-                let w = cosine_sample_hemisphere(u);
-                (w, cosine_hemisphere_pdf(w.z.abs()))
+        // A group's directions and what each adds if open are made before
+        // its shadow rays are traced, so that their divisions and square
+        // roots overlap, and the rays are traced together.
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); GROUP];
+        let mut adds = [0f32; GROUP];
+        for group in u.chunks(GROUP) {
+            for ((&u, ray), add) in group.iter().zip(&mut rays).zip(&mut adds) {
+                let (w, pdf) = if self.settings.cos_sample {
+                    let w = cosine_sample_hemisphere(u);
+                    (w, cosine_hemisphere_pdf(w.z.abs()))
+                } else {
+                    (uniform_sample_hemisphere(u), uniform_hemisphere_pdf())
+                };
+                let wi = Vec3::new(
+                    sx.x * w.x + t.x * w.y + n.x * w.z,
+                    sx.y * w.x + t.y * w.y + n.y * w.z,
+                    sx.z * w.x + t.z * w.y + n.z * w.z,
+                );
+                *ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, wi);
+                *add = wi.dot(n) / (pdf * count);
+            }
+            // The group's rays leave one point: traced as a packet.
+            let k = group.len();
+            scratch.counts.shadow += k as u64;
+            let mut blocked = [false; GROUP];
+            if self.scalar {
+                for (b, ray) in blocked.iter_mut().zip(&rays[..k]) {
+                    *b = scene.aggregate.occluded_at(ray, time);
+                }
             } else {
-                (uniform_sample_hemisphere(u), uniform_hemisphere_pdf())
-            };
-            let wi = Vec3::new(
-                sx.x * w.x + t.x * w.y + n.x * w.z,
-                sx.y * w.x + t.y * w.y + n.y * w.z,
-                sx.z * w.x + t.z * w.y + n.z * w.z,
-            );
-            scratch.counts.shadow += 1;
-            let shadow = spawn_ray(s.point.p, s.point.p_error, s.point.n, wi);
-            if !scene.aggregate.occluded_at(&shadow, time) {
-                l += wi.dot(n) / (pdf * count);
+                scene
+                    .aggregate
+                    .occluded_packet(&rays[..k], &[time; GROUP][..k], &mut blocked[..k]);
+            }
+            for (&add, &b) in adds.iter().zip(&blocked).take(k) {
+                if !b {
+                    l += add;
+                }
             }
         }
         Vec3::splat(l)
