@@ -61,14 +61,25 @@ fn directlighting_and_whitted() {
 /// samples skipped) and 5.
 #[test]
 fn directlighting_lanes_every_kind_of_camera_vertex() {
-    let scene = |max_depth: u32| {
-        format!(
-            r#"
+    for max_depth in [1, 5] {
+        let integrator = format!(
+            "Integrator \"directlighting\" \"string strategy\" \"all\" \"integer maxdepth\" [{max_depth}]"
+        );
+        let desc = common::load_text(&lanes_scene(&integrator)).scene;
+        both_ways(desc, 24, 13, &format!("lanes, maxdepth {max_depth}"));
+    }
+}
+
+/// The scene of `directlighting_lanes_every_kind_of_camera_vertex` with
+/// the statement `integrator`.
+fn lanes_scene(integrator: &str) -> String {
+    format!(
+        r#"
 LookAt 0 1 4  0 0.8 0  0 1 0
 Camera "perspective" "float fov" [45]
 Film "image" "integer xresolution" [24] "integer yresolution" [24]
 Sampler "halton" "integer pixelsamples" [16]
-Integrator "directlighting" "string strategy" "all" "integer maxdepth" [{max_depth}]
+{integrator}
 WorldBegin
 AttributeBegin
   AreaLightSource "diffuse" "rgb L" [8 6 4]
@@ -128,19 +139,14 @@ AttributeBegin
 AttributeEnd
 WorldEnd
 "#
-        )
-    };
-    for max_depth in [1, 5] {
-        let desc = common::load_text(&scene(max_depth)).scene;
-        both_ways(desc, 24, 13, &format!("lanes, maxdepth {max_depth}"));
-    }
+    )
 }
 
 /// ambientocclusion: the batch's camera rays as packets, each hemisphere's
-/// shadow rays in groups traced as packets (a triangles-only scene) or
-/// ray by ray (spheres, a `Material "none"` sheet crossed), against the
-/// scalar loop's rays one by one; sample counts that leave a group
-/// part-full (1, 5, 16, 37).
+/// shadow rays in groups traced as packets (the Cornell box, triangles
+/// only) or ray by ray (the lanes scene: spheres, a `Material "none"`
+/// sheet crossed), against the scalar loop's rays one by one; sample
+/// counts that leave a group part-full (1, 5, 16, 37).
 #[test]
 fn ambientocclusion_packets() {
     for n in [1, 5, 16, 37] {
@@ -156,30 +162,11 @@ fn ambientocclusion_packets() {
             &format!("ambientocclusion cornell, nsamples {n}"),
         );
     }
-    let text = r#"
-LookAt 0 1 4  0 0.8 0  0 1 0
-Camera "perspective" "float fov" [45]
-Sampler "halton" "integer pixelsamples" [16]
-Integrator "ambientocclusion" "integer nsamples" [12] "bool cossample" "false"
-WorldBegin
-Material "matte"
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point P" [-2 0 -2  2 0 -2  2 0 2  -2 0 2]
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point P" [-2 0 -2  2 0 -2  2 2 -2  -2 2 -2]
-AttributeBegin
-  Translate -0.5 0.35 0
-  Shape "sphere" "float radius" [0.35]
-AttributeEnd
-AttributeBegin
-  Material "none"
-  Shape "trianglemesh" "integer indices" [0 1 2]
-    "point P" [-1 0.1 1.5  0 0.1 1.5  -1 1.1 1.5]
-AttributeEnd
-WorldEnd
-"#;
+    let text = lanes_scene(
+        "Integrator \"ambientocclusion\" \"integer nsamples\" [12] \"bool cossample\" \"false\"",
+    );
     both_ways(
-        common::load_text(text).scene,
+        common::load_text(&text).scene,
         24,
         7,
         "ambientocclusion, spheres",
