@@ -1,7 +1,10 @@
 //! Coherent rays traced together: a packet of up to [`PACKET_MAX`] rays
-//! (a pixel's camera rays) walks the four-wide BVH once, each node's boxes
-//! and each leaf's triangles tested for every ray of the packet that
-//! reaches them.
+//! (a pixel's camera rays, or the shadow rays ambient occlusion sends from
+//! one point) walks the four-wide BVH once, each node's boxes and each
+//! leaf's triangles tested for every ray of the packet that reaches them:
+//! for the closest hit ([`Bvh4::closest_packet`]) or for any hit
+//! ([`Bvh4::any_packet`], which drops a ray from the packet once it is
+//! blocked).
 //!
 //! One ray's traversal is a chain of dependent steps (a node's loads, its
 //! box test, the choice of the next child, a branch that random rays
