@@ -422,3 +422,57 @@ impl GlobalSequence for HaltonSampler {
         HaltonSampler::sample_dimension(self, index, dim)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2D array's entries computed in lanes are, bit for bit, the
+    /// entries one by one (`sample_2d_dimensions` at each entry's index):
+    /// arrays of 1 to 37 entries after 1D arrays, small films (indices in
+    /// 32 bits, the lanes) and a huge one (indices past 2^32, one by one),
+    /// both seeds' tables.
+    #[test]
+    fn arrays_in_lanes_are_the_entries_one_by_one() {
+        let sizes = [1u32, 2, 3, 4, 5, 8, 13, 37];
+        for (res, spp, seed) in [(24, 16, 0u64), (300, 64, 5), (1 << 16, 4096, 0)] {
+            let bounds = Bounds2i::new(IVec2::ZERO, IVec2::splat(res));
+            let mut s = HaltonSampler::new(spp, bounds, false, seed);
+            s.request_1d_array(3);
+            for &n in &sizes {
+                s.request_2d_array(n);
+            }
+            let mut wide = 0;
+            for (pixel, index) in [(0, 0), (7, 1), (res - 1, spp - 1), (res / 3, spp / 2)] {
+                let pixel = IVec2::new(pixel, res - 1 - pixel);
+                s.start_pixel_sample(pixel, index);
+                let _ = s.get_1d_array(3);
+                for (i, &n) in sizes.iter().enumerate() {
+                    let dim = ARRAY_START_DIM + 1 + 2 * i as u32;
+                    let first = index as u64 * n as u64;
+                    let mut one = s.clone();
+                    let expected: Vec<Vec2> = (0..n as u64)
+                        .map(|k| one.sample_2d_dimensions(one.index_for_sample(first + k), dim))
+                        .collect();
+                    wide += usize::from(s.index_for_sample(first + n as u64 - 1) > u32::MAX as u64);
+                    let got = s.get_2d_array(n).expect("requested").to_vec();
+                    let bits = |v: &[Vec2]| {
+                        v.iter()
+                            .map(|p| (p.x.to_bits(), p.y.to_bits()))
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(
+                        bits(&got),
+                        bits(&expected),
+                        "res {res} pixel {pixel} sample {index} n {n}"
+                    );
+                }
+            }
+            assert_eq!(
+                wide > 0,
+                res == 1 << 16,
+                "indices past 32 bits at res {res}"
+            );
+        }
+    }
+}
