@@ -6,8 +6,8 @@ use super::lowdiscrepancy::{
     DigitBase, PermutationTables, BLOCK_DIM_END, BLOCK_LANES, PRIME_TABLE_SIZE,
 };
 use super::{
-    count, global_1d_array, past_arrays, ArrayStore, GlobalSequence, SamplerKindEntry,
-    PIXELSAMPLES_16,
+    count, global_1d_array, global_2d_array, past_arrays, ArrayStore, GlobalSequence,
+    SamplerKindEntry, PIXELSAMPLES_16,
 };
 use crate::geometry::Bounds2i;
 use crate::sampling::rng::{hash_to_unit, mix64};
@@ -274,50 +274,7 @@ impl HaltonSampler {
 
     #[inline]
     pub fn get_2d_array(&mut self, n: u32) -> Option<&[Vec2]> {
-        let i = self.arrays.next_2d;
-        if self.arrays.sizes_2d.get(i) == Some(&n) {
-            // pbrt-v3's `GlobalSampler` values (`global_2d_array`'s), the
-            // entries' indices in lanes.
-            let mut data = std::mem::take(&mut self.arrays.data_2d[i]);
-            let dim = ARRAY_START_DIM + self.arrays.sizes_1d.len() as u32 + 2 * i as u32;
-            self.array_2d_values(dim, self.sample_index as u64 * n as u64, &mut data);
-            self.arrays.data_2d[i] = data;
-        }
-        self.arrays.get_2d(n, 0)
-    }
-
-    /// The 2D array entries at dimensions `dim`, `dim + 1` of the sample
-    /// indices `index_for_sample(first + k)` into `out[k]`: bit for bit
-    /// `sample_2d_dimensions` entry by entry, with four entries' indices in
-    /// the SIMD lanes of each dimension where the dimensions are block
-    /// dimensions and the indices fit 32 bits.
-    fn array_2d_values(&mut self, dim: u32, first: u64, out: &mut [Vec2]) {
-        let n = out.len() as u64;
-        let lanes = n >= 2
-            && dim >= 2
-            && (dim as usize + 1) < BLOCK_DIM_END
-            && self.index_for_sample(first + n - 1) <= u32::MAX as u64;
-        if !lanes {
-            for (k, v) in out.iter_mut().enumerate() {
-                *v = self.sample_2d_dimensions(self.index_for_sample(first + k as u64), dim);
-            }
-            return;
-        }
-        // Four entries at a time, both dimensions in one call (the last
-        // group's spare lanes repeat its last index).
-        let dims = [dim as usize, dim as usize + 1];
-        let mut v = [0f32; BLOCK_LANES];
-        for (c, group) in out.chunks_mut(BLOCK_LANES / 2).enumerate() {
-            let k0 = first + (c * BLOCK_LANES / 2) as u64;
-            let last = group.len() as u64 - 1;
-            let a: [u32; BLOCK_LANES] = std::array::from_fn(|j| {
-                self.index_for_sample(k0 + ((j % (BLOCK_LANES / 2)) as u64).min(last)) as u32
-            });
-            self.tables.scrambled_indices(dims, &a, &mut v);
-            for (j, e) in group.iter_mut().enumerate() {
-                *e = Vec2::new(v[j], v[BLOCK_LANES / 2 + j]);
-            }
-        }
+        global_2d_array(self, n)
     }
 
     /// `get_2d_array` written into `out` (cleared first) without going
@@ -420,6 +377,40 @@ impl GlobalSequence for HaltonSampler {
     #[inline]
     fn sample_dimension(&mut self, index: u64, dim: u32) -> f32 {
         HaltonSampler::sample_dimension(self, index, dim)
+    }
+
+    /// The 2D array entries at dimensions `dim`, `dim + 1` of the sample
+    /// indices `index_for_sample(first + k)` into `out[k]`: bit for bit
+    /// `sample_2d_dimensions` entry by entry, with four entries' indices in
+    /// the SIMD lanes of each dimension where the dimensions are block
+    /// dimensions and the indices fit 32 bits.
+    fn array_2d_values(&mut self, dim: u32, first: u64, out: &mut [Vec2]) {
+        let n = out.len() as u64;
+        let lanes = n >= 2
+            && dim >= 2
+            && (dim as usize + 1) < BLOCK_DIM_END
+            && self.index_for_sample(first + n - 1) <= u32::MAX as u64;
+        if !lanes {
+            for (k, v) in out.iter_mut().enumerate() {
+                *v = self.sample_2d_dimensions(self.index_for_sample(first + k as u64), dim);
+            }
+            return;
+        }
+        // Four entries at a time, both dimensions in one call (the last
+        // group's spare lanes repeat its last index).
+        let dims = [dim as usize, dim as usize + 1];
+        let mut v = [0f32; BLOCK_LANES];
+        for (c, group) in out.chunks_mut(BLOCK_LANES / 2).enumerate() {
+            let k0 = first + (c * BLOCK_LANES / 2) as u64;
+            let last = group.len() as u64 - 1;
+            let a: [u32; BLOCK_LANES] = std::array::from_fn(|j| {
+                self.index_for_sample(k0 + ((j % (BLOCK_LANES / 2)) as u64).min(last)) as u32
+            });
+            self.tables.scrambled_indices(dims, &a, &mut v);
+            for (j, e) in group.iter_mut().enumerate() {
+                *e = Vec2::new(v[j], v[BLOCK_LANES / 2 + j]);
+            }
+        }
     }
 }
 

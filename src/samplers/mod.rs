@@ -392,6 +392,19 @@ pub(crate) trait GlobalSequence {
     fn index_for_sample(&self, sample_num: u64) -> u64;
     /// Dimension `dim` of the global sample `index`.
     fn sample_dimension(&mut self, index: u64, dim: u32) -> f32;
+    /// The 2D array entries at dimensions `dim`, `dim + 1` of the samples
+    /// `index_for_sample(first + k)` into `out[k]` (a sequence may compute
+    /// several at once, with these values).
+    #[inline]
+    fn array_2d_values(&mut self, dim: u32, first: u64, out: &mut [Vec2]) {
+        for (k, v) in out.iter_mut().enumerate() {
+            let index = self.index_for_sample(first + k as u64);
+            *v = Vec2::new(
+                self.sample_dimension(index, dim),
+                self.sample_dimension(index, dim + 1),
+            );
+        }
+    }
 }
 
 /// The current sample's next 1D array of `n` values of a global sequence.
@@ -418,13 +431,7 @@ pub(crate) fn global_2d_array<S: GlobalSequence>(s: &mut S, n: u32) -> Option<&[
         let mut data = std::mem::take(&mut s.arrays().data_2d[i]);
         let dim = S::ARRAY_START_DIM + s.arrays().sizes_1d.len() as u32 + 2 * i as u32;
         let first = s.sample_index() as u64 * n as u64;
-        for (k, v) in data.iter_mut().enumerate() {
-            let index = s.index_for_sample(first + k as u64);
-            *v = Vec2::new(
-                s.sample_dimension(index, dim),
-                s.sample_dimension(index, dim + 1),
-            );
-        }
+        s.array_2d_values(dim, first, &mut data);
         s.arrays().data_2d[i] = data;
     }
     s.arrays().get_2d(n, 0)
