@@ -30,7 +30,7 @@ pub enum Wrap {
     Clamp,
 }
 
-const WEIGHT_LUT_SIZE: usize = 128;
+pub(super) const WEIGHT_LUT_SIZE: usize = 128;
 
 /// pbrt-v3's EWA weights: exp(−2r²) − exp(−2) at r² = i/127.
 pub fn ewa_weights() -> &'static [f32; WEIGHT_LUT_SIZE] {
@@ -51,10 +51,11 @@ pub fn ewa_weights() -> &'static [f32; WEIGHT_LUT_SIZE] {
 /// 2²⁷ (1.5 GiB of RGB, 2 GiB with the coarser levels).
 pub const MAX_TEXELS: usize = 1 << 27;
 
-struct Level<T> {
-    w: i32,
-    h: i32,
-    texels: Vec<T>,
+/// One level of the pyramid; its sides are powers of two.
+pub(super) struct Level<T> {
+    pub(super) w: i32,
+    pub(super) h: i32,
+    pub(super) texels: Vec<T>,
 }
 
 /// A MIP map of values `T`.
@@ -134,11 +135,11 @@ fn round_up_pow2(v: i32) -> i32 {
 /// pbrt-v3's EWA footprint on a level: the texel-space centre, the
 /// ellipse's coefficients (r² = a·s² + b·s·t + c·t²) and the bounding box of
 /// texels to scan (`s0..=s1`, `t0..=t1`, as floats before the area check).
-struct Ellipse {
-    st: Vec2,
-    a: f32,
-    b: f32,
-    c: f32,
+pub(super) struct Ellipse {
+    pub(super) st: Vec2,
+    pub(super) a: f32,
+    pub(super) b: f32,
+    pub(super) c: f32,
     s0: f32,
     s1: f32,
     t0: f32,
@@ -346,44 +347,70 @@ impl<T: TexValue> MipMap<T> {
         if !(area.is_finite() && area <= (1 << 22) as f32) {
             return self.bilerp(level, st);
         }
-        let Ellipse { st, a, b, c, .. } = e;
-        let (s0, s1, t0, t1) = (e.s0 as i32, e.s1 as i32, e.t0 as i32, e.t1 as i32);
-        let mut sum = T::ZERO;
-        let mut sum_w = 0.0f32;
-        // The texels of one row in turn: for `repeat`, the wrapped column
-        // steps along with `is` (no remainder per texel).
-        let repeat = self.wrap == Wrap::Repeat;
-        let s_first = if repeat { wrap_mod(s0, l.w) } else { s0 };
-        for it in t0..=t1 {
-            let tt = it as f32 - st.y;
-            // The last term of r², the same for the whole row.
-            let ctt = c * tt * tt;
-            let row = if repeat { wrap_mod(it, l.h) * l.w } else { 0 };
-            let mut sw = s_first;
-            for is in s0..=s1 {
-                let ss = is as f32 - st.x;
-                let r2 = a * ss * ss + b * ss * tt + ctt;
-                if r2 < 1.0 {
-                    let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
-                    let weight = self.weights[index];
-                    let texel = if repeat {
-                        l.texels[(row + sw) as usize]
-                    } else {
-                        texel_of(l, is, it, self.wrap)
-                    };
-                    sum = sum.add(texel.scale(weight));
-                    sum_w += weight;
-                }
-                if repeat {
-                    sw += 1;
-                    if sw == l.w {
-                        sw = 0;
-                    }
+        let (sum, sum_w) = super::ewa_lanes::scan(l, &e, self.weights, self.wrap);
+        sum.div(sum_w)
+    }
+}
+
+impl Ellipse {
+    /// The texels to scan: columns `s0..=s1` of rows `t0..=t1`.
+    pub(super) fn texel_box(&self) -> (i32, i32, i32, i32) {
+        (
+            self.s0 as i32,
+            self.s1 as i32,
+            self.t0 as i32,
+            self.t1 as i32,
+        )
+    }
+}
+
+/// EWA's sums over a footprint's texels, one texel at a time: the weighted
+/// texels and the weights, each added in the order of the rows and of the
+/// texels in a row ([`super::ewa_lanes::scan`] computes the same sums).
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
+pub(super) fn ewa_scan_plain<T: TexValue>(
+    l: &Level<T>,
+    e: &Ellipse,
+    weights: &[f32; WEIGHT_LUT_SIZE],
+    wrap: Wrap,
+) -> (T, f32) {
+    let &Ellipse { st, a, b, c, .. } = e;
+    let (s0, s1, t0, t1) = e.texel_box();
+    let mut sum = T::ZERO;
+    let mut sum_w = 0.0f32;
+    // The texels of one row in turn: for `repeat`, the wrapped column
+    // steps along with `is` (no remainder per texel).
+    let repeat = wrap == Wrap::Repeat;
+    let s_first = if repeat { wrap_mod(s0, l.w) } else { s0 };
+    for it in t0..=t1 {
+        let tt = it as f32 - st.y;
+        // The last term of r², the same for the whole row.
+        let ctt = c * tt * tt;
+        let row = if repeat { wrap_mod(it, l.h) * l.w } else { 0 };
+        let mut sw = s_first;
+        for is in s0..=s1 {
+            let ss = is as f32 - st.x;
+            let r2 = a * ss * ss + b * ss * tt + ctt;
+            if r2 < 1.0 {
+                let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
+                let weight = weights[index];
+                let texel = if repeat {
+                    l.texels[(row + sw) as usize]
+                } else {
+                    texel_of(l, is, it, wrap)
+                };
+                sum = sum.add(texel.scale(weight));
+                sum_w += weight;
+            }
+            if repeat {
+                sw += 1;
+                if sw == l.w {
+                    sw = 0;
                 }
             }
         }
-        sum.div(sum_w)
     }
+    (sum, sum_w)
 }
 
 /// std::max(a, b): `b` if `a < b`, else `a`.
@@ -397,7 +424,7 @@ fn max(a: f32, b: f32) -> f32 {
 }
 
 #[inline(always)]
-fn texel_of<T: TexValue>(l: &Level<T>, s: i32, t: i32, wrap: Wrap) -> T {
+pub(super) fn texel_of<T: TexValue>(l: &Level<T>, s: i32, t: i32, wrap: Wrap) -> T {
     let (s, t) = match wrap {
         Wrap::Repeat => (wrap_mod(s, l.w), wrap_mod(t, l.h)),
         Wrap::Clamp => (s.clamp(0, l.w - 1), t.clamp(0, l.h - 1)),
@@ -457,6 +484,7 @@ fn resample<T: TexValue>(w: i32, h: i32, img: &[T], pw: i32, ph: i32, wrap: Wrap
 mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
+    use glam::Vec3;
 
     /// pbrt-v3's `EWA` scan as written there: every texel through `Texel`.
     fn ewa_plain<T: TexValue>(m: &MipMap<T>, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
@@ -540,27 +568,63 @@ mod tests {
         }
     }
 
-    #[test]
-    fn ewa_equals_the_plain_scan() {
+    /// A random EWA footprint: centres inside the image, across its edges
+    /// and far outside; differentials from none to a few dozen texels, so
+    /// that rows are shorter and longer than eight texels.
+    fn footprint(rng: &mut Pcg32, levels: usize) -> (usize, Vec2, Vec2, Vec2) {
+        let level = rng.uniform_u32_below(levels as u32) as usize;
+        let spread = [3.0, 3.0, 40.0][rng.uniform_u32_below(3) as usize];
+        let st = Vec2::new(rng.uniform_f32(), rng.uniform_f32()) * spread
+            - Vec2::splat(0.5 * (spread - 1.0));
+        let scale = [0.2, 0.2, 1.5][rng.uniform_u32_below(3) as usize] * rng.uniform_f32().powi(3);
+        let d0 = Vec2::new(rng.uniform_f32() - 0.5, rng.uniform_f32() - 0.5) * scale;
+        let d1 = Vec2::new(rng.uniform_f32() - 0.5, rng.uniform_f32() - 0.5) * scale;
+        (level, st, d0, d1)
+    }
+
+    /// `ewa` (whose scan runs in lanes where AVX2 is enabled) gives
+    /// pbrt-v3's scan as written, bit for bit, for float and RGB maps in
+    /// every wrap mode; and the scan's two sums are the plain scan's.
+    fn ewa_matches<T: TexValue>(texel: impl Fn(&mut Pcg32) -> T, bits: impl Fn(T) -> Vec<u32>) {
         let mut rng = Pcg32::new();
-        let (w, h) = (37usize, 16usize);
-        let texels: Vec<f32> = (0..w * h).map(|_| rng.uniform_f32() * 2.0 - 0.25).collect();
-        for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Black] {
-            let m = MipMap::new(w, h, texels.clone(), false, 8.0, wrap).unwrap();
-            for _ in 0..3000 {
-                let level = rng.uniform_u32_below(m.levels() as u32) as usize;
-                let st = Vec2::new(rng.uniform_f32() * 3.0 - 1.0, rng.uniform_f32() * 3.0 - 1.0);
-                let scale = 0.2 * rng.uniform_f32().powi(3);
-                let d0 = Vec2::new(rng.uniform_f32() - 0.5, rng.uniform_f32() - 0.5) * scale;
-                let d1 = Vec2::new(rng.uniform_f32() - 0.5, rng.uniform_f32() - 0.5) * scale;
-                let fast = m.ewa(level, st, d0, d1);
-                let plain = ewa_plain(&m, level, st, d0, d1);
-                assert_eq!(
-                    fast.to_bits(),
-                    plain.to_bits(),
-                    "{wrap:?} level {level} st {st}"
-                );
+        for (w, h) in [(37usize, 16usize), (3, 70), (1, 1)] {
+            let texels: Vec<T> = (0..w * h).map(|_| texel(&mut rng)).collect();
+            for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Black] {
+                let m = MipMap::new(w, h, texels.clone(), false, 8.0, wrap).unwrap();
+                for _ in 0..3000 {
+                    let (level, st, d0, d1) = footprint(&mut rng, m.levels());
+                    let fast = m.ewa(level, st, d0, d1);
+                    let plain = ewa_plain(&m, level, st, d0, d1);
+                    let at = format!("{w}x{h} {wrap:?} level {level} st {st} d {d0} {d1}");
+                    assert_eq!(bits(fast), bits(plain), "{at}");
+                    let l = &m.levels[level];
+                    let e = Ellipse::new(l, st, d0, d1);
+                    let (sum, sum_w) = crate::textures::ewa_lanes::scan(l, &e, m.weights, wrap);
+                    let (sum_p, sum_w_p) = ewa_scan_plain(l, &e, m.weights, wrap);
+                    assert_eq!(
+                        (bits(sum), sum_w.to_bits()),
+                        (bits(sum_p), sum_w_p.to_bits()),
+                        "{at}"
+                    );
+                }
             }
         }
+    }
+
+    #[test]
+    fn ewa_equals_the_plain_scan() {
+        // Negative texels too (Lanczos resampling's ringing is clamped,
+        // but a power-of-two image keeps its values).
+        ewa_matches(|r| r.uniform_f32() * 2.0 - 0.25, |v| vec![v.to_bits()]);
+        ewa_matches(
+            |r| {
+                Vec3::new(
+                    r.uniform_f32(),
+                    r.uniform_f32() * 3.0,
+                    r.uniform_f32() - 0.5,
+                )
+            },
+            |v| v.to_array().map(f32::to_bits).to_vec(),
+        );
     }
 }

@@ -19,6 +19,7 @@ mod bilerp;
 mod checkerboard;
 mod constant;
 mod dots;
+mod ewa_lanes;
 mod fbm;
 mod imagemap;
 mod mapping;
