@@ -56,9 +56,10 @@ fn directlighting_and_whitted() {
 /// directlighting's batched camera vertices (Lambertian ones four at a
 /// time, one light per pass): seven triangle lights (two packs, the
 /// second part-full; one two-sided, one black), camera hits on glass, a
-/// mirror, plastic, textured and bump-mapped matte (differentials) and a
-/// `Material "none"` sheet, with `maxdepth` 1 (no specular children, so no
-/// samples skipped) and 5.
+/// mirror, plastic, textured and bump-mapped matte (differentials), a
+/// `Material "none"` sheet, cylinder instances (one moving) and an alpha
+/// cut-out, with `maxdepth` 1 (no specular children, so no samples
+/// skipped) and 5.
 #[test]
 fn directlighting_lanes_every_kind_of_camera_vertex() {
     for max_depth in [1, 5] {
@@ -137,15 +138,41 @@ AttributeBegin
   Shape "trianglemesh" "integer indices" [0 1 2]
     "point P" [-1 0.1 1.5  0 0.1 1.5  -1 1.1 1.5]
 AttributeEnd
+ObjectBegin "post"
+  Shape "cylinder" "float radius" [0.08] "float zmin" [0] "float zmax" [0.9]
+ObjectEnd
+AttributeBegin
+  Translate 1.2 0 -0.9
+  Rotate -90 1 0 0
+  ObjectInstance "post"
+AttributeEnd
+AttributeBegin
+  ActiveTransform StartTime
+  Translate -1.3 0 -0.9
+  ActiveTransform EndTime
+  Translate -1.1 0 -0.8
+  ActiveTransform All
+  Rotate -90 1 0 0
+  ObjectInstance "post"
+AttributeEnd
+Texture "cut" "float" "checkerboard" "float uscale" [3] "float vscale" [3]
+  "float tex1" [1] "float tex2" [0]
+AttributeBegin
+  Material "matte" "rgb Kd" [0.7 0.7 0.2]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [0.3 0.05 0.6  1.1 0.05 0.6  1.1 0.85 0.6  0.3 0.85 0.6]
+    "float uv" [0 0 1 0 1 1 0 1] "texture alpha" "cut"
+AttributeEnd
 WorldEnd
 "#
     )
 }
 
 /// ambientocclusion: the batch's camera rays as packets, each hemisphere's
-/// shadow rays in groups traced as packets (the Cornell box, triangles
-/// only) or ray by ray (the lanes scene: spheres, a `Material "none"`
-/// sheet crossed), against the scalar loop's rays one by one; sample
+/// shadow rays in groups traced as packets, against the scalar loop's
+/// rays one by one: in the Cornell box (triangles only) and in the lanes
+/// scene, whose spheres, cylinder instances (one moving), alpha cut-out
+/// and `Material "none"` sheet the packet asks about ray by ray; sample
 /// counts that leave a group part-full (1, 5, 16, 37).
 #[test]
 fn ambientocclusion_packets() {

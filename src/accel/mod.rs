@@ -745,19 +745,32 @@ impl Shapes<'_> {
             return false;
         };
         bvh.any(ray, ray.t_max, |pos| {
-            let prim = self.level.prims[pos as usize];
-            if prim.mesh == INSTANCE_TAG {
-                instance_hit(prim.index)
-            } else if prim.mesh == QUADRIC_TAG {
-                self.quadrics[prim.index as usize]
-                    .intersect(ray.o, ray.d, ray.t_max)
-                    .is_some()
-            } else if prim.mesh == MOVING_TAG {
-                moving_hit(prim.index)
-            } else {
-                self.alpha_triangle(ray, prim, ray.t_max, true).is_some()
-            }
+            self.blocks(ray, pos, &mut instance_hit, &mut moving_hit)
         })
+    }
+
+    /// Whether the primitive at BVH position `pos`, other than a plain
+    /// triangle, blocks `ray` before its `t_max` (the any-hit callback).
+    #[inline(always)]
+    fn blocks(
+        &self,
+        ray: &Ray,
+        pos: u32,
+        instance_hit: &mut impl FnMut(u32) -> bool,
+        moving_hit: &mut impl FnMut(u32) -> bool,
+    ) -> bool {
+        let prim = self.level.prims[pos as usize];
+        if prim.mesh == INSTANCE_TAG {
+            instance_hit(prim.index)
+        } else if prim.mesh == QUADRIC_TAG {
+            self.quadrics[prim.index as usize]
+                .intersect(ray.o, ray.d, ray.t_max)
+                .is_some()
+        } else if prim.mesh == MOVING_TAG {
+            moving_hit(prim.index)
+        } else {
+            self.alpha_triangle(ray, prim, ray.t_max, true).is_some()
+        }
     }
 
     /// A triangle of a mesh with an alpha mask: hit, and not cut away
@@ -1003,14 +1016,24 @@ impl Aggregate {
 
     /// Whether something blocks each of `rays` (at scene times `times`)
     /// before its `t_max`, in `out`, each [`Aggregate::occluded_at`]'s
-    /// answer: traced as one packet when the scene is triangles only (as
-    /// [`Aggregate::intersect_packet`]) and there are at most
-    /// [`PACKET_MAX`], else ray by ray. For rays from one point.
+    /// answer: traced as one packet when there are at most [`PACKET_MAX`]
+    /// (and the tree is not deeper than a packet's stack), the primitives
+    /// other than plain triangles tested ray by ray where the packet meets
+    /// them, else ray by ray. For coherent rays (from one point).
     #[inline(never)]
     pub fn occluded_packet(&self, rays: &[Ray], times: &[f32], out: &mut [bool]) {
         match self.top.bvh.as_ref() {
-            Some(bvh) if bvh.traces_packets() && rays.len() <= PACKET_MAX => {
-                let blocked = bvh.any_packet(rays);
+            Some(bvh) if bvh.any_packets_fit() && rays.len() <= PACKET_MAX => {
+                let top = self.shapes();
+                let blocked = bvh.any_packet(rays, |i, pos| {
+                    let ray = &rays[i];
+                    top.blocks(
+                        ray,
+                        pos,
+                        &mut |k| self.instance_occluded(ray, k),
+                        &mut |k| self.moving_occluded(ray, times[i], k),
+                    )
+                });
                 for (i, o) in out[..rays.len()].iter_mut().enumerate() {
                     *o = blocked >> i & 1 == 1;
                 }
@@ -1077,14 +1100,18 @@ impl Aggregate {
     pub fn occluded_at(&self, ray: &Ray, time: f32) -> bool {
         self.shapes().occluded(
             ray,
-            |i| {
-                let inst = &self.instances[i as usize];
-                inst.object
-                    .shapes()
-                    .occluded(&inst.place.object_ray(ray), |_| false, |_| false)
-            },
+            |i| self.instance_occluded(ray, i),
             |i| self.moving_occluded(ray, time, i),
         )
+    }
+
+    /// Whether instance `i` (not moving) blocks `ray` before its `t_max`.
+    #[inline]
+    fn instance_occluded(&self, ray: &Ray, i: u32) -> bool {
+        let inst = &self.instances[i as usize];
+        inst.object
+            .shapes()
+            .occluded(&inst.place.object_ray(ray), |_| false, |_| false)
     }
 
     /// The object and placement of an instance hit (a moving instance's at

@@ -1,10 +1,10 @@
 //! Coherent rays traced together: a packet of up to [`PACKET_MAX`] rays
-//! (a pixel's camera rays, or the shadow rays ambient occlusion sends from
-//! one point) walks the four-wide BVH once, each node's boxes and each
+//! (a pixel's camera rays, or the shadow rays ambient occlusion or a
+//! many-sample light sends from one point) walks the four-wide BVH once, each node's boxes and each
 //! leaf's triangles tested for every ray of the packet that reaches them:
 //! for the closest hit ([`Bvh4::closest_packet`]) or for any hit
 //! ([`Bvh4::any_packet`], which drops a ray from the packet once it is
-//! blocked).
+//! blocked, and asks a callback about primitives other than triangles).
 //!
 //! One ray's traversal is a chain of dependent steps (a node's loads, its
 //! box test, the choice of the next child, a branch that random rays
@@ -162,15 +162,29 @@ impl Bvh4 {
 }
 
 impl Bvh4 {
+    /// Whether [`Bvh4::any_packet`] can trace this tree (a stack it has
+    /// room for; any primitives).
+    pub(super) fn any_packets_fit(&self) -> bool {
+        self.stack_need <= STACK
+    }
+
     /// Whether something blocks each of `rays` (at most [`PACKET_MAX`])
     /// with `t <= ray.t_max`: bit `i` for `rays[i]`, each [`Bvh4::any`]'s
-    /// answer for the ray alone (whether any triangle is hit in that range
-    /// does not depend on the order nodes are visited in). For rays from
-    /// one point (ambient occlusion's). Only where
-    /// [`Bvh4::traces_packets`].
-    pub(super) fn any_packet(&self, rays: &[Ray]) -> u32 {
+    /// answer for the ray alone, `blocks(i, position)` deciding a leaf's
+    /// primitives other than plain triangles for ray `i` as `any`'s
+    /// callback does. Each ray meets the leaves its own traversal meets
+    /// (boxes are tested against its fixed `t_max`), and whether any of
+    /// their primitives blocks it does not depend on the order they are
+    /// visited in. For coherent rays (ambient occlusion's from one point,
+    /// a light's samples seen from one point). Only where
+    /// [`Bvh4::any_packets_fit`].
+    pub(super) fn any_packet(
+        &self,
+        rays: &[Ray],
+        mut blocks: impl FnMut(usize, u32) -> bool,
+    ) -> u32 {
         let n = rays.len();
-        assert!(n <= PACKET_MAX && self.traces_packets());
+        assert!(n <= PACKET_MAX && self.any_packets_fit());
         if n == 0 {
             return 0;
         }
@@ -222,13 +236,20 @@ impl Bvh4 {
                 }
             } else {
                 let leaf = &self.leaves[(cur & !LEAF) as usize];
+                let others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
                 each(active, |i| {
                     let tr = tris(i);
-                    let hit = match tr.kz() {
-                        0 => tr.any4::<0>(&leaf.v, t_max[i], leaf.triangles),
-                        1 => tr.any4::<1>(&leaf.v, t_max[i], leaf.triangles),
-                        _ => tr.any4::<2>(&leaf.v, t_max[i], leaf.triangles),
-                    };
+                    let mut hit = leaf.triangles != 0
+                        && match tr.kz() {
+                            0 => tr.any4::<0>(&leaf.v, t_max[i], leaf.triangles),
+                            1 => tr.any4::<1>(&leaf.v, t_max[i], leaf.triangles),
+                            _ => tr.any4::<2>(&leaf.v, t_max[i], leaf.triangles),
+                        };
+                    let mut m = others;
+                    while !hit && m != 0 {
+                        hit = blocks(i, leaf.first + m.trailing_zeros());
+                        m &= m - 1;
+                    }
                     blocked |= u32::from(hit) << i;
                 });
             }
@@ -258,6 +279,7 @@ mod tests {
     use crate::sampling::rng::Pcg32;
     use crate::shapes::intersect_triangle;
     use glam::Vec3;
+    use obvhs::aabb::Aabb;
 
     fn point(rng: &mut Pcg32, s: f32) -> Vec3 {
         Vec3::new(
@@ -319,39 +341,73 @@ mod tests {
             .collect()
     }
 
+    /// Whether a ray meets the sphere (centre, radius) at a t in (0, t_max].
+    fn meets_sphere(r: &Ray, (c, radius): (Vec3, f32)) -> bool {
+        let oc = r.o - c;
+        let (a, b, cc) = (
+            r.d.dot(r.d),
+            2.0 * oc.dot(r.d),
+            oc.dot(oc) - radius * radius,
+        );
+        let disc = b * b - 4.0 * a * cc;
+        if disc < 0.0 {
+            return false;
+        }
+        let q = disc.sqrt();
+        let (t0, t1) = ((-b - q) / (2.0 * a), (-b + q) / (2.0 * a));
+        (t0 > 0.0 && t0 <= r.t_max) || (t1 > 0.0 && t1 <= r.t_max)
+    }
+
+    /// Any-hit packets against triangles alone, and against triangles
+    /// mixed with spheres (other primitives, decided by the callback): each
+    /// ray gets what `Bvh4::any` answers for it alone.
     #[test]
     fn each_ray_of_a_packet_gets_its_own_occlusion() {
         let mut rng = Pcg32::with_sequence(11);
-        let (mut blocked, mut open) = (0, 0);
+        let (mut blocked, mut open, mut by_spheres) = (0, 0, 0);
         for n in [4, 20, 300, 3000] {
-            let tris = scene(&mut rng, n);
-            let (bvh, _) = build(&tris, &[]);
-            for _ in 0..400 {
-                let len = 1 + rng.uniform_u32_below(PACKET_MAX as u32) as usize;
-                let mut rays = packet(&mut rng, len);
-                // Shadow rays of limited reach too, some ending on the
-                // grid (at a vertex or edge) or just short of it.
-                for r in rays.iter_mut() {
-                    if rng.uniform_u32_below(2) == 0 {
-                        r.t_max = rng.uniform_f32() * 8.0;
+            for n_spheres in [0, 1, 3, n / 4] {
+                let tris = scene(&mut rng, n);
+                let spheres: Vec<(Vec3, f32)> = (0..n_spheres)
+                    .map(|_| (point(&mut rng, 4.0), 0.05 + 0.4 * rng.uniform_f32()))
+                    .collect();
+                let boxes: Vec<Aabb> = spheres
+                    .iter()
+                    .map(|&(c, r)| {
+                        Aabb::new((c - Vec3::splat(r)).into(), (c + Vec3::splat(r)).into())
+                    })
+                    .collect();
+                let (bvh, order) = build(&tris, &boxes);
+                let sphere_at = |pos: u32| spheres[order[pos as usize] as usize - tris.len()];
+                for _ in 0..200 {
+                    let len = 1 + rng.uniform_u32_below(PACKET_MAX as u32) as usize;
+                    let mut rays = packet(&mut rng, len);
+                    // Shadow rays of limited reach too, some ending on the
+                    // grid (at a vertex or edge) or just short of it.
+                    for r in rays.iter_mut() {
+                        if rng.uniform_u32_below(2) == 0 {
+                            r.t_max = rng.uniform_f32() * 8.0;
+                        }
                     }
-                }
-                let got = bvh.any_packet(&rays);
-                for (i, r) in rays.iter().enumerate() {
-                    let alone = bvh.any(r, r.t_max, |_| unreachable!("triangles only"));
-                    assert_eq!(got >> i & 1 == 1, alone, "ray {r:?}");
-                    if alone {
-                        blocked += 1;
-                    } else {
-                        open += 1;
+                    let got =
+                        bvh.any_packet(&rays, |i, pos| meets_sphere(&rays[i], sphere_at(pos)));
+                    for (i, r) in rays.iter().enumerate() {
+                        let alone = bvh.any(r, r.t_max, |pos| meets_sphere(r, sphere_at(pos)));
+                        assert_eq!(got >> i & 1 == 1, alone, "ray {r:?}");
+                        if alone {
+                            blocked += 1;
+                            by_spheres += usize::from(!bvh.any(r, r.t_max, |_| false));
+                        } else {
+                            open += 1;
+                        }
                     }
+                    assert_eq!(got >> len, 0, "bits past the packet");
                 }
-                assert_eq!(got >> len, 0, "bits past the packet");
             }
         }
         assert!(
-            blocked > 2000 && open > 2000,
-            "{blocked} blocked, {open} open"
+            blocked > 2000 && open > 2000 && by_spheres > 200,
+            "{blocked} blocked ({by_spheres} by spheres alone), {open} open"
         );
     }
 
