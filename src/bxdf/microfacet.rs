@@ -74,21 +74,46 @@ pub trait MicrofacetModel {
     /// (`G` is 0 when `wi` is `None`), for lobes that need all three.
     #[inline]
     fn d_g_pdf(&self, wo: Vec3, wi: Option<Vec3>, wh: Vec3) -> (f32, f32, f32) {
-        let d = self.d(wh);
-        let visible = self.sample_visible();
-        let lambda_o = if visible || wi.is_some() {
-            self.lambda(wo)
-        } else {
-            0.0
-        };
-        let g = wi.map_or(0.0, |wi| self.g_from_lambdas(lambda_o, self.lambda(wi)));
-        let pdf = if visible {
-            d / (1.0 + lambda_o) * wo.dot(wh).abs() / abs_cos_theta(wo)
-        } else {
-            d * abs_cos_theta(wh)
-        };
-        (d, g, pdf)
+        d_g_pdf_plain(self, wo, wi, wh)
     }
+}
+
+/// [`MicrofacetModel::d_g_pdf`] from `d` and `lambda`, one direction after
+/// the other.
+#[inline(always)]
+pub(super) fn d_g_pdf_plain<M: MicrofacetModel + ?Sized>(
+    m: &M,
+    wo: Vec3,
+    wi: Option<Vec3>,
+    wh: Vec3,
+) -> (f32, f32, f32) {
+    let d = m.d(wh);
+    let visible = m.sample_visible();
+    let lambda_o = if visible || wi.is_some() {
+        m.lambda(wo)
+    } else {
+        0.0
+    };
+    let g = wi.map_or(0.0, |wi| m.g_from_lambdas(lambda_o, m.lambda(wi)));
+    d_g_pdf_finish(visible, d, g, lambda_o, wo, wh)
+}
+
+/// The density of `sample_wh` from `D(wh)` and `Λ(wo)`, with `(D, G)`.
+#[inline(always)]
+pub(super) fn d_g_pdf_finish(
+    visible: bool,
+    d: f32,
+    g: f32,
+    lambda_o: f32,
+    wo: Vec3,
+    wh: Vec3,
+) -> (f32, f32, f32) {
+    let pdf = if visible {
+        d / (1.0 + lambda_o) * wo.dot(wh).abs() / abs_cos_theta(wo)
+    } else {
+        d * abs_cos_theta(wh)
+    };
+    (d, g, pdf)
 }
 
 /// Trowbridge–Reitz (GGX) distribution.
@@ -393,6 +418,12 @@ impl MicrofacetModel for TrowbridgeReitz {
     #[inline]
     fn sample_visible(&self) -> bool {
         self.sample_visible
+    }
+    /// The three directions' terms side by side
+    /// ([`super::microfacet_lanes`]), bit for bit [`d_g_pdf_plain`].
+    #[inline]
+    fn d_g_pdf(&self, wo: Vec3, wi: Option<Vec3>, wh: Vec3) -> (f32, f32, f32) {
+        super::microfacet_lanes::trowbridge_reitz_d_g_pdf(self, wo, wi, wh)
     }
 }
 

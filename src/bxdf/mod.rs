@@ -17,6 +17,7 @@ mod fresnel_blend;
 pub mod hair;
 mod lambertian;
 pub(crate) mod microfacet;
+mod microfacet_lanes;
 mod microfacet_lobes;
 mod oren_nayar;
 mod specular;
