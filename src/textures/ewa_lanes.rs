@@ -57,6 +57,21 @@ unsafe fn scan_avx2<T: TexValue>(
         _mm256_set1_epi32(WEIGHT_LUT_SIZE as i32 - 1),
     );
     let mut index = [0i32; 8];
+    // The rows' texels are far apart in a big level (a row of a 1024-texel
+    // RGB level is 12 KiB): the first and last cache line of every row
+    // (up to 16 rows) are asked for before the scan reads any, so that
+    // their misses overlap. A hint: nothing is read.
+    if t1 >= t0 && s1 >= s0 && (t1 as i64 - t0 as i64) < 16 {
+        for it in t0..=t1 {
+            for is in [s0, s1] {
+                let (s, t) = match wrap {
+                    Wrap::Repeat => (is & w_mask, it & h_mask),
+                    Wrap::Clamp | Wrap::Black => (is.clamp(0, w_mask), it.clamp(0, h_mask)),
+                };
+                crate::accel::prefetch(l.texels.as_ptr().wrapping_add((t * l.w + s) as usize));
+            }
+        }
+    }
     for it in t0..=t1 {
         let tt = it as f32 - e.st.y;
         let ctt = e.c * tt * tt;
