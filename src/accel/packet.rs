@@ -1,6 +1,6 @@
 //! Coherent rays traced together: a packet of up to [`PACKET_MAX`] rays
-//! (a pixel's camera rays, or the shadow rays ambient occlusion or a
-//! many-sample light sends from one point) walks the four-wide BVH once, each node's boxes and each
+//! (a pixel's camera rays, or the shadow rays ambient occlusion sends from
+//! one point) walks the four-wide BVH once, each node's boxes and each
 //! leaf's triangles tested for every ray of the packet that reaches them:
 //! for the closest hit ([`Bvh4::closest_packet`]) or for any hit
 //! ([`Bvh4::any_packet`], which drops a ray from the packet once it is
@@ -175,9 +175,8 @@ impl Bvh4 {
     /// callback does. Each ray meets the leaves its own traversal meets
     /// (boxes are tested against its fixed `t_max`), and whether any of
     /// their primitives blocks it does not depend on the order they are
-    /// visited in. For coherent rays (ambient occlusion's from one point,
-    /// a light's samples seen from one point). Only where
-    /// [`Bvh4::any_packets_fit`].
+    /// visited in. For coherent rays (ambient occlusion's from one point).
+    /// Only where [`Bvh4::any_packets_fit`].
     pub(super) fn any_packet(
         &self,
         rays: &[Ray],
