@@ -23,7 +23,7 @@ use super::random::{stream_rng, SampleStream};
 use super::sobolmatrices::{sobol_matrices, to_unit, SOBOL_MATRIX_SIZE};
 use super::ArrayStore;
 use crate::geometry::Bounds2i;
-use crate::sampling::bounded_fast::{BoundedDraws, Jumps};
+use crate::sampling::bounded_fast::{BoundedDraws, Jumps, Stride};
 use crate::sampling::rng::{mix64, Pcg32};
 use glam::{IVec2, Vec2};
 
@@ -67,6 +67,42 @@ pub struct PixelSampler {
     /// The shuffles' draws below every count up to the largest of `spp`
     /// and the arrays' sizes.
     draws: BoundedDraws,
+    /// The fixed steps of the stream of the tables last made.
+    steps: Steps,
+}
+
+/// The fixed steps a pixel's tables take on one RNG stream, made once per
+/// stream (a tile's), not per table.
+#[derive(Clone, Copy, Debug)]
+struct Steps {
+    /// The stream's increment (`Pcg32::parts().1`).
+    inc: u64,
+    jumps: Jumps,
+    /// `spp` steps: the shuffles within runs of one value.
+    spp: Stride,
+    /// 1 + `spp` and 2 + `spp` steps: a table of one value per pixel
+    /// sample whose values are not made (its scrambles and those shuffles).
+    past: [Stride; 2],
+}
+
+impl Steps {
+    fn new(rng: &Pcg32, spp: usize) -> Self {
+        Self {
+            inc: rng.parts().1,
+            jumps: Jumps::of(rng),
+            spp: Stride::new(rng, spp as u64),
+            past: [1, 2].map(|s| Stride::new(rng, s + spp as u64)),
+        }
+    }
+
+    /// The steps of `rng`'s stream (made anew if they are another's).
+    #[inline]
+    fn of(&mut self, rng: &Pcg32, spp: usize) -> &Steps {
+        if self.inc != rng.parts().1 {
+            *self = Steps::new(rng, spp);
+        }
+        self
+    }
 }
 
 /// pbrt-v3's `Shuffle(samp, count, nDimensions, rng)`: blocks of `n` values
@@ -113,9 +149,10 @@ fn shuffle_within<T>(
     spp: usize,
     rng: &mut Pcg32,
     draws: &BoundedDraws,
+    steps: &Steps,
 ) {
     if per_sample == 1 {
-        rng.advance(spp as i64);
+        steps.spp.apply(rng);
         return;
     }
     for i in 0..spp {
@@ -126,22 +163,22 @@ fn shuffle_within<T>(
 /// The RNG stepped past the draws that [`van_der_corput`] (`scrambles` 1)
 /// or [`sobol_2d`] (`scrambles` 2) make, without the values or the swaps.
 fn skip_table(
-    scrambles: i64,
+    scrambles: usize,
     per_sample: usize,
     spp: usize,
     rng: &mut Pcg32,
     draws: &BoundedDraws,
+    steps: &Steps,
 ) {
-    rng.advance(scrambles);
-    let jumps = Jumps::of(rng);
     if per_sample == 1 {
-        rng.advance(spp as i64);
+        steps.past[scrambles - 1].apply(rng);
     } else {
+        rng.advance(scrambles as i64);
         for _ in 0..spp {
-            draws.skip(rng, &jumps, per_sample);
+            draws.skip(rng, &steps.jumps, per_sample);
         }
     }
-    draws.skip(rng, &jumps, spp);
+    draws.skip(rng, &steps.jumps, spp);
 }
 
 /// pbrt-v3's `GrayCodeSample` (one dimension) and `VanDerCorput`: the
@@ -154,13 +191,14 @@ fn van_der_corput(
     c: &[u32],
     rng: &mut Pcg32,
     draws: &BoundedDraws,
+    steps: &Steps,
 ) {
     let mut v = rng.uniform_u32();
     for (i, o) in out.iter_mut().enumerate().take(per_sample * spp) {
         *o = to_unit(v);
         v ^= c[(i as u32 + 1).trailing_zeros() as usize];
     }
-    shuffle_within(out, per_sample, spp, rng, draws);
+    shuffle_within(out, per_sample, spp, rng, draws, steps);
     shuffle(out, spp, per_sample, rng, draws);
 }
 
@@ -173,6 +211,7 @@ fn sobol_2d(
     c: [&[u32]; 2],
     rng: &mut Pcg32,
     draws: &BoundedDraws,
+    steps: &Steps,
 ) {
     let mut v = [rng.uniform_u32(), rng.uniform_u32()];
     for (i, o) in out.iter_mut().enumerate().take(per_sample * spp) {
@@ -181,7 +220,7 @@ fn sobol_2d(
         v[0] ^= c[0][k];
         v[1] ^= c[1][k];
     }
-    shuffle_within(out, per_sample, spp, rng, draws);
+    shuffle_within(out, per_sample, spp, rng, draws, steps);
     shuffle(out, spp, per_sample, rng, draws);
 }
 
@@ -236,6 +275,7 @@ impl PixelSampler {
             dim_2d: 0,
             extra: SampleStream::new(),
             draws: BoundedDraws::new(spp),
+            steps: Steps::new(&Pcg32::new(), spp as usize),
         }
     }
 
@@ -278,6 +318,7 @@ impl PixelSampler {
         let spp = self.spp as usize;
         let rng = &mut self.rng;
         let draws = &self.draws;
+        let steps = self.steps.of(rng, spp);
         let (c0, c1) = (self.c0, self.c1);
         let mut rest_2d = &mut self.samples_2d[..];
         if let Pattern::MaxMinDist(c) = self.pattern {
@@ -291,18 +332,18 @@ impl PixelSampler {
             }
         }
         for s in &mut self.samples_1d {
-            van_der_corput(1, spp, s, c0, rng, draws);
+            van_der_corput(1, spp, s, c0, rng, draws, steps);
         }
         for s in rest_2d {
-            sobol_2d(1, spp, s, [c0, c1], rng, draws);
+            sobol_2d(1, spp, s, [c0, c1], rng, draws, steps);
         }
         if eager {
             let a = &mut self.arrays;
             for (&n, data) in a.sizes_1d.iter().zip(a.data_1d.iter_mut()) {
-                van_der_corput(n as usize, spp, data, c0, rng, draws);
+                van_der_corput(n as usize, spp, data, c0, rng, draws, steps);
             }
             for (&n, data) in a.sizes_2d.iter().zip(a.data_2d.iter_mut()) {
-                sobol_2d(n as usize, spp, data, [c0, c1], rng, draws);
+                sobol_2d(n as usize, spp, data, [c0, c1], rng, draws, steps);
             }
             a.unmade_1d.iter_mut().for_each(|u| *u = None);
             a.unmade_2d.iter_mut().for_each(|u| *u = None);
@@ -314,11 +355,11 @@ impl PixelSampler {
         let a = &mut self.arrays;
         for (&n, unmade) in a.sizes_1d.iter().zip(a.unmade_1d.iter_mut()) {
             *unmade = Some(*rng);
-            skip_table(1, n as usize, spp, rng, draws);
+            skip_table(1, n as usize, spp, rng, draws, steps);
         }
         for (&n, unmade) in a.sizes_2d.iter().zip(a.unmade_2d.iter_mut()) {
             *unmade = Some(*rng);
-            skip_table(2, n as usize, spp, rng, draws);
+            skip_table(2, n as usize, spp, rng, draws, steps);
         }
     }
 
@@ -414,14 +455,9 @@ impl PixelSampler {
             return None;
         }
         if let Some((data, mut rng)) = self.arrays.unmade_1d(n) {
-            van_der_corput(
-                n as usize,
-                self.spp as usize,
-                data,
-                self.c0,
-                &mut rng,
-                &self.draws,
-            );
+            let spp = self.spp as usize;
+            let steps = self.steps.of(&rng, spp);
+            van_der_corput(n as usize, spp, data, self.c0, &mut rng, &self.draws, steps);
         }
         self.arrays.get_1d(n, self.sample_index as usize)
     }
@@ -433,14 +469,9 @@ impl PixelSampler {
         }
         if let Some((data, mut rng)) = self.arrays.unmade_2d(n) {
             let c = [self.c0, self.c1];
-            sobol_2d(
-                n as usize,
-                self.spp as usize,
-                data,
-                c,
-                &mut rng,
-                &self.draws,
-            );
+            let spp = self.spp as usize;
+            let steps = self.steps.of(&rng, spp);
+            sobol_2d(n as usize, spp, data, c, &mut rng, &self.draws, steps);
         }
         self.arrays.get_2d(n, self.sample_index as usize)
     }
@@ -474,7 +505,8 @@ mod tests {
             assert_eq!(ra.uniform_u32(), rb.uniform_u32());
             // The runs of one pixel sample each, shuffled within themselves.
             let (spp, per) = (count, n);
-            shuffle_within(&mut a, per, spp, &mut ra, &draws);
+            let steps = Steps::new(&ra, spp);
+            shuffle_within(&mut a, per, spp, &mut ra, &draws, &steps);
             for i in 0..spp {
                 shuffle_plain(&mut b[i * per..], per, 1, &mut rb);
             }

@@ -90,6 +90,41 @@ impl Jumps {
     }
 }
 
+/// A fixed number of steps of one stream as one affine map of the state,
+/// `a·s + c` (mod 2^64): [`Pcg32::advance`] by that number, with its
+/// constants made once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stride {
+    a: u64,
+    c: u64,
+}
+
+impl Stride {
+    /// `delta` steps of `rng`'s stream.
+    pub fn new(rng: &Pcg32, delta: u64) -> Self {
+        let (mut cur_a, mut cur_c) = (Pcg32::MULT, rng.parts().1);
+        let (mut a, mut c) = (1u64, 0u64);
+        let mut delta = delta;
+        while delta > 0 {
+            if delta & 1 != 0 {
+                a = a.wrapping_mul(cur_a);
+                c = c.wrapping_mul(cur_a).wrapping_add(cur_c);
+            }
+            cur_c = cur_a.wrapping_add(1).wrapping_mul(cur_c);
+            cur_a = cur_a.wrapping_mul(cur_a);
+            delta >>= 1;
+        }
+        Self { a, c }
+    }
+
+    /// Steps `rng` (on the stream the stride was made for).
+    #[inline(always)]
+    pub fn apply(&self, rng: &mut Pcg32) {
+        let s = rng.parts().0;
+        rng.set_state(self.a.wrapping_mul(s).wrapping_add(self.c));
+    }
+}
+
 impl BoundedDraws {
     /// Steps `rng` (whose stream `jumps` describes) past the draws of
     /// `below(rng, count - i)` for `i` in `0..count` (a shuffle of `count`
@@ -183,6 +218,28 @@ mod tests {
             }
         }
         assert_eq!(fast.uniform_u32(), plain.uniform_u32());
+    }
+
+    #[test]
+    fn stride_is_advance() {
+        for seq in [0u64, 1, 17, 1 << 40, u64::MAX >> 1] {
+            let mut r = Pcg32::with_sequence(seq);
+            r.uniform_u32();
+            for delta in [0u64, 1, 2, 3, 7, 64, 65, 66, 1000, 1 << 33] {
+                let mut a = r;
+                let mut b = r;
+                Stride::new(&r, delta).apply(&mut a);
+                b.advance(delta as i64);
+                assert_eq!(a, b, "sequence {seq} delta {delta}");
+            }
+            // A stride made on another stream moves this one elsewhere.
+            let other = Pcg32::with_sequence(seq ^ 1);
+            let mut a = r;
+            Stride::new(&other, 5).apply(&mut a);
+            let mut b = r;
+            b.advance(5);
+            assert_ne!(a, b);
+        }
     }
 
     #[test]
