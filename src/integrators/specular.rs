@@ -6,7 +6,7 @@
 //! lane from their hits ([`tree_lanes`]).
 
 use super::batch::Batch;
-use super::common::{emitted, escaped, shade_geom, with_diff};
+use super::common::{emitted, escaped, shade_geom, with_diff_into};
 use super::{Scratch, MAX_PASS_THROUGH};
 use crate::accel::{Hit, SurfaceHit};
 use crate::geometry::{spawn_ray, Ray, RayDiff};
@@ -74,116 +74,144 @@ pub(super) fn specular_tree_li<'a>(
     let mut stack = std::mem::take(&mut scratch.work);
     stack.clear();
     // The camera ray's vertex is taken without going through the stack
-    // (most samples have no other).
-    let mut root = Some(Work {
+    // (most samples have no other), and each vertex is expanded in place
+    // in `w` (an `Option` taken each time was copied by wide loads that
+    // stalled on the narrower stores that had just made it).
+    let mut w = Work {
         ray,
         diff,
         beta: Vec3::ONE,
         depth: 0,
         pass: 0,
-    });
+    };
     let mut l = Vec3::ZERO;
     let mut first = first;
     let mut vertices = 0u32;
-    while let Some(w) = root.take().or_else(|| stack.pop()) {
+    let mut hit: Option<Hit> = None;
+    let mut s: SurfaceHit;
+    let mut geom: Option<DiffGeom>;
+    loop {
         vertices += 1;
         if vertices > MAX_TREE_VERTICES {
             note_cut(Cut::Tree);
             break;
         }
-        scratch.counts.closest += 1;
-        let (hit, s, mut geom) = match std::mem::replace(&mut first, First::Trace) {
-            First::Shaded { hit, s, geom } => (hit, s, geom),
-            f => {
-                let hit = match f {
-                    First::Hit(h) => h,
-                    _ => scene.aggregate.intersect_at(&w.ray, time),
-                };
-                let Some(hit) = hit else {
-                    l += w.beta * escaped(scene, w.ray.d);
-                    continue;
-                };
-                let mut s = scene.aggregate.surface_at(&hit, time);
-                let material = &scene.materials[s.material as usize];
-                if material.is_none() {
-                    if w.pass < MAX_PASS_THROUGH {
-                        let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
-                        // A spawned ray has no differentials (pbrt-v3's SpawnRay).
-                        stack.push(Work {
-                            ray,
-                            diff: None,
-                            pass: w.pass + 1,
-                            ..w
-                        });
-                    }
-                    continue;
+        'vertex: {
+            scratch.counts.closest += 1;
+            // The vertex's hit, surface and differential geometry are
+            // written in place (returned and then moved, they were copied
+            // by wide loads that stalled on the narrower stores that had
+            // just made them).
+            match std::mem::replace(&mut first, First::Trace) {
+                First::Shaded {
+                    hit: h,
+                    s: s0,
+                    geom: g,
+                } => {
+                    hit = Some(h);
+                    s = s0;
+                    geom = g;
                 }
-                // A material that reads the geometry gets it with the
-                // ray's differentials; otherwise it is computed only if
-                // specular children will carry differentials.
-                let geom = w
-                    .diff
-                    .as_ref()
-                    .filter(|_| scene.material_needs_geom[s.material as usize])
-                    .map(|d| with_diff(scene, &hit, &s, d));
-                shade_geom(scene, &hit, &mut s, material, false, geom.as_ref(), bsdf);
-                (hit, s, geom)
+                f => {
+                    match f {
+                        First::Hit(h) => hit = h,
+                        _ => scene.aggregate.intersect_into(&w.ray, time, &mut hit),
+                    }
+                    let Some(h) = hit.as_ref() else {
+                        l += w.beta * escaped(scene, w.ray.d);
+                        break 'vertex;
+                    };
+                    s = scene.aggregate.surface_at(h, time);
+                    let material = &scene.materials[s.material as usize];
+                    if material.is_none() {
+                        if w.pass < MAX_PASS_THROUGH {
+                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                            // A spawned ray has no differentials (pbrt-v3's SpawnRay).
+                            stack.push(Work {
+                                ray,
+                                diff: None,
+                                pass: w.pass + 1,
+                                ..w
+                            });
+                        }
+                        break 'vertex;
+                    }
+                    // A material that reads the geometry gets it with the
+                    // ray's differentials; otherwise it is computed only if
+                    // specular children will carry differentials.
+                    geom = None;
+                    if let Some(d) = w.diff.as_ref() {
+                        if scene.material_needs_geom[s.material as usize] {
+                            with_diff_into(scene, h, &s, d, &mut geom);
+                        }
+                    }
+                    shade_geom(scene, h, &mut s, material, false, geom.as_ref(), bsdf);
+                }
             }
-        };
-        let wo = -w.ray.d;
-        if geom.is_none() && bsdf.has_specular() {
-            geom = w.diff.as_ref().map(|d| with_diff(scene, &hit, &s, d));
+            let Some(h) = hit.as_ref() else {
+                break 'vertex;
+            };
+            let wo = -w.ray.d;
+            if geom.is_none() && bsdf.has_specular() {
+                if let Some(d) = w.diff.as_ref() {
+                    with_diff_into(scene, h, &s, d, &mut geom);
+                }
+            }
+            let mut local = emitted(scene, &s, wo);
+            kind.add_direct(&mut local, scene, &s, bsdf, wo, sampler, scratch);
+            l += w.beta * local;
+            if w.depth + 1 < kind.max_depth() {
+                let mut children = [None, None];
+                for (i, filter) in [
+                    BxdfFlags::SPECULAR_REFLECTION,
+                    BxdfFlags::SPECULAR_TRANSMISSION,
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    if !bsdf.has_specular() {
+                        // pbrt-v3 draws the sample and the BSDF ignores it.
+                        sampler.skip_2d();
+                        continue;
+                    }
+                    let u = sampler.get_2d();
+                    if let Some(bs) = bsdf.sample(wo, u, filter) {
+                        let cos = bs.wi.dot(s.point.ns).abs();
+                        if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
+                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                            let beta = w.beta * bs.f * cos / bs.pdf;
+                            let diff = match (&w.diff, &geom) {
+                                (Some(d), Some(g)) if i == 0 => {
+                                    Some(g.reflected(s.point.p, s.point.ns, wo, bs.wi, d))
+                                }
+                                (Some(d), Some(g)) => Some(
+                                    g.transmitted(s.point.p, s.point.ns, wo, bs.wi, bsdf.eta, d),
+                                ),
+                                _ => None,
+                            };
+                            children[i] = Some(Work {
+                                ray,
+                                diff,
+                                beta,
+                                depth: w.depth + 1,
+                                pass: 0,
+                            });
+                        }
+                    }
+                }
+                // Pushed transmission first so that reflection is expanded first.
+                let [reflected, transmitted] = children;
+                if let Some(t) = transmitted {
+                    stack.push(t);
+                }
+                if let Some(r) = reflected {
+                    stack.push(r);
+                }
+            }
         }
-        let mut local = emitted(scene, &s, wo);
-        kind.add_direct(&mut local, scene, &s, bsdf, wo, sampler, scratch);
-        l += w.beta * local;
-        if w.depth + 1 < kind.max_depth() {
-            let mut children = [None, None];
-            for (i, filter) in [
-                BxdfFlags::SPECULAR_REFLECTION,
-                BxdfFlags::SPECULAR_TRANSMISSION,
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                if !bsdf.has_specular() {
-                    // pbrt-v3 draws the sample and the BSDF ignores it.
-                    sampler.skip_2d();
-                    continue;
-                }
-                let u = sampler.get_2d();
-                if let Some(bs) = bsdf.sample(wo, u, filter) {
-                    let cos = bs.wi.dot(s.point.ns).abs();
-                    if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
-                        let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-                        let beta = w.beta * bs.f * cos / bs.pdf;
-                        let diff = match (&w.diff, &geom) {
-                            (Some(d), Some(g)) if i == 0 => {
-                                Some(g.reflected(s.point.p, s.point.ns, wo, bs.wi, d))
-                            }
-                            (Some(d), Some(g)) => {
-                                Some(g.transmitted(s.point.p, s.point.ns, wo, bs.wi, bsdf.eta, d))
-                            }
-                            _ => None,
-                        };
-                        children[i] = Some(Work {
-                            ray,
-                            diff,
-                            beta,
-                            depth: w.depth + 1,
-                            pass: 0,
-                        });
-                    }
-                }
-            }
-            // Pushed transmission first so that reflection is expanded first.
-            let [reflected, transmitted] = children;
-            if let Some(t) = transmitted {
-                stack.push(t);
-            }
-            if let Some(r) = reflected {
-                stack.push(r);
-            }
+        match stack.pop() {
+            Some(next) => w = next,
+            None => break,
         }
     }
     scratch.work = stack;
