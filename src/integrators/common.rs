@@ -27,20 +27,6 @@ pub(super) fn with_diff(scene: &RenderScene, hit: &Hit, s: &SurfaceHit, d: &RayD
     g
 }
 
-/// [`with_diff`] written into `out` (the differentials computed where the
-/// geometry stays, not in a value then copied).
-#[inline]
-pub(super) fn with_diff_into(
-    scene: &RenderScene,
-    hit: &Hit,
-    s: &SurfaceHit,
-    d: &RayDiff,
-    out: &mut Option<DiffGeom>,
-) {
-    out.insert(scene.aggregate.diff_geom(hit, s))
-        .compute_differentials(s.point.p, s.point.n, d);
-}
-
 /// The BSDF of `material` at a hit, built into `bsdf`, with the hit's
 /// differential geometry (and its screen-space derivatives when the ray
 /// has differentials) computed only if the material uses it.

@@ -6,7 +6,7 @@
 //! lane from their hits ([`tree_lanes`]).
 
 use super::batch::Batch;
-use super::common::{emitted, escaped, shade_geom, with_diff_into};
+use super::common::{emitted, escaped, shade_geom, with_diff};
 use super::{Scratch, MAX_PASS_THROUGH};
 use crate::accel::{Hit, SurfaceHit};
 use crate::geometry::{spawn_ray, Ray, RayDiff};
@@ -86,10 +86,9 @@ pub(super) fn specular_tree_li<'a>(
     };
     let mut l = Vec3::ZERO;
     let mut first = first;
+    let mut at_root = true;
     let mut vertices = 0u32;
     let mut hit: Option<Hit> = None;
-    let mut s: SurfaceHit;
-    let mut geom: Option<DiffGeom>;
     loop {
         vertices += 1;
         if vertices > MAX_TREE_VERTICES {
@@ -98,116 +97,78 @@ pub(super) fn specular_tree_li<'a>(
         }
         'vertex: {
             scratch.counts.closest += 1;
-            // The vertex's hit, surface and differential geometry are
-            // written in place (returned and then moved, they were copied
-            // by wide loads that stalled on the narrower stores that had
-            // just made them).
-            match std::mem::replace(&mut first, First::Trace) {
-                First::Shaded {
-                    hit: h,
-                    s: s0,
-                    geom: g,
-                } => {
-                    hit = Some(h);
-                    s = s0;
-                    geom = g;
-                }
-                f => {
-                    match f {
-                        First::Hit(h) => hit = h,
-                        _ => scene.aggregate.intersect_into(&w.ray, time, &mut hit),
-                    }
-                    let Some(h) = hit.as_ref() else {
-                        l += w.beta * escaped(scene, w.ray.d);
-                        break 'vertex;
-                    };
-                    s = scene.aggregate.surface_at(h, time);
-                    let material = &scene.materials[s.material as usize];
-                    if material.is_none() {
-                        if w.pass < MAX_PASS_THROUGH {
-                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
-                            // A spawned ray has no differentials (pbrt-v3's SpawnRay).
-                            stack.push(Work {
-                                ray,
-                                diff: None,
-                                pass: w.pass + 1,
-                                ..w
-                            });
+            // The surface and differential geometry are read where they
+            // were made (in `first`, or fresh locals that the calls write
+            // into): moved into shared variables, they were copied by wide
+            // loads that stalled on the narrower stores that had just made
+            // them.
+            if at_root {
+                at_root = false;
+                match &mut first {
+                    First::Shaded { hit: h, s, geom } => {
+                        if geom.is_none() && bsdf.has_specular() {
+                            *geom = w.diff.as_ref().map(|d| with_diff(scene, h, s, d));
                         }
+                        l += expand(
+                            kind,
+                            scene,
+                            &w,
+                            s,
+                            geom.as_ref(),
+                            bsdf,
+                            sampler,
+                            scratch,
+                            &mut stack,
+                        );
                         break 'vertex;
                     }
-                    // A material that reads the geometry gets it with the
-                    // ray's differentials; otherwise it is computed only if
-                    // specular children will carry differentials.
-                    geom = None;
-                    if let Some(d) = w.diff.as_ref() {
-                        if scene.material_needs_geom[s.material as usize] {
-                            with_diff_into(scene, h, &s, d, &mut geom);
-                        }
-                    }
-                    shade_geom(scene, h, &mut s, material, false, geom.as_ref(), bsdf);
+                    First::Hit(h) => hit = *h,
+                    First::Trace => scene.aggregate.intersect_into(&w.ray, time, &mut hit),
                 }
+            } else {
+                scene.aggregate.intersect_into(&w.ray, time, &mut hit);
             }
             let Some(h) = hit.as_ref() else {
+                l += w.beta * escaped(scene, w.ray.d);
                 break 'vertex;
             };
-            let wo = -w.ray.d;
+            let mut s = scene.aggregate.surface_at(h, time);
+            let material = &scene.materials[s.material as usize];
+            if material.is_none() {
+                if w.pass < MAX_PASS_THROUGH {
+                    let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, w.ray.d);
+                    // A spawned ray has no differentials (pbrt-v3's SpawnRay).
+                    stack.push(Work {
+                        ray,
+                        diff: None,
+                        pass: w.pass + 1,
+                        ..w
+                    });
+                }
+                break 'vertex;
+            }
+            // A material that reads the geometry gets it with the ray's
+            // differentials; otherwise it is computed only if specular
+            // children will carry differentials.
+            let shading_geom;
+            let mut geom = None;
+            if let Some(d) = w.diff.as_ref() {
+                if scene.material_needs_geom[s.material as usize] {
+                    shading_geom = with_diff(scene, h, &s, d);
+                    geom = Some(&shading_geom);
+                }
+            }
+            shade_geom(scene, h, &mut s, material, false, geom, bsdf);
+            let child_geom;
             if geom.is_none() && bsdf.has_specular() {
                 if let Some(d) = w.diff.as_ref() {
-                    with_diff_into(scene, h, &s, d, &mut geom);
+                    child_geom = with_diff(scene, h, &s, d);
+                    geom = Some(&child_geom);
                 }
             }
-            let mut local = emitted(scene, &s, wo);
-            kind.add_direct(&mut local, scene, &s, bsdf, wo, sampler, scratch);
-            l += w.beta * local;
-            if w.depth + 1 < kind.max_depth() {
-                let mut children = [None, None];
-                for (i, filter) in [
-                    BxdfFlags::SPECULAR_REFLECTION,
-                    BxdfFlags::SPECULAR_TRANSMISSION,
-                ]
-                .into_iter()
-                .enumerate()
-                {
-                    if !bsdf.has_specular() {
-                        // pbrt-v3 draws the sample and the BSDF ignores it.
-                        sampler.skip_2d();
-                        continue;
-                    }
-                    let u = sampler.get_2d();
-                    if let Some(bs) = bsdf.sample(wo, u, filter) {
-                        let cos = bs.wi.dot(s.point.ns).abs();
-                        if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
-                            let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-                            let beta = w.beta * bs.f * cos / bs.pdf;
-                            let diff = match (&w.diff, &geom) {
-                                (Some(d), Some(g)) if i == 0 => {
-                                    Some(g.reflected(s.point.p, s.point.ns, wo, bs.wi, d))
-                                }
-                                (Some(d), Some(g)) => Some(
-                                    g.transmitted(s.point.p, s.point.ns, wo, bs.wi, bsdf.eta, d),
-                                ),
-                                _ => None,
-                            };
-                            children[i] = Some(Work {
-                                ray,
-                                diff,
-                                beta,
-                                depth: w.depth + 1,
-                                pass: 0,
-                            });
-                        }
-                    }
-                }
-                // Pushed transmission first so that reflection is expanded first.
-                let [reflected, transmitted] = children;
-                if let Some(t) = transmitted {
-                    stack.push(t);
-                }
-                if let Some(r) = reflected {
-                    stack.push(r);
-                }
-            }
+            l += expand(
+                kind, scene, &w, &s, geom, bsdf, sampler, scratch, &mut stack,
+            );
         }
         match stack.pop() {
             Some(next) => w = next,
@@ -216,6 +177,77 @@ pub(super) fn specular_tree_li<'a>(
     }
     scratch.work = stack;
     l
+}
+
+/// A shaded vertex of the tree (surface `s`, BSDF `bsdf`, differential
+/// geometry `geom` if computed): its emission and direct light, weighted
+/// by the vertex's throughput, and its specular children pushed onto
+/// `stack` (reflection to be expanded first).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn expand(
+    kind: &impl SpecularTree,
+    scene: &RenderScene,
+    w: &Work,
+    s: &SurfaceHit,
+    geom: Option<&DiffGeom>,
+    bsdf: &Bsdf,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+    stack: &mut Vec<Work>,
+) -> Vec3 {
+    let wo = -w.ray.d;
+    let mut local = emitted(scene, s, wo);
+    kind.add_direct(&mut local, scene, s, bsdf, wo, sampler, scratch);
+    if w.depth + 1 < kind.max_depth() {
+        let mut children = [None, None];
+        for (i, filter) in [
+            BxdfFlags::SPECULAR_REFLECTION,
+            BxdfFlags::SPECULAR_TRANSMISSION,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if !bsdf.has_specular() {
+                // pbrt-v3 draws the sample and the BSDF ignores it.
+                sampler.skip_2d();
+                continue;
+            }
+            let u = sampler.get_2d();
+            if let Some(bs) = bsdf.sample(wo, u, filter) {
+                let cos = bs.wi.dot(s.point.ns).abs();
+                if bs.pdf > 0.0 && bs.f != Vec3::ZERO && cos != 0.0 {
+                    let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+                    let beta = w.beta * bs.f * cos / bs.pdf;
+                    let diff = match (&w.diff, geom) {
+                        (Some(d), Some(g)) if i == 0 => {
+                            Some(g.reflected(s.point.p, s.point.ns, wo, bs.wi, d))
+                        }
+                        (Some(d), Some(g)) => {
+                            Some(g.transmitted(s.point.p, s.point.ns, wo, bs.wi, bsdf.eta, d))
+                        }
+                        _ => None,
+                    };
+                    children[i] = Some(Work {
+                        ray,
+                        diff,
+                        beta,
+                        depth: w.depth + 1,
+                        pass: 0,
+                    });
+                }
+            }
+        }
+        // Pushed transmission first so that reflection is expanded first.
+        let [reflected, transmitted] = children;
+        if let Some(t) = transmitted {
+            stack.push(t);
+        }
+        if let Some(r) = reflected {
+            stack.push(r);
+        }
+    }
+    w.beta * local
 }
 
 /// Where [`specular_tree_li`] starts its camera vertex.
