@@ -392,10 +392,24 @@ pub(super) fn sample_all_lights(
     let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
     for (j, &n) in n_light_samples.iter().enumerate() {
         let light = j as u32;
-        // Both arrays are always asked for, as pbrt-v3 does.
-        let got_light = sampler.fill_2d_array(n, &mut u_light);
-        let got_scatter = sampler.fill_2d_array(n, &mut u_scatter);
-        let ld = if got_light && got_scatter {
+        // Both arrays are always asked for, as pbrt-v3 does; a delta
+        // light reads neither (its sample has no random values and its
+        // light takes no BSDF sample), so their values are not made.
+        let delta = scene.lights[j].is_delta();
+        let (got_light, got_scatter) = if delta {
+            let got_light = sampler.skip_2d_array(n, &mut u_light);
+            (got_light, sampler.skip_2d_array(n, &mut u_scatter))
+        } else {
+            let got_light = sampler.fill_2d_array(n, &mut u_light);
+            (got_light, sampler.fill_2d_array(n, &mut u_scatter))
+        };
+        let ld = if got_light && got_scatter && delta {
+            let mut sum = Vec3::ZERO;
+            for _ in 0..n {
+                sum += estimate_direct(scene, s, bsdf, wo, light, Vec2::ZERO, Vec2::ZERO, sampler, scratch);
+            }
+            sum / n as f32
+        } else if got_light && got_scatter {
             let mut sum = Vec3::ZERO;
             for (&ul, &us) in u_light.iter().zip(&u_scatter) {
                 sum += estimate_direct(scene, s, bsdf, wo, light, ul, us, sampler, scratch);

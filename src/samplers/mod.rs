@@ -345,6 +345,19 @@ impl Sampler {
         }
     }
 
+    /// Consumes the next requested 2D array as [`Sampler::fill_2d_array`]
+    /// does, for a caller that does not read its values (a delta light's
+    /// sample): the same answer and the sampler left in the same state, but
+    /// the pixel samplers do not make the array (their RNG has already
+    /// stepped past it); the other samplers fill `out` as `fill_2d_array`.
+    #[inline]
+    pub fn skip_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
+        match self {
+            Sampler::ZeroTwoSequence(p) | Sampler::MaxMinDist(p) => p.skip_2d_array(n),
+            _ => self.fill_2d_array(n, out),
+        }
+    }
+
     /// `get_2d_array` copied into `out` (cleared first): true if there was
     /// an array, else `out` stays empty. Halton computes the values straight
     /// into `out`.
@@ -535,5 +548,18 @@ impl ArrayStore {
         self.next_2d += 1;
         let start = copy * n as usize;
         self.data_2d[i].get(start..start + n as usize)
+    }
+
+    /// [`ArrayStore::get_2d`]'s answer (whether it would give values) and
+    /// its step to the next array, without reading the array.
+    #[inline]
+    pub fn skip_2d(&mut self, n: u32, copy: usize) -> bool {
+        let i = self.next_2d;
+        if i >= self.sizes_2d.len() || self.sizes_2d[i] != n {
+            return false;
+        }
+        self.next_2d += 1;
+        let start = copy * n as usize;
+        start + n as usize <= self.data_2d[i].len()
     }
 }

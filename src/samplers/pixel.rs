@@ -475,6 +475,14 @@ impl PixelSampler {
         }
         self.arrays.get_2d(n, self.sample_index as usize)
     }
+
+    /// `get_2d_array(n).is_some()` without making the array: its values
+    /// are left unmade (the tile's RNG stepped past them when the pixel
+    /// started), for a later sample that reads them.
+    #[inline]
+    pub fn skip_2d_array(&mut self, n: u32) -> bool {
+        self.in_table() && self.arrays.skip_2d(n, self.sample_index as usize)
+    }
 }
 
 #[cfg(test)]
@@ -560,6 +568,54 @@ mod tests {
                 );
                 assert_eq!(lazy.get_2d_array(1).unwrap(), &a.data_2d[1][i..i + 1]);
                 assert_eq!(lazy.get_1d_array(1).unwrap(), &a.data_1d[1][i..i + 1]);
+            }
+        }
+    }
+
+    /// A 2D array stepped past unread (a delta light's) answers as a read
+    /// one, leaves the next arrays and values where reading would, and is
+    /// still made right when a later sample of the pixel reads it.
+    #[test]
+    fn skipped_arrays_answer_and_step_as_read_ones() {
+        let bounds = Bounds2i::new(IVec2::new(0, 0), IVec2::new(20, 18));
+        let make = |maxmin: bool| {
+            let mut s = if maxmin {
+                crate::samplers::maxmindist::sampler(4, 2, bounds, 7)
+            } else {
+                PixelSampler::new(Pattern::ZeroTwo, 4, 2, bounds, 7)
+            };
+            s.request_2d_array(1);
+            s.request_2d_array(1);
+            s.request_2d_array(4);
+            s.request_1d_array(2);
+            s.request_2d_array(1);
+            s
+        };
+        for maxmin in [false, true] {
+            let (mut read, mut skip) = (make(maxmin), make(maxmin));
+            for y in 0..18 {
+                for x in 0..20 {
+                    let p = IVec2::new(x, y);
+                    // Samples 4 and 5 are past the table (no arrays).
+                    for sample in 0..6u32 {
+                        read.start_pixel_sample(p, sample);
+                        skip.start_pixel_sample(p, sample);
+                        let which = (x + 3 * y + sample as i32) % 4;
+                        for (k, n) in [1u32, 1, 4].into_iter().enumerate() {
+                            let r = read.get_2d_array(n).map(|a| a.to_vec());
+                            if k as i32 == which {
+                                assert_eq!(skip.skip_2d_array(n), r.is_some());
+                            } else {
+                                assert_eq!(skip.get_2d_array(n).map(|a| a.to_vec()), r);
+                            }
+                        }
+                        // A mismatched size answers no and steps nowhere.
+                        assert!(!skip.skip_2d_array(3));
+                        assert_eq!(skip.get_1d_array(2), read.get_1d_array(2));
+                        assert_eq!(skip.get_2d_array(1), read.get_2d_array(1));
+                        assert_eq!(skip.get_2d(), read.get_2d());
+                    }
+                }
             }
         }
     }
