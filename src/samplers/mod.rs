@@ -266,6 +266,7 @@ impl Sampler {
     pub fn skip_2d(&mut self) {
         match self {
             Sampler::Halton(h) => h.skip_2d(),
+            Sampler::ZeroTwoSequence(p) | Sampler::MaxMinDist(p) => p.skip_2d(),
             _ => {
                 let _ = self.get_2d();
             }

@@ -49,6 +49,10 @@ pub struct PixelSampler {
     c1: &'static [u32],
     samples_1d: Vec<Vec<f32>>,
     samples_2d: Vec<Vec<Vec2>>,
+    /// The RNG where each dimension's table starts, while the table is not
+    /// made (made when a sample first reads it, as the arrays).
+    unmade_1d: Vec<Option<Pcg32>>,
+    unmade_2d: Vec<Option<Pcg32>>,
     pub(super) arrays: ArrayStore,
     bounds: Bounds2i,
     tiles_x: i32,
@@ -258,6 +262,8 @@ impl PixelSampler {
             c1: &m[SOBOL_MATRIX_SIZE..SOBOL_MATRIX_SIZE + 32],
             samples_1d: vec![vec![0.0; spp as usize]; dimensions as usize],
             samples_2d: vec![vec![Vec2::ZERO; spp as usize]; dimensions as usize],
+            unmade_1d: vec![None; dimensions as usize],
+            unmade_2d: vec![None; dimensions as usize],
             arrays: ArrayStore::default(),
             bounds: sample_bounds,
             tiles_x: ((d.x + TILE_SIZE - 1) / TILE_SIZE).max(1),
@@ -320,24 +326,45 @@ impl PixelSampler {
         let draws = &self.draws;
         let steps = self.steps.of(rng, spp);
         let (c0, c1) = (self.c0, self.c1);
-        let mut rest_2d = &mut self.samples_2d[..];
+        let mut rest_2d = &mut self.unmade_2d[..];
         if let Pattern::MaxMinDist(c) = self.pattern {
-            if let Some((first, rest)) = std::mem::take(&mut rest_2d).split_first_mut() {
+            if let (Some(first), Some((u, rest))) = (
+                self.samples_2d.first_mut(),
+                std::mem::take(&mut rest_2d).split_first_mut(),
+            ) {
                 let inv = 1.0 / self.spp as f32;
                 for (i, v) in first.iter_mut().enumerate() {
                     *v = Vec2::new(i as f32 * inv, to_unit(multiply_generator(c, i as u32)));
                 }
                 shuffle(first, spp, 1, rng, draws);
+                *u = None;
                 rest_2d = rest;
             }
         }
-        for s in &mut self.samples_1d {
-            van_der_corput(1, spp, s, c0, rng, draws, steps);
+        // The dimensions' tables, as the arrays below, are made when a
+        // sample first reads them (directlighting's and whitted's second
+        // and third 2D dimensions are the specular bounces' samples, which
+        // a BSDF without specular lobes never reads): here the RNG only
+        // steps past their draws.
+        for u in &mut self.unmade_1d {
+            *u = Some(*rng);
+            skip_table(1, 1, spp, rng, draws, steps);
         }
-        for s in rest_2d {
-            sobol_2d(1, spp, s, [c0, c1], rng, draws, steps);
+        for u in rest_2d {
+            *u = Some(*rng);
+            skip_table(2, 1, spp, rng, draws, steps);
         }
         if eager {
+            for (s, u) in self.samples_1d.iter_mut().zip(&mut self.unmade_1d) {
+                if let Some(mut r) = u.take() {
+                    van_der_corput(1, spp, s, c0, &mut r, draws, steps);
+                }
+            }
+            for (s, u) in self.samples_2d.iter_mut().zip(&mut self.unmade_2d) {
+                if let Some(mut r) = u.take() {
+                    sobol_2d(1, spp, s, [c0, c1], &mut r, draws, steps);
+                }
+            }
             let a = &mut self.arrays;
             for (&n, data) in a.sizes_1d.iter().zip(a.data_1d.iter_mut()) {
                 van_der_corput(n as usize, spp, data, c0, rng, draws, steps);
@@ -427,8 +454,15 @@ impl PixelSampler {
 
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
-        if self.dim_1d < self.samples_1d.len() && self.in_table() {
-            let v = self.samples_1d[self.dim_1d][self.sample_index as usize];
+        let d = self.dim_1d;
+        if d < self.samples_1d.len() && self.in_table() {
+            if let Some(mut rng) = self.unmade_1d[d].take() {
+                let spp = self.spp as usize;
+                let steps = self.steps.of(&rng, spp);
+                let s = &mut self.samples_1d[d];
+                van_der_corput(1, spp, s, self.c0, &mut rng, &self.draws, steps);
+            }
+            let v = self.samples_1d[d][self.sample_index as usize];
             self.dim_1d += 1;
             v
         } else {
@@ -438,14 +472,35 @@ impl PixelSampler {
 
     #[inline]
     pub fn get_2d(&mut self) -> Vec2 {
-        if self.dim_2d < self.samples_2d.len() && self.in_table() {
-            let v = self.samples_2d[self.dim_2d][self.sample_index as usize];
+        let d = self.dim_2d;
+        if d < self.samples_2d.len() && self.in_table() {
+            if let Some(mut rng) = self.unmade_2d[d].take() {
+                let spp = self.spp as usize;
+                let steps = self.steps.of(&rng, spp);
+                let c = [self.c0, self.c1];
+                let s = &mut self.samples_2d[d];
+                sobol_2d(1, spp, s, c, &mut rng, &self.draws, steps);
+            }
+            let v = self.samples_2d[d][self.sample_index as usize];
             self.dim_2d += 1;
             v
         } else {
             let extra = self.extra();
             let x = extra.uniform_f32();
             Vec2::new(x, extra.uniform_f32())
+        }
+    }
+
+    /// Consumes a 2D value as [`PixelSampler::get_2d`] does, without
+    /// making its dimension's table.
+    #[inline]
+    pub fn skip_2d(&mut self) {
+        if self.dim_2d < self.samples_2d.len() && self.in_table() {
+            self.dim_2d += 1;
+        } else {
+            let extra = self.extra();
+            extra.uniform_f32();
+            extra.uniform_f32();
         }
     }
 
@@ -568,6 +623,64 @@ mod tests {
                 );
                 assert_eq!(lazy.get_2d_array(1).unwrap(), &a.data_2d[1][i..i + 1]);
                 assert_eq!(lazy.get_1d_array(1).unwrap(), &a.data_1d[1][i..i + 1]);
+            }
+        }
+    }
+
+    /// Dimensions whose tables are made only when read (or stepped past
+    /// by `skip_2d`) give the values of tables made at once, whatever was
+    /// read at earlier pixels and samples.
+    #[test]
+    fn unread_dimensions_step_as_made_ones() {
+        let bounds = Bounds2i::new(IVec2::new(-3, 0), IVec2::new(29, 21));
+        for maxmin in [false, true] {
+            let make = || {
+                let mut s = if maxmin {
+                    crate::samplers::maxmindist::sampler(8, 3, bounds, 3)
+                } else {
+                    PixelSampler::new(Pattern::ZeroTwo, 8, 3, bounds, 3)
+                };
+                s.request_2d_array(2);
+                s
+            };
+            let (mut lazy, mut eager) = (make(), make());
+            let mut k = 0;
+            for y in 0..21 {
+                for x in -3..29 {
+                    k += 1;
+                    if k % 3 != 0 {
+                        continue;
+                    }
+                    let p = IVec2::new(x, y);
+                    let (tile, index) = eager.tile_of(p).unwrap();
+                    eager.rng.set_sequence(tile.wrapping_add(eager.seed_offset));
+                    for _ in 0..=index {
+                        eager.generate_with(true);
+                    }
+                    let sample = (k % 8) as u32;
+                    lazy.start_pixel_sample(p, sample);
+                    let i = sample as usize;
+                    if k % 2 == 0 {
+                        lazy.skip_2d();
+                    } else {
+                        assert_eq!(lazy.get_2d(), eager.samples_2d[0][i]);
+                    }
+                    assert_eq!(lazy.get_1d(), eager.samples_1d[0][i]);
+                    lazy.skip_2d();
+                    assert_eq!(lazy.get_2d(), eager.samples_2d[2][i]);
+                    assert_eq!(
+                        lazy.get_2d_array(2).unwrap(),
+                        &eager.arrays.data_2d[0][2 * i..2 * i + 2]
+                    );
+                    assert_eq!(lazy.get_1d(), eager.samples_1d[1][i]);
+                    assert_eq!(lazy.get_1d(), eager.samples_1d[2][i]);
+                    // A later sample of the pixel reads the dimension skipped.
+                    lazy.start_pixel_sample(p, (sample + 1) % 8);
+                    let i = (sample as usize + 1) % 8;
+                    assert_eq!(lazy.get_2d(), eager.samples_2d[0][i]);
+                    assert_eq!(lazy.get_1d(), eager.samples_1d[0][i]);
+                    assert_eq!(lazy.get_2d(), eager.samples_2d[1][i]);
+                }
             }
         }
     }
