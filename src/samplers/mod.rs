@@ -355,8 +355,15 @@ impl Sampler {
     pub fn skip_2d_array(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
         match self {
             Sampler::ZeroTwoSequence(p) | Sampler::MaxMinDist(p) => p.skip_2d_array(n),
-            _ => self.fill_2d_array(n, out),
+            _ => self.fill_2d_array_apart(n, out),
         }
+    }
+
+    /// [`Sampler::fill_2d_array`] out of line, so that `skip_2d_array`'s
+    /// callers stay small.
+    #[inline(never)]
+    fn fill_2d_array_apart(&mut self, n: u32, out: &mut Vec<Vec2>) -> bool {
+        self.fill_2d_array(n, out)
     }
 
     /// `get_2d_array` copied into `out` (cleared first): true if there was
