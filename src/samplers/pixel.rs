@@ -318,8 +318,8 @@ impl PixelSampler {
         self.generate_with(false);
     }
 
-    /// [`PixelSampler::generate`], with the arrays made now if `eager` (the
-    /// tests' reference), else when first read.
+    /// [`PixelSampler::generate`], with the tables and arrays made now if
+    /// `eager` (the tests' reference), else when first read.
     fn generate_with(&mut self, eager: bool) {
         let spp = self.spp as usize;
         let rng = &mut self.rng;
@@ -342,10 +342,10 @@ impl PixelSampler {
             }
         }
         // The dimensions' tables, as the arrays below, are made when a
-        // sample first reads them (directlighting's and whitted's second
-        // and third 2D dimensions are the specular bounces' samples, which
-        // a BSDF without specular lobes never reads): here the RNG only
-        // steps past their draws.
+        // sample first reads them (directlighting's and whitted's third and
+        // fourth 2D dimensions are the camera vertex's specular bounces'
+        // samples, which a BSDF without specular lobes never reads): here
+        // the RNG only steps past their draws.
         for u in &mut self.unmade_1d {
             *u = Some(*rng);
             skip_table(1, 1, spp, rng, draws, steps);
