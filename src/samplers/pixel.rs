@@ -582,6 +582,28 @@ mod tests {
     /// RNG where making them does: a pixel's arrays read lazily, after
     /// earlier pixels of its tile left theirs unread, equal the arrays made
     /// at once at every pixel from the tile's start.
+    /// Every `n`th pixel of `b` in row order, with its number (from 1).
+    fn every_nth_pixel(b: Bounds2i, n: usize) -> impl Iterator<Item = (usize, IVec2)> {
+        (b.min.y..b.max.y)
+            .flat_map(move |y| (b.min.x..b.max.x).map(move |x| IVec2::new(x, y)))
+            .enumerate()
+            .map(|(i, p)| (i + 1, p))
+            .filter(move |(k, _)| k % n == 0)
+    }
+
+    /// Sample `k % 8` of pixel `p` started by `lazy`, and by `eager` the
+    /// reference: the tables and arrays of every pixel of `p`'s tile up to
+    /// `p` made at once, as pbrt-v3's `StartPixel` makes them. The sample.
+    fn start_both(lazy: &mut PixelSampler, eager: &mut PixelSampler, p: IVec2, k: usize) -> usize {
+        let (tile, index) = eager.tile_of(p).unwrap();
+        eager.rng.set_sequence(tile.wrapping_add(eager.seed_offset));
+        for _ in 0..=index {
+            eager.generate_with(true);
+        }
+        lazy.start_pixel_sample(p, (k % 8) as u32);
+        k % 8
+    }
+
     #[test]
     fn unread_arrays_step_the_rng_as_made_ones() {
         let bounds = Bounds2i::new(IVec2::new(-2, -2), IVec2::new(30, 20));
@@ -595,35 +617,19 @@ mod tests {
         };
         let mut lazy = make();
         let mut eager = make();
-        let mut k = 0;
-        for y in -2..20 {
-            for x in -2..30 {
-                k += 1;
-                if k % 5 != 0 {
-                    continue;
-                }
-                let p = IVec2::new(x, y);
-                // The reference: every pixel of the tile up to p made at once.
-                let (tile, index) = eager.tile_of(p).unwrap();
-                eager.rng.set_sequence(tile.wrapping_add(eager.seed_offset));
-                for _ in 0..=index {
-                    eager.generate_with(true);
-                }
-                let sample = (k % 8) as u32;
-                lazy.start_pixel_sample(p, sample);
-                let i = sample as usize;
-                let a = &eager.arrays;
-                assert_eq!(
-                    lazy.get_1d_array(3).unwrap(),
-                    &a.data_1d[0][3 * i..3 * i + 3]
-                );
-                assert_eq!(
-                    lazy.get_2d_array(16).unwrap(),
-                    &a.data_2d[0][16 * i..16 * i + 16]
-                );
-                assert_eq!(lazy.get_2d_array(1).unwrap(), &a.data_2d[1][i..i + 1]);
-                assert_eq!(lazy.get_1d_array(1).unwrap(), &a.data_1d[1][i..i + 1]);
-            }
+        for (k, p) in every_nth_pixel(bounds, 5) {
+            let i = start_both(&mut lazy, &mut eager, p, k);
+            let a = &eager.arrays;
+            assert_eq!(
+                lazy.get_1d_array(3).unwrap(),
+                &a.data_1d[0][3 * i..3 * i + 3]
+            );
+            assert_eq!(
+                lazy.get_2d_array(16).unwrap(),
+                &a.data_2d[0][16 * i..16 * i + 16]
+            );
+            assert_eq!(lazy.get_2d_array(1).unwrap(), &a.data_2d[1][i..i + 1]);
+            assert_eq!(lazy.get_1d_array(1).unwrap(), &a.data_1d[1][i..i + 1]);
         }
     }
 
@@ -644,43 +650,29 @@ mod tests {
                 s
             };
             let (mut lazy, mut eager) = (make(), make());
-            let mut k = 0;
-            for y in 0..21 {
-                for x in -3..29 {
-                    k += 1;
-                    if k % 3 != 0 {
-                        continue;
-                    }
-                    let p = IVec2::new(x, y);
-                    let (tile, index) = eager.tile_of(p).unwrap();
-                    eager.rng.set_sequence(tile.wrapping_add(eager.seed_offset));
-                    for _ in 0..=index {
-                        eager.generate_with(true);
-                    }
-                    let sample = (k % 8) as u32;
-                    lazy.start_pixel_sample(p, sample);
-                    let i = sample as usize;
-                    if k % 2 == 0 {
-                        lazy.skip_2d();
-                    } else {
-                        assert_eq!(lazy.get_2d(), eager.samples_2d[0][i]);
-                    }
-                    assert_eq!(lazy.get_1d(), eager.samples_1d[0][i]);
+            for (k, p) in every_nth_pixel(bounds, 3) {
+                let i = start_both(&mut lazy, &mut eager, p, k);
+                let sample = i as u32;
+                if k % 2 == 0 {
                     lazy.skip_2d();
-                    assert_eq!(lazy.get_2d(), eager.samples_2d[2][i]);
-                    assert_eq!(
-                        lazy.get_2d_array(2).unwrap(),
-                        &eager.arrays.data_2d[0][2 * i..2 * i + 2]
-                    );
-                    assert_eq!(lazy.get_1d(), eager.samples_1d[1][i]);
-                    assert_eq!(lazy.get_1d(), eager.samples_1d[2][i]);
-                    // A later sample of the pixel reads the dimension skipped.
-                    lazy.start_pixel_sample(p, (sample + 1) % 8);
-                    let i = (sample as usize + 1) % 8;
+                } else {
                     assert_eq!(lazy.get_2d(), eager.samples_2d[0][i]);
-                    assert_eq!(lazy.get_1d(), eager.samples_1d[0][i]);
-                    assert_eq!(lazy.get_2d(), eager.samples_2d[1][i]);
                 }
+                assert_eq!(lazy.get_1d(), eager.samples_1d[0][i]);
+                lazy.skip_2d();
+                assert_eq!(lazy.get_2d(), eager.samples_2d[2][i]);
+                assert_eq!(
+                    lazy.get_2d_array(2).unwrap(),
+                    &eager.arrays.data_2d[0][2 * i..2 * i + 2]
+                );
+                assert_eq!(lazy.get_1d(), eager.samples_1d[1][i]);
+                assert_eq!(lazy.get_1d(), eager.samples_1d[2][i]);
+                // A later sample of the pixel reads the dimension skipped.
+                lazy.start_pixel_sample(p, (sample + 1) % 8);
+                let i = (sample as usize + 1) % 8;
+                assert_eq!(lazy.get_2d(), eager.samples_2d[0][i]);
+                assert_eq!(lazy.get_1d(), eager.samples_1d[0][i]);
+                assert_eq!(lazy.get_2d(), eager.samples_2d[1][i]);
             }
         }
     }

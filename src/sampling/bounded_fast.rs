@@ -92,7 +92,7 @@ impl Jumps {
 
 /// A fixed number of steps of one stream as one affine map of the state,
 /// `a·s + c` (mod 2^64): [`Pcg32::advance`] by that number, with its
-/// constants made once.
+/// constants ([`Pcg32::jump`]) made once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stride {
     a: u64,
@@ -102,18 +102,7 @@ pub struct Stride {
 impl Stride {
     /// `delta` steps of `rng`'s stream.
     pub fn new(rng: &Pcg32, delta: u64) -> Self {
-        let (mut cur_a, mut cur_c) = (Pcg32::MULT, rng.parts().1);
-        let (mut a, mut c) = (1u64, 0u64);
-        let mut delta = delta;
-        while delta > 0 {
-            if delta & 1 != 0 {
-                a = a.wrapping_mul(cur_a);
-                c = c.wrapping_mul(cur_a).wrapping_add(cur_c);
-            }
-            cur_c = cur_a.wrapping_add(1).wrapping_mul(cur_c);
-            cur_a = cur_a.wrapping_mul(cur_a);
-            delta >>= 1;
-        }
+        let (a, c) = rng.jump(delta);
         Self { a, c }
     }
 

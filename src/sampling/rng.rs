@@ -104,11 +104,17 @@ impl Pcg32 {
 
     /// pbrt-v3's `RNG::Advance`: skip `delta` (two's complement) steps in O(log n).
     pub fn advance(&mut self, delta: i64) {
+        let (acc_mult, acc_plus) = self.jump(delta as u64);
+        self.state = acc_mult.wrapping_mul(self.state).wrapping_add(acc_plus);
+    }
+
+    /// `delta` steps of this stream as the affine map of the state they
+    /// are, `(a, c)` with `s ↦ a·s + c` (mod 2^64).
+    pub(crate) fn jump(&self, mut delta: u64) -> (u64, u64) {
         let mut cur_mult = PCG32_MULT;
         let mut cur_plus = self.inc;
         let mut acc_mult: u64 = 1;
         let mut acc_plus: u64 = 0;
-        let mut delta = delta as u64;
         while delta > 0 {
             if delta & 1 != 0 {
                 acc_mult = acc_mult.wrapping_mul(cur_mult);
@@ -118,7 +124,7 @@ impl Pcg32 {
             cur_mult = cur_mult.wrapping_mul(cur_mult);
             delta /= 2;
         }
-        self.state = acc_mult.wrapping_mul(self.state).wrapping_add(acc_plus);
+        (acc_mult, acc_plus)
     }
 }
 
