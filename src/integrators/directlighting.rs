@@ -396,22 +396,23 @@ pub(super) fn sample_all_lights(
         // light reads neither (its sample has no random values and its
         // light takes no BSDF sample), so their values are not made.
         let delta = scene.lights[j].is_delta();
-        let (got_light, got_scatter) = if delta {
-            let got_light = sampler.skip_2d_array(n, &mut u_light);
-            (got_light, sampler.skip_2d_array(n, &mut u_scatter))
-        } else {
-            let got_light = sampler.fill_2d_array(n, &mut u_light);
-            (got_light, sampler.fill_2d_array(n, &mut u_scatter))
-        };
-        let ld = if got_light && got_scatter && delta {
-            let mut sum = Vec3::ZERO;
-            for _ in 0..n {
-                sum += estimate_direct(scene, s, bsdf, wo, light, Vec2::ZERO, Vec2::ZERO, sampler, scratch);
+        let mut take = |out: &mut Vec<Vec2>| {
+            if delta {
+                sampler.skip_2d_array(n, out)
+            } else {
+                sampler.fill_2d_array(n, out)
             }
-            sum / n as f32
-        } else if got_light && got_scatter {
+        };
+        let got_light = take(&mut u_light);
+        let got_scatter = take(&mut u_scatter);
+        let ld = if got_light && got_scatter {
             let mut sum = Vec3::ZERO;
-            for (&ul, &us) in u_light.iter().zip(&u_scatter) {
+            for k in 0..n as usize {
+                let (ul, us) = if delta {
+                    (Vec2::ZERO, Vec2::ZERO)
+                } else {
+                    (u_light[k], u_scatter[k])
+                };
                 sum += estimate_direct(scene, s, bsdf, wo, light, ul, us, sampler, scratch);
             }
             sum / n as f32
