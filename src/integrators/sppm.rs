@@ -631,14 +631,30 @@ struct PhotonRuns {
     values: Vec<f32>,
 }
 
+thread_local! {
+    /// A thread's run storage, kept between its chunks: every value is
+    /// written before it is read (`filled`), so it is never cleared.
+    static RUN_VALUES: std::cell::Cell<Vec<f32>> = const { std::cell::Cell::new(Vec::new()) };
+}
+
 impl PhotonRuns {
     fn new(first: u64, len: usize) -> PhotonRuns {
+        let mut values = RUN_VALUES.take();
+        if values.len() < RUN_DIMS * len {
+            values.resize(RUN_DIMS * len, 0.0);
+        }
         PhotonRuns {
             first,
             len,
             filled: 0,
-            values: vec![0.0; RUN_DIMS * len],
+            values,
         }
+    }
+}
+
+impl Drop for PhotonRuns {
+    fn drop(&mut self) {
+        RUN_VALUES.set(std::mem::take(&mut self.values));
     }
 }
 
