@@ -246,6 +246,43 @@ impl MltSampler {
         }
         let i = self.stream + STREAMS * self.index;
         self.index += 1;
+        // The common case without a call: a value that exists and needs no
+        // fresh draw for a large step missed, stepped by the next random
+        // number of the batch (its normal variate already made for a small
+        // step). As `ensure_ready`, in the same order.
+        let next = self.rng.next;
+        if let Some(xi) = self.x.get_mut(i) {
+            if xi.last_modified >= self.last_large_step
+                && next < AHEAD
+                && (self.large_step || self.rng.normals)
+            {
+                xi.value_backup = xi.value;
+                xi.modified_backup = xi.last_modified;
+                self.rng.next = next + 1;
+                if self.large_step {
+                    xi.value = self.rng.uniform[next];
+                } else {
+                    let n_small = self.iteration - xi.last_modified;
+                    let sigma = if n_small == 1 {
+                        self.sigma
+                    } else {
+                        self.sigma * (n_small as f32).sqrt()
+                    };
+                    xi.value += self.rng.normal[next] * sigma;
+                    xi.value -= xi.value.floor();
+                }
+                xi.last_modified = self.iteration;
+                return xi.value;
+            }
+        }
+        self.get_1d_general(i)
+    }
+
+    /// [`MltSampler::get_1d`]'s other cases: a new value, a fresh draw
+    /// for a large step missed, a batch to draw or its normal variates to
+    /// make.
+    #[inline(never)]
+    fn get_1d_general(&mut self, i: usize) -> f32 {
         self.ensure_ready(i);
         self.x[i].value
     }
@@ -393,6 +430,44 @@ mod tests {
         let mut rng = Pcg32::with_sequence(4);
         for _ in 0..40 {
             assert_eq!(ahead.uniform_f32().to_bits(), rng.uniform_f32().to_bits());
+        }
+    }
+
+    #[test]
+    fn reads_without_a_call_are_the_general_reads() {
+        // Two samplers of one sequence, one read through `get_1d`, the
+        // other always through the general path, over iterations of small
+        // and large steps (accepted and rejected), streams of varying
+        // lengths (values missed for several iterations, new values), and
+        // batches drawn part uniform, part normal.
+        let mut fast = MltSampler::new(4, 21, 0.05, 0.3);
+        let mut general = MltSampler::new(4, 21, 0.05, 0.3);
+        let mut pick = Pcg32::with_sequence(77);
+        let mut read = |fast: &mut MltSampler, general: &mut MltSampler, k: usize, n: u32| {
+            fast.start_stream(k);
+            general.start_stream(k);
+            for _ in 0..n {
+                let i = general.stream + STREAMS * general.index;
+                general.index += 1;
+                assert_eq!(fast.get_1d().to_bits(), general.get_1d_general(i).to_bits());
+            }
+        };
+        read(&mut fast, &mut general, CAMERA_STREAM, 9);
+        for _ in 0..3000 {
+            fast.start_iteration();
+            general.start_iteration();
+            assert_eq!(fast.large_step, general.large_step);
+            for k in [CAMERA_STREAM, LIGHT_STREAM, CONNECTION_STREAM] {
+                let n = (pick.uniform_f32() * 14.0) as u32;
+                read(&mut fast, &mut general, k, n);
+            }
+            if pick.uniform_f32() < 0.4 {
+                fast.accept();
+                general.accept();
+            } else {
+                fast.reject();
+                general.reject();
+            }
         }
     }
 
