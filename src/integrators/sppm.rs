@@ -571,12 +571,13 @@ impl Sppm {
                     // The chunk's photon indices (iteration-major).
                     let from = iter as u64 * photons as u64 + start as u64;
                     let len = (end - start) as usize;
-                    let mut runs = PhotonRuns::new(from, len);
+                    let mut runs = PhotonRuns::new(len, bases);
                     for index in from..from + len as u64 {
                         let mut h = Halton {
                             bases,
                             runs: &mut runs,
                             index,
+                            at: (index - from) as usize,
                             dim: 0,
                         };
                         self.trace_photon(run.scene, grid, vps, &mut h, &mut recs, &mut counts);
@@ -624,8 +625,9 @@ const RUN_DIMS: usize = 32;
 /// them from the first photon that draws it to the chunk's end, filled at
 /// once ([`RadicalTable::fill`]).
 struct PhotonRuns {
-    first: u64,
     len: usize,
+    /// Bit `d`: dimension `d`'s base has a digit table (it is filled in runs).
+    fills: u32,
     /// Bit `d`: dimension `d` is filled from some photon on.
     filled: u32,
     values: Vec<f32>,
@@ -638,14 +640,20 @@ thread_local! {
 }
 
 impl PhotonRuns {
-    fn new(first: u64, len: usize) -> PhotonRuns {
+    fn new(len: usize, bases: &[RadicalTable]) -> PhotonRuns {
         let mut values = RUN_VALUES.take();
         if values.len() < RUN_DIMS * len {
             values.resize(RUN_DIMS * len, 0.0);
         }
+        let fills = bases
+            .iter()
+            .take(RUN_DIMS)
+            .enumerate()
+            .filter(|(_, b)| b.fills())
+            .fold(0u32, |m, (d, _)| m | 1 << d);
         PhotonRuns {
-            first,
             len,
+            fills,
             filled: 0,
             values,
         }
@@ -663,6 +671,8 @@ struct Halton<'b, 'r> {
     bases: &'b [RadicalTable],
     runs: &'r mut PhotonRuns,
     index: u64,
+    /// The photon's place in the chunk (`index` − the chunk's first).
+    at: usize,
     dim: usize,
 }
 
@@ -675,21 +685,20 @@ impl Halton<'_, '_> {
         if self.dim == self.bases.len() {
             self.dim = 0;
         }
-        let b = &self.bases[d];
-        if d < RUN_DIMS && b.fills() {
-            let runs = &mut *self.runs;
-            let at = d * runs.len + (self.index - runs.first) as usize;
+        let runs = &mut *self.runs;
+        if d < RUN_DIMS && runs.fills & (1 << d) != 0 {
+            let at = d * runs.len + self.at;
             if runs.filled & (1 << d) == 0 {
                 // This photon and the chunk's later ones.
-                b.fill(self.index, &mut runs.values[at..(d + 1) * runs.len]);
+                self.bases[d].fill(self.index, &mut runs.values[at..(d + 1) * runs.len]);
                 runs.filled |= 1 << d;
             }
             runs.values[at]
         } else {
-            b.radical_inverse(self.index)
+            self.bases[d].radical_inverse(self.index)
         }
     }
-    #[inline]
+    #[inline(always)]
     fn next_2d(&mut self) -> Vec2 {
         let x = self.next();
         Vec2::new(x, self.next())
@@ -1121,7 +1130,7 @@ mod tests {
         let bases: Vec<RadicalTable> = PRIMES.iter().map(|&p| RadicalTable::new(p)).collect();
         let mut r = Pcg32::with_sequence(9);
         for (first, len) in [(0u64, 256usize), (1_000_000, 256), (4095, 17), (1 << 40, 30)] {
-            let mut runs = PhotonRuns::new(first, len);
+            let mut runs = PhotonRuns::new(len, &bases);
             for index in first..first + len as u64 {
                 let dims = match r.uniform_u32() % 8 {
                     0 => 0,
@@ -1132,6 +1141,7 @@ mod tests {
                     bases: &bases,
                     runs: &mut runs,
                     index,
+                    at: (index - first) as usize,
                     dim: 0,
                 };
                 for d in 0..dims {
