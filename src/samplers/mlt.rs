@@ -443,7 +443,7 @@ mod tests {
         let mut fast = MltSampler::new(4, 21, 0.05, 0.3);
         let mut general = MltSampler::new(4, 21, 0.05, 0.3);
         let mut pick = Pcg32::with_sequence(77);
-        let mut read = |fast: &mut MltSampler, general: &mut MltSampler, k: usize, n: u32| {
+        let read = |fast: &mut MltSampler, general: &mut MltSampler, k: usize, n: u32| {
             fast.start_stream(k);
             general.start_stream(k);
             for _ in 0..n {
