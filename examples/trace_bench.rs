@@ -4,8 +4,8 @@
 //!
 //! cargo run --release --example trace_bench -- [SCENE] [N]
 //!
-//! Prints ns per closest-hit ray, ns per shadow ray and per surface lookup,
-//! single-threaded. Compare two builds by running both in turn.
+//! Prints ns per closest-hit ray (one at a time, and 16 side by side), ns
+//! per shadow ray and per surface lookup, single-threaded. Compare two builds by running both in turn.
 
 use glam::Vec3;
 use pbrs::accel::{Aggregate, Hit};
@@ -15,6 +15,10 @@ use pbrs::loader::load_scene;
 use pbrs::sampling::rng::Pcg32;
 use std::path::Path;
 use std::time::Instant;
+
+/// Rays traced side by side (`Aggregate::intersect_stream`), as a batch of
+/// `path` traces its bounces.
+const SIDE_BY_SIDE: usize = 16;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -79,13 +83,17 @@ fn main() {
         let hits = closest_all(g, &rays);
         let closest = t.elapsed().as_secs_f64() * 1e9 / n as f64;
         let t = Instant::now();
+        let n_stream = closest_stream(g, &rays);
+        let stream = t.elapsed().as_secs_f64() * 1e9 / n as f64;
+        assert_eq!(n_stream, hits.len());
+        let t = Instant::now();
         let blocked = shadow_all(g, &shadow);
         let occl = t.elapsed().as_secs_f64() * 1e9 / n as f64;
         let t = Instant::now();
         let acc = surface_all(g, &hits);
         let surf = t.elapsed().as_secs_f64() * 1e9 / hits.len().max(1) as f64;
         println!(
-            "round {round}: closest {closest:.1} ns/ray ({} hits), shadow {occl:.1} ns/ray ({blocked} blocked), surface {surf:.1} ns ({acc:.0})",
+            "round {round}: closest {closest:.1} ns/ray ({} hits), {SIDE_BY_SIDE} side by side {stream:.1} ns/ray, shadow {occl:.1} ns/ray ({blocked} blocked), surface {surf:.1} ns ({acc:.0})",
             hits.len()
         );
     }
@@ -101,6 +109,18 @@ fn closest_all(g: &Aggregate, rays: &[Ray]) -> Vec<Hit> {
         if let Some(h) = g.intersect(r) {
             hits.push(h);
         }
+    }
+    hits
+}
+
+#[inline(never)]
+fn closest_stream(g: &Aggregate, rays: &[Ray]) -> usize {
+    let times = [0.0f32; SIDE_BY_SIDE];
+    let mut out = [None; SIDE_BY_SIDE];
+    let mut hits = 0;
+    for c in rays.chunks(SIDE_BY_SIDE) {
+        g.intersect_stream(c, &times[..c.len()], &mut out[..c.len()]);
+        hits += out[..c.len()].iter().filter(|h| h.is_some()).count();
     }
     hits
 }

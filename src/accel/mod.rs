@@ -17,6 +17,7 @@ mod binned;
 mod bvh4;
 mod packet;
 mod split;
+mod stream;
 
 pub use bvh4::BuildWork;
 pub use packet::PACKET_MAX;
@@ -998,6 +999,33 @@ impl Aggregate {
             Some(bvh) if bvh.traces_packets() && n <= PACKET_MAX => {
                 let mut found = [None; PACKET_MAX];
                 bvh.closest_packet(rays, &mut found[..n]);
+                for (o, f) in out[..n].iter_mut().zip(&found[..n]) {
+                    *o = f.map(|(pos, t, b)| {
+                        let prim = self.top.prims[pos as usize];
+                        prefetch_indices(&self.meshes, prim);
+                        triangle_hit(prim, t, b)
+                    });
+                }
+            }
+            _ => {
+                for ((r, &time), o) in rays.iter().zip(times).zip(out.iter_mut()) {
+                    self.intersect_into(r, time, o);
+                }
+            }
+        }
+    }
+
+    /// The closest hits of incoherent `rays` (at scene times `times`) in
+    /// `out`, each [`Aggregate::intersect_into`]'s: traced side by side
+    /// ([`stream`]) when the scene is triangles only and there are at most
+    /// [`stream::STREAM_MAX`], else ray by ray.
+    #[inline(never)]
+    pub fn intersect_stream(&self, rays: &[Ray], times: &[f32], out: &mut [Option<Hit>]) {
+        let n = rays.len();
+        match self.top.bvh.as_ref() {
+            Some(bvh) if bvh.traces_streams() && n <= stream::STREAM_MAX => {
+                let mut found = [None; stream::STREAM_MAX];
+                bvh.closest_stream(rays, &mut found[..n]);
                 for (o, f) in out[..n].iter_mut().zip(&found[..n]) {
                     *o = f.map(|(pos, t, b)| {
                         let prim = self.top.prims[pos as usize];

@@ -271,7 +271,7 @@ impl Bvh4 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::accel::bvh4::tests::build;
     use crate::accel::bvh4::Closest;
@@ -280,7 +280,7 @@ mod tests {
     use glam::Vec3;
     use obvhs::aabb::Aabb;
 
-    fn point(rng: &mut Pcg32, s: f32) -> Vec3 {
+    pub(in crate::accel) fn point(rng: &mut Pcg32, s: f32) -> Vec3 {
         Vec3::new(
             rng.uniform_f32() - 0.5,
             rng.uniform_f32() - 0.5,
@@ -291,7 +291,7 @@ mod tests {
     /// Random triangles, each also present a second time (exact ties
     /// between BVH positions), and a grid of unit squares split into
     /// triangles (shared edges and vertices).
-    fn scene(rng: &mut Pcg32, n: usize) -> Vec<[Vec3; 3]> {
+    pub(in crate::accel) fn scene(rng: &mut Pcg32, n: usize) -> Vec<[Vec3; 3]> {
         let mut tris: Vec<[Vec3; 3]> = (0..n)
             .map(|_| {
                 let c = point(rng, 4.0);
@@ -316,7 +316,7 @@ mod tests {
 
     /// Packets of `len` rays: from one point into a narrow cone (a pixel's
     /// camera rays), towards grid vertices and edges, or anywhere.
-    fn packet(rng: &mut Pcg32, len: usize) -> Vec<Ray> {
+    pub(in crate::accel) fn packet(rng: &mut Pcg32, len: usize) -> Vec<Ray> {
         let kind = rng.uniform_u32_below(3);
         let o = point(rng, 6.0);
         let aim = point(rng, 2.0);

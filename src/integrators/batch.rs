@@ -111,17 +111,9 @@ pub(super) fn trace_paths<M: PathMedium>(
     let mut camera_rays = true;
     while !b.active.is_empty() {
         scratch.counts.closest += b.active.len() as u64;
-        if camera_rays {
-            closest_of_lanes(&b.active, |j| states[j].ray, &b.times, &mut b.hits, scene);
-        } else {
-            for &j in &b.active {
-                let j = j as usize;
-                let ray = &states[j].ray;
-                scene
-                    .aggregate
-                    .intersect_into(ray, b.times[j], &mut b.hits[j]);
-            }
-        }
+        // The bounces are not: traced side by side.
+        let rays = |j: usize| states[j].ray;
+        closest_of_lanes(&b.active, rays, &b.times, &mut b.hits, scene, camera_rays);
         camera_rays = false;
         let mut kept = 0;
         for k in 0..b.active.len() {
@@ -154,18 +146,19 @@ pub(super) fn trace_camera_rays(b: &mut Batch, scene: &RenderScene) {
             b.active.push(j as u32);
         }
     }
-    closest_of_lanes(&b.active, |j| b.rays[j], &b.times, &mut b.hits, scene);
+    closest_of_lanes(&b.active, |j| b.rays[j], &b.times, &mut b.hits, scene, true);
 }
 
 /// The closest hits of lanes `active`'s rays (`ray(lane)`, at times
-/// `times[lane]`) in `hits[lane]`, traced as packets of up to
-/// [`PACKET_MAX`] lanes.
+/// `times[lane]`) in `hits[lane]`, up to [`PACKET_MAX`] lanes at a time:
+/// traced as packets if they are `coherent`, else side by side.
 fn closest_of_lanes(
     active: &[u32],
     ray: impl Fn(usize) -> Ray,
     times: &[f32],
     hits: &mut [Option<Hit>],
     scene: &RenderScene,
+    coherent: bool,
 ) {
     for lanes in active.chunks(PACKET_MAX) {
         let n = lanes.len();
@@ -176,9 +169,15 @@ fn closest_of_lanes(
             at[k] = times[j as usize];
         }
         let mut found = [None; PACKET_MAX];
-        scene
-            .aggregate
-            .intersect_packet(&rays[..n], &at[..n], &mut found[..n]);
+        if coherent {
+            scene
+                .aggregate
+                .intersect_packet(&rays[..n], &at[..n], &mut found[..n]);
+        } else {
+            scene
+                .aggregate
+                .intersect_stream(&rays[..n], &at[..n], &mut found[..n]);
+        }
         for (&j, &h) in lanes.iter().zip(&found[..n]) {
             hits[j as usize] = h;
         }

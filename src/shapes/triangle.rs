@@ -471,7 +471,31 @@ impl TriangleRay4 {
         lanes: u32,
     ) -> Option<(u32, f32, [f32; 3])> {
         debug_assert_eq!(KZ, self.scalar.kz);
-        let Some(r) = self.lanes_k::<KZ>(v, t_max, lanes) else {
+        self.intersect4_kz(KZ as usize, v, t_max, lanes)
+    }
+
+    /// [`TriangleRay4::intersect4`] with the ray's own axis read at run
+    /// time (the vertices' coordinates loaded from offsets it computes, so
+    /// no branch on it): for rays traced side by side, whose axes differ.
+    #[inline(always)]
+    pub fn intersect4_any_axis(
+        &self,
+        v: &TrianglePack,
+        t_max: f32,
+        lanes: u32,
+    ) -> Option<(u32, f32, [f32; 3])> {
+        self.intersect4_kz(self.scalar.kz as usize, v, t_max, lanes)
+    }
+
+    #[inline(always)]
+    fn intersect4_kz(
+        &self,
+        kz: usize,
+        v: &TrianglePack,
+        t_max: f32,
+        lanes: u32,
+    ) -> Option<(u32, f32, [f32; 3])> {
+        let Some(r) = self.lanes_kz(kz, v, t_max, lanes) else {
             return self.scalar.intersect4_scalar(v, t_max, lanes);
         };
         if r.mask == 0 {
@@ -505,18 +529,17 @@ impl TriangleRay4 {
     #[inline(always)]
     pub fn any4<const KZ: u8>(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> bool {
         debug_assert_eq!(KZ, self.scalar.kz);
-        match self.lanes_k::<KZ>(v, t_max, lanes) {
+        match self.lanes_kz(KZ as usize, v, t_max, lanes) {
             Some(r) => r.mask != 0,
             None => self.scalar.intersect4_scalar(v, t_max, lanes).is_some(),
         }
     }
 
-    /// The four-lane body of `intersect_k`. `None` if a lane in `lanes` has
+    /// The four-lane body of `intersect_k` for the ray's axis `kz`. `None` if a lane in `lanes` has
     /// an edge value of exactly zero (the caller then decides lane by lane).
     #[inline(always)]
-    fn lanes_k<const KZ: u8>(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> Option<Lanes> {
-        let kz = KZ as usize;
-        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    fn lanes_kz(&self, kz: usize, v: &TrianglePack, t_max: f32, lanes: u32) -> Option<Lanes> {
+        let (kx, ky) = ([1, 2, 0][kz], [2, 0, 1][kz]);
         let [ox, oy, oz] = self.o;
         // Translate and permute.
         let mut p0x = v[kx] - ox;
