@@ -31,6 +31,7 @@
 //! thread count. Photons cross transmissive surfaces as importance (the
 //! radiance-mode (η_i/η_t)² of dielectric transmission is undone).
 
+use crate::accel::Hit;
 use super::common::{emitted, escaped, light_sampler, shade};
 use super::directlighting::sample_one_light;
 use super::{
@@ -313,6 +314,22 @@ pub struct SppmRun<'r> {
     pub pool: &'r rayon::ThreadPool,
 }
 
+/// Camera paths a row advances side by side.
+const LANES: usize = 16;
+
+/// A camera path under way: the `pixel`th of its row, its next ray and
+/// what pbrt-v3's camera loop keeps.
+#[derive(Clone, Copy)]
+struct CameraLane {
+    pixel: usize,
+    ray: Ray,
+    time: f32,
+    beta: Vec3,
+    specular_bounce: bool,
+    depth: u32,
+    crossed: u32,
+}
+
 /// Photons per chunk: the unit of parallel work whose contributions are
 /// added in order (small enough that an iteration of one photon per pixel
 /// of a small film still keeps every thread busy to its end).
@@ -399,7 +416,11 @@ impl Sppm {
     }
 
     /// Step (1): each pixel's camera path, rows in parallel (each pixel's
-    /// path depends only on its own samples).
+    /// path depends only on its own samples). Within a row, [`LANES`]
+    /// pixels' paths advance side by side, their rays traced together
+    /// ([`crate::accel::Aggregate::intersect_stream`]), each lane with its
+    /// own copy of the sampler; a lane whose path ends takes the row's next
+    /// pixel.
     fn camera_pass<'a>(
         &self,
         run: &SppmRun<'a>,
@@ -423,21 +444,58 @@ impl Sppm {
             // (a fifth of this pass's wall time on pbrt-v3's f16-9a).
             .with_max_len(1)
             .map(|(row, ((px, vp), lobes))| {
-                let mut sampler = sampler.clone();
+                let mut samplers = vec![sampler.clone(); LANES];
+                let mut lanes: [Option<CameraLane>; LANES] = [None; LANES];
                 let mut scratch = Scratch::default();
                 let mut bsdf = Bsdf::empty();
                 lobes.clear();
                 let y = pb.min.y + row as i32;
-                for (i, (p, vp)) in px.iter_mut().zip(vp).enumerate() {
-                    let pixel = IVec2::new(pb.min.x + i as i32, y);
-                    sampler.start_pixel_sample(pixel, iter);
-                    let out = (p, &mut *vp, &mut bsdf);
-                    if self.visible_point(scene, &mut sampler, &mut scratch, pixel, out) {
-                        vp.row = row as u32;
-                        vp.first = lobes.len() as u32;
-                        vp.n = bsdf.lobes().len() as u32;
-                        vp.bsdf = bsdf.head();
-                        lobes.extend_from_slice(bsdf.lobes());
+                let mut next = 0;
+                let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+                let mut times = [0f32; LANES];
+                let mut hits = [None; LANES];
+                let mut which = [0usize; LANES];
+                loop {
+                    let mut n = 0;
+                    for (k, (lane, sampler)) in lanes.iter_mut().zip(&mut samplers).enumerate() {
+                        while lane.is_none() && next < px.len() {
+                            let pixel = IVec2::new(pb.min.x + next as i32, y);
+                            sampler.start_pixel_sample(pixel, iter);
+                            *lane = self.camera_lane(scene, sampler, pixel, next);
+                            next += 1;
+                        }
+                        if let Some(l) = lane {
+                            (rays[n], times[n], which[n]) = (l.ray, l.time, k);
+                            n += 1;
+                        }
+                    }
+                    if n == 0 {
+                        break;
+                    }
+                    scratch.counts.closest += n as u64;
+                    scene
+                        .aggregate
+                        .intersect_stream(&rays[..n], &times[..n], &mut hits[..n]);
+                    for (&k, hit) in which[..n].iter().zip(&hits[..n]) {
+                        let Some(l) = lanes[k].as_mut() else {
+                            continue;
+                        };
+                        let i = l.pixel;
+                        let out = (&mut px[i], &mut vp[i], &mut bsdf);
+                        match self.camera_step(scene, l, hit, &mut samplers[k], &mut scratch, out) {
+                            None => {}
+                            Some(made) => {
+                                if made {
+                                    let vp = &mut vp[i];
+                                    vp.row = row as u32;
+                                    vp.first = lobes.len() as u32;
+                                    vp.n = bsdf.lobes().len() as u32;
+                                    vp.bsdf = bsdf.head();
+                                    lobes.extend_from_slice(bsdf.lobes());
+                                }
+                                lanes[k] = None;
+                            }
+                        }
                     }
                 }
                 scratch.counts()
@@ -449,85 +507,108 @@ impl Sppm {
         c
     }
 
-    /// One pixel's camera path (pbrt-v3's loop "Follow camera ray path
-    /// until a visible point is created"). Returns true if it made one:
-    /// then `vp` holds all of it but its BSDF, which is `bsdf`.
-    fn visible_point<'a>(
+    /// The start of pixel `pixel`'s camera path (pbrt-v3's camera sample
+    /// and ray), the `i`th of its row; `None` if it traces nothing.
+    fn camera_lane(
         &self,
-        scene: &'a RenderScene,
+        scene: &RenderScene,
         sampler: &mut Sampler,
-        scratch: &mut Scratch,
         pixel: IVec2,
-        (px, vp, bsdf): (&mut Pixel, &mut VisiblePoint, &mut Bsdf<'a>),
-    ) -> bool {
+        i: usize,
+    ) -> Option<CameraLane> {
         let lens = scene.camera.uses_lens() || scene.camera.is_moving();
         let cs: CameraSample = sampler.camera_sample(pixel, lens);
-        let (mut ray, weight) = scene.camera.generate_ray(&cs);
-        if weight <= 0.0 || weight.is_nan() {
-            return false;
+        let (ray, weight) = scene.camera.generate_ray(&cs);
+        if weight <= 0.0 || weight.is_nan() || self.settings.max_depth == 0 {
+            return None;
         }
-        let time = scene.camera.time(&cs);
+        Some(CameraLane {
+            pixel: i,
+            ray,
+            time: scene.camera.time(&cs),
+            beta: Vec3::ONE,
+            specular_bounce: false,
+            depth: 0,
+            crossed: 0,
+        })
+    }
+
+    /// One vertex of a pixel's camera path (pbrt-v3's loop "Follow camera
+    /// ray path until a visible point is created"), where its ray met
+    /// `hit`: `None` while the path goes on (`lane.ray` is its next ray),
+    /// else whether it made a visible point: then `vp` holds all of it but
+    /// its BSDF, which is `bsdf`.
+    fn camera_step<'a>(
+        &self,
+        scene: &'a RenderScene,
+        lane: &mut CameraLane,
+        hit: &Option<Hit>,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+        (px, vp, bsdf): (&mut Pixel, &mut VisiblePoint, &mut Bsdf<'a>),
+    ) -> Option<bool> {
+        let CameraLane { ray, time, beta, .. } = *lane;
         let max_depth = self.settings.max_depth;
-        let mut beta = Vec3::ONE;
-        let mut specular_bounce = false;
-        let (mut depth, mut crossed) = (0, 0);
-        while depth < max_depth {
-            scratch.counts.closest += 1;
-            let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
-                px.ld += beta * escaped(scene, ray.d);
-                return false;
-            };
-            let mut s = scene.aggregate.surface_at(&hit, time);
-            let material = &scene.materials[s.material as usize];
-            if material.is_none() {
-                crossed += 1;
-                if crossed > MAX_PASS_THROUGH {
-                    return false;
-                }
-                ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
-                continue;
+        let Some(hit) = hit else {
+            px.ld += beta * escaped(scene, ray.d);
+            return Some(false);
+        };
+        let mut s = scene.aggregate.surface_at(hit, time);
+        let material = &scene.materials[s.material as usize];
+        if material.is_none() {
+            lane.crossed += 1;
+            if lane.crossed > MAX_PASS_THROUGH {
+                return Some(false);
             }
-            shade(scene, &hit, &mut s, material, true, None, bsdf);
-            let bsdf = &*bsdf;
-            let wo = -ray.d;
-            if depth == 0 || specular_bounce {
-                px.ld += beta * emitted(scene, &s, wo);
-            }
-            px.ld += beta * sample_one_light(scene, &s, bsdf, wo, sampler, scratch, &self.direct);
-            let diffuse = bsdf.num_components(BxdfFlags(
-                BxdfFlags::DIFFUSE.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
-            )) > 0;
-            let glossy = bsdf.num_components(BxdfFlags(
-                BxdfFlags::GLOSSY.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
-            )) > 0;
-            if diffuse || (glossy && depth + 1 == max_depth) {
-                vp.p = s.point.p;
-                vp.wo = wo;
-                vp.beta = beta;
-                return true;
-            }
-            if depth + 1 < max_depth {
-                let Some(bs) = bsdf.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
-                    return false;
-                };
-                if bs.pdf == 0.0 || bs.f == Vec3::ZERO {
-                    return false;
-                }
-                specular_bounce = bs.is_specular();
-                beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
-                let y = luminance(beta);
-                if y < 0.25 {
-                    let continue_prob = y.min(1.0);
-                    if sampler.get_1d() > continue_prob {
-                        return false;
-                    }
-                    beta /= continue_prob;
-                }
-                ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
-            }
-            depth += 1;
+            lane.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            return None;
         }
-        false
+        shade(scene, hit, &mut s, material, true, None, bsdf);
+        let bsdf = &*bsdf;
+        let wo = -ray.d;
+        if lane.depth == 0 || lane.specular_bounce {
+            px.ld += beta * emitted(scene, &s, wo);
+        }
+        px.ld += beta * sample_one_light(scene, &s, bsdf, wo, sampler, scratch, &self.direct);
+        let diffuse = bsdf.num_components(BxdfFlags(
+            BxdfFlags::DIFFUSE.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
+        )) > 0;
+        let glossy = bsdf.num_components(BxdfFlags(
+            BxdfFlags::GLOSSY.0 | BxdfFlags::REFLECTION.0 | BxdfFlags::TRANSMISSION.0,
+        )) > 0;
+        if diffuse || (glossy && lane.depth + 1 == max_depth) {
+            vp.p = s.point.p;
+            vp.wo = wo;
+            vp.beta = beta;
+            return Some(true);
+        }
+        if lane.depth + 1 < max_depth {
+            let Some(bs) = bsdf.sample(wo, sampler.get_2d(), BxdfFlags::ALL) else {
+                return Some(false);
+            };
+            if bs.pdf == 0.0 || bs.f == Vec3::ZERO {
+                return Some(false);
+            }
+            lane.specular_bounce = bs.is_specular();
+            let mut beta = beta;
+            beta *= bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf;
+            let y = luminance(beta);
+            if y < 0.25 {
+                let continue_prob = y.min(1.0);
+                if sampler.get_1d() > continue_prob {
+                    return Some(false);
+                }
+                beta /= continue_prob;
+            }
+            lane.beta = beta;
+            lane.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
+        }
+        lane.depth += 1;
+        if lane.depth < max_depth {
+            None
+        } else {
+            Some(false)
+        }
     }
 
     /// Step (3): photons in fixed chunks traced in parallel, each chunk's
