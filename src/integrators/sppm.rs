@@ -28,7 +28,10 @@
 //! directly). Unlike pbrt-v3, which adds photons with floating-point
 //! atomics, photons are traced in fixed chunks and their contributions
 //! added to the pixels in photon order, so the image does not depend on the
-//! thread count. Photons cross transmissive surfaces as importance (the
+//! thread count. Within a row of the camera pass and within a chunk of
+//! photons, sixteen paths advance side by side, their rays traced together
+//! (`Aggregate::intersect_stream`, which overlaps their traversals); each
+//! path's values are those it has alone. Photons cross transmissive surfaces as importance (the
 //! radiance-mode (η_i/η_t)² of dielectric transmission is undone).
 
 use crate::accel::Hit;
@@ -326,6 +329,20 @@ struct CameraLane {
     time: f32,
     beta: Vec3,
     specular_bounce: bool,
+    depth: u32,
+    crossed: u32,
+}
+
+/// A photon under way: its place in its chunk, its index and next Halton
+/// dimension, its next ray and power.
+#[derive(Clone, Copy)]
+struct PhotonLane {
+    at: usize,
+    index: u64,
+    dim: usize,
+    ray: Ray,
+    time: f32,
+    beta: Vec3,
     depth: u32,
     crossed: u32,
 }
@@ -653,16 +670,8 @@ impl Sppm {
                     let from = iter as u64 * photons as u64 + start as u64;
                     let len = (end - start) as usize;
                     let mut runs = PhotonRuns::new(len, bases);
-                    for index in from..from + len as u64 {
-                        let mut h = Halton {
-                            bases,
-                            runs: &mut runs,
-                            index,
-                            at: (index - from) as usize,
-                            dim: 0,
-                        };
-                        self.trace_photon(run.scene, grid, vps, &mut h, &mut recs, &mut counts);
-                    }
+                    let photons = (&mut runs, bases, from);
+                    self.trace_photons(run.scene, grid, vps, photons, &mut recs, &mut counts);
                     (recs, counts)
                 })
                 .collect_into_vec(&mut all)
@@ -703,14 +712,17 @@ fn update_pixel(p: &mut Pixel, vp: &mut VisiblePoint, phi: DVec3, m: u32) {
 const RUN_DIMS: usize = 32;
 
 /// A chunk's photons have consecutive indices: dimension `d` of all of
-/// them from the first photon that draws it to the chunk's end, filled at
-/// once ([`RadicalTable::fill`]).
+/// them from the first photon that may still draw it (when one first does)
+/// to the chunk's end, filled at once ([`RadicalTable::fill`]).
 struct PhotonRuns {
     len: usize,
     /// Bit `d`: dimension `d`'s base has a digit table (it is filled in runs).
     fills: u32,
     /// Bit `d`: dimension `d` is filled from some photon on.
     filled: u32,
+    /// The first place in the chunk whose photon may still draw values: a
+    /// dimension is filled from there on.
+    low: usize,
     values: Vec<f32>,
 }
 
@@ -736,6 +748,7 @@ impl PhotonRuns {
             len,
             fills,
             filled: 0,
+            low: 0,
             values,
         }
     }
@@ -768,13 +781,16 @@ impl Halton<'_, '_> {
         }
         let runs = &mut *self.runs;
         if d < RUN_DIMS && runs.fills & (1 << d) != 0 {
-            let at = d * runs.len + self.at;
             if runs.filled & (1 << d) == 0 {
-                // This photon and the chunk's later ones.
-                self.bases[d].fill(self.index, &mut runs.values[at..(d + 1) * runs.len]);
+                // The photons from the first that may still draw values
+                // to the chunk's end.
+                let low = runs.low.min(self.at);
+                let first = self.index - (self.at - low) as u64;
+                let row = &mut runs.values[d * runs.len..(d + 1) * runs.len];
+                self.bases[d].fill(first, &mut row[low..]);
                 runs.filled |= 1 << d;
             }
-            runs.values[at]
+            runs.values[d * runs.len + self.at]
         } else {
             self.bases[d].radical_inverse(self.index)
         }
@@ -787,18 +803,100 @@ impl Halton<'_, '_> {
 }
 
 impl Sppm {
-    /// One photon (pbrt-v3's "Follow photon path for photonIndex"): its
-    /// contributions are pushed to `recs`.
+    /// A chunk's photons (indices `from ..`, as many as `runs` holds;
+    /// pbrt-v3's "Follow photon path for photonIndex"), [`LANES`] of them
+    /// side by side, their rays traced together; a lane whose photon ends
+    /// takes the chunk's next one. Their contributions are pushed to
+    /// `recs` in photon order.
     #[allow(clippy::too_many_arguments)]
-    fn trace_photon(
+    fn trace_photons(
         &self,
         scene: &RenderScene,
         grid: &Grid,
         vps: &VisiblePoints,
-        h: &mut Halton,
+        (runs, bases, from): (&mut PhotonRuns, &[RadicalTable], u64),
         recs: &mut Vec<(u32, Vec3)>,
         counts: &mut RayCounts,
     ) {
+        let len = runs.len;
+        let mut lanes: [Option<PhotonLane>; LANES] = [None; LANES];
+        // Each record's photon (its place in the chunk).
+        let mut places: Vec<u16> = Vec::new();
+        let mut mine = Vec::new();
+        let mut next = 0;
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+        let mut times = [0f32; LANES];
+        let mut hits = [None; LANES];
+        let mut which = [0usize; LANES];
+        loop {
+            for k in 0..LANES {
+                while lanes[k].is_none() && next < len {
+                    runs.low = lanes.iter().flatten().map(|l| l.at).fold(next, usize::min);
+                    lanes[k] = self.emit_photon(scene, (runs, bases), from + next as u64, next);
+                    next += 1;
+                }
+            }
+            let mut n = 0;
+            for (k, lane) in lanes.iter().enumerate() {
+                if let Some(l) = lane {
+                    (rays[n], times[n], which[n]) = (l.ray, l.time, k);
+                    n += 1;
+                }
+            }
+            if n == 0 {
+                break;
+            }
+            runs.low = lanes.iter().flatten().map(|l| l.at).fold(len, usize::min);
+            counts.closest += n as u64;
+            scene
+                .aggregate
+                .intersect_stream(&rays[..n], &times[..n], &mut hits[..n]);
+            for (&k, hit) in which[..n].iter().zip(&hits[..n]) {
+                let Some(l) = lanes[k].as_mut() else {
+                    continue;
+                };
+                let before = recs.len();
+                let goes_on = self.photon_step(scene, (grid, vps), (runs, bases), l, hit, recs);
+                places.resize(places.len() + recs.len() - before, l.at as u16);
+                if !goes_on {
+                    lanes[k] = None;
+                }
+            }
+        }
+        // In photon order (each photon's in the order it made them): a
+        // counting sort by place, stable.
+        let mut start = vec![0u32; len + 1];
+        for &p in &places {
+            start[p as usize + 1] += 1;
+        }
+        for i in 0..len {
+            start[i + 1] += start[i];
+        }
+        mine.resize(recs.len(), (0u32, Vec3::ZERO));
+        for (&p, &r) in places.iter().zip(recs.iter()) {
+            let slot = &mut start[p as usize];
+            mine[*slot as usize] = r;
+            *slot += 1;
+        }
+        std::mem::swap(recs, &mut mine);
+    }
+
+    /// A photon's emission (the chunk's `at`th, index `index`): `None` if
+    /// it carries nothing or traces no ray.
+    fn emit_photon(
+        &self,
+        scene: &RenderScene,
+        (runs, bases): (&mut PhotonRuns, &[RadicalTable]),
+        index: u64,
+        at: usize,
+    ) -> Option<PhotonLane> {
+        let mut h = Halton {
+            bases,
+            runs,
+            index,
+            at,
+            dim: 0,
+        };
         // The emission's dimensions drawn together, before anything
         // branches on them (those looked up one index at a time then have
         // their digit chains in flight at once).
@@ -806,85 +904,115 @@ impl Sppm {
         let u_light0 = h.next_2d();
         let u_light1 = h.next_2d();
         let u_time = h.next();
-        let Some((light, light_pmf)) =
+        let dim = h.dim;
+        let (light, light_pmf) =
             self.power
-                .sample(Vec3::ZERO, Vec3::ZERO, u, &scene.lights, &scene.aggregate)
-        else {
-            return;
-        };
+                .sample(Vec3::ZERO, Vec3::ZERO, u, &scene.lights, &scene.aggregate)?;
         let time = scene.camera.time(&CameraSample {
             time: u_time,
             ..CameraSample::default()
         });
-        let Some(e) = scene.lights[light as usize].sample_le(u_light0, u_light1, &scene.aggregate)
-        else {
-            return;
-        };
+        let e = scene.lights[light as usize].sample_le(u_light0, u_light1, &scene.aggregate)?;
         if !(e.pdf_pos > 0.0 && e.pdf_dir > 0.0) || e.le == Vec3::ZERO {
-            return;
+            return None;
         }
-        let mut beta = e.n.dot(e.ray.d).abs() * e.le / (light_pmf * e.pdf_pos * e.pdf_dir);
-        if beta == Vec3::ZERO || !beta.is_finite() {
-            return;
+        let beta = e.n.dot(e.ray.d).abs() * e.le / (light_pmf * e.pdf_pos * e.pdf_dir);
+        if beta == Vec3::ZERO || !beta.is_finite() || self.settings.max_depth == 0 {
+            return None;
         }
-        let mut ray = e.ray;
-        let (mut depth, mut crossed) = (0, 0);
-        while depth < self.settings.max_depth {
-            counts.closest += 1;
-            let Some(hit) = scene.aggregate.intersect_at(&ray, time) else {
-                return;
-            };
-            let mut s = scene.aggregate.surface_at(&hit, time);
-            let material = &scene.materials[s.material as usize];
-            if material.is_none() {
-                if depth > 0 {
-                    grid.gather(s.point.p, -ray.d, beta, vps, recs);
-                }
-                crossed += 1;
-                if crossed > MAX_PASS_THROUGH {
-                    return;
-                }
-                ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
-                continue;
-            }
-            // The photon's next ray first, the visible points it reaches
-            // here after it: the gather is off the path's critical chain
-            // (the step changes neither the ray, the power nor the point).
-            let next = 'step: {
-                // This vertex's dimensions (the BSDF sample's and Russian
-                // roulette's), drawn before the shading that needs them.
-                let u_bsdf = h.next_2d();
-                let u_rr = h.next();
-                let mut bsdf = Bsdf::empty();
-                shade(scene, &hit, &mut s, material, true, None, &mut bsdf);
-                let wo = -ray.d;
-                let Some(bs) = bsdf.sample(wo, u_bsdf, BxdfFlags::ALL) else {
-                    break 'step None;
-                };
-                if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
-                    break 'step None;
-                }
-                let bnew =
-                    beta * bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf * importance(&bsdf, &bs, wo);
-                let q = (1.0 - luminance(bnew) / luminance(beta)).max(0.0);
-                if u_rr < q {
-                    break 'step None;
-                }
-                Some((
-                    bnew / (1.0 - q),
-                    spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi),
-                ))
-            };
+        Some(PhotonLane {
+            at,
+            index,
+            dim,
+            ray: e.ray,
+            time,
+            beta,
+            depth: 0,
+            crossed: 0,
+        })
+    }
+
+    /// One vertex of a photon's path, where its ray met `hit`: its
+    /// contributions pushed to `recs`; whether it goes on (`lane.ray` its
+    /// next ray).
+    fn photon_step(
+        &self,
+        scene: &RenderScene,
+        (grid, vps): (&Grid, &VisiblePoints),
+        (runs, bases): (&mut PhotonRuns, &[RadicalTable]),
+        lane: &mut PhotonLane,
+        hit: &Option<Hit>,
+        recs: &mut Vec<(u32, Vec3)>,
+    ) -> bool {
+        let PhotonLane {
+            ray,
+            time,
+            beta,
+            depth,
+            ..
+        } = *lane;
+        let Some(hit) = hit else {
+            return false;
+        };
+        let mut s = scene.aggregate.surface_at(hit, time);
+        let material = &scene.materials[s.material as usize];
+        if material.is_none() {
             if depth > 0 {
                 grid.gather(s.point.p, -ray.d, beta, vps, recs);
             }
-            let Some((b, r)) = next else {
-                return;
-            };
-            beta = b;
-            ray = r;
-            depth += 1;
+            lane.crossed += 1;
+            if lane.crossed > MAX_PASS_THROUGH {
+                return false;
+            }
+            lane.ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, ray.d);
+            return true;
         }
+        let mut h = Halton {
+            bases,
+            runs,
+            index: lane.index,
+            at: lane.at,
+            dim: lane.dim,
+        };
+        // The photon's next ray first, the visible points it reaches here
+        // after it: the gather is off the path's critical chain (the step
+        // changes neither the ray, the power nor the point).
+        let next = 'step: {
+            // This vertex's dimensions (the BSDF sample's and Russian
+            // roulette's), drawn before the shading that needs them.
+            let u_bsdf = h.next_2d();
+            let u_rr = h.next();
+            lane.dim = h.dim;
+            let mut bsdf = Bsdf::empty();
+            shade(scene, hit, &mut s, material, true, None, &mut bsdf);
+            let wo = -ray.d;
+            let Some(bs) = bsdf.sample(wo, u_bsdf, BxdfFlags::ALL) else {
+                break 'step None;
+            };
+            if bs.f == Vec3::ZERO || bs.pdf == 0.0 {
+                break 'step None;
+            }
+            let bnew =
+                beta * bs.f * bs.wi.dot(s.point.ns).abs() / bs.pdf * importance(&bsdf, &bs, wo);
+            let q = (1.0 - luminance(bnew) / luminance(beta)).max(0.0);
+            if u_rr < q {
+                break 'step None;
+            }
+            Some((
+                bnew / (1.0 - q),
+                spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi),
+            ))
+        };
+        if depth > 0 {
+            grid.gather(s.point.p, -ray.d, beta, vps, recs);
+        }
+        let Some((b, r)) = next else {
+            return false;
+        };
+        lane.beta = b;
+        lane.ray = r;
+        lane.depth += 1;
+        lane.depth < self.settings.max_depth
     }
 }
 
@@ -1211,24 +1339,49 @@ mod tests {
         let bases: Vec<RadicalTable> = PRIMES.iter().map(|&p| RadicalTable::new(p)).collect();
         let mut r = Pcg32::with_sequence(9);
         for (first, len) in [(0u64, 256usize), (1_000_000, 256), (4095, 17), (1 << 40, 30)] {
-            let mut runs = PhotonRuns::new(len, &bases);
-            for index in first..first + len as u64 {
-                let dims = match r.uniform_u32() % 8 {
-                    0 => 0,
-                    1 => bases.len() + 5,
-                    k => (r.uniform_u32() % (6 + 12 * k)) as usize,
-                };
-                let mut h = Halton {
-                    bases: &bases,
-                    runs: &mut runs,
-                    index,
-                    at: (index - first) as usize,
-                    dim: 0,
-                };
-                for d in 0..dims {
-                    let want = bases[d % bases.len()].radical_inverse(index);
-                    assert_eq!(h.next().to_bits(), want.to_bits(), "index {index} dim {d}");
+            for lanes in [1, 3, 16] {
+                // Photons under way side by side, started in order, each
+                // drawing its dimensions a few at a time in turns, as
+                // `trace_photons` draws them (a later photon may draw a
+                // dimension first).
+                let mut runs = PhotonRuns::new(len, &bases);
+                let mut under_way: Vec<(usize, usize, usize)> = Vec::new(); // (at, dim, dims)
+                let mut next = 0;
+                let mut drawn = 0;
+                while next < len || !under_way.is_empty() {
+                    while under_way.len() < lanes && next < len {
+                        let dims = match r.uniform_u32() % 8 {
+                            0 => 0,
+                            1 => bases.len() + 5,
+                            k => (r.uniform_u32() % (6 + 12 * k)) as usize,
+                        };
+                        under_way.push((next, 0, dims));
+                        next += 1;
+                    }
+                    let k = r.uniform_u32_below(under_way.len() as u32) as usize;
+                    runs.low = under_way.iter().map(|u| u.0).min().unwrap();
+                    let (at, dim, dims) = under_way[k];
+                    let index = first + at as u64;
+                    let mut h = Halton {
+                        bases: &bases,
+                        runs: &mut runs,
+                        index,
+                        at,
+                        dim: dim % bases.len(),
+                    };
+                    let end = dims.min(dim + 1 + r.uniform_u32_below(6) as usize);
+                    for d in dim..end {
+                        let want = bases[d % bases.len()].radical_inverse(index);
+                        assert_eq!(h.next().to_bits(), want.to_bits(), "index {index} dim {d}");
+                        drawn += 1;
+                    }
+                    if end == dims {
+                        under_way.swap_remove(k);
+                    } else {
+                        under_way[k].1 = end;
+                    }
                 }
+                assert!(drawn > len, "{drawn} values drawn");
             }
         }
     }
