@@ -406,29 +406,46 @@ impl Sppm {
         // Each pixel's photons of the iteration (flux and count), zeroed
         // again as the pixels are updated.
         let mut acc = vec![(DVec3::ZERO, 0u32); n_pixels];
-        for iter in 0..s.iterations {
-            counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
-            run.pool.install(|| grid.rebuild(&pixels, &vps.points));
-            let c = self.photon_pass(run, &grid, &vps, &bases, iter, photons, &mut acc);
-            counts.add(&c);
-            let k = iter + 1;
-            let write = k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
-            let np = k as u64 * photons as u64;
-            // Each pixel on its own: in parallel, the same values.
-            run.pool.install(|| {
-                (pixels.par_iter_mut(), vps.points.par_iter_mut(), acc.par_iter_mut(), image.par_iter_mut())
-                    .into_par_iter()
-                    .for_each(|(p, vp, a, l)| {
-                        let (phi, m) = std::mem::take(a);
-                        update_pixel(p, vp, phi, m);
-                        *l = p.ld / k as f32;
-                        if np > 0 && p.radius > 0.0 {
-                            *l += p.tau / (np as f32 * std::f32::consts::PI * p.radius * p.radius);
-                        }
-                    })
+        // The iterations run as one job on the render's threads (a pass
+        // started from outside them waits for a thread to wake up and then
+        // wakes this one: two thread switches per pass, a tenth of a small
+        // scene's time); this thread hands each iteration's image to `done`
+        // while the next iteration runs.
+        let (images, finished) = std::sync::mpsc::sync_channel::<(u32, Vec<Vec3>, bool)>(1);
+        run.pool.in_place_scope(|scope| {
+            scope.spawn(|_| {
+                // Moved in: dropped when the iterations end, which ends
+                // the loop below.
+                let images = images;
+                for iter in 0..s.iterations {
+                    counts.add(&self.camera_pass(run, &sampler, &mut pixels, &mut vps, iter));
+                    grid.rebuild(&pixels, &vps.points);
+                    let c = self.photon_pass(run, &grid, &vps, &bases, iter, photons, &mut acc);
+                    counts.add(&c);
+                    let k = iter + 1;
+                    let write =
+                        k == s.iterations || (s.write_frequency > 0 && k % s.write_frequency == 0);
+                    let np = k as u64 * photons as u64;
+                    // Each pixel on its own: in parallel, the same values.
+                    (pixels.par_iter_mut(), vps.points.par_iter_mut(), acc.par_iter_mut(), image.par_iter_mut())
+                        .into_par_iter()
+                        .for_each(|(p, vp, a, l)| {
+                            let (phi, m) = std::mem::take(a);
+                            update_pixel(p, vp, phi, m);
+                            *l = p.ld / k as f32;
+                            if np > 0 && p.radius > 0.0 {
+                                *l += p.tau / (np as f32 * std::f32::consts::PI * p.radius * p.radius);
+                            }
+                        });
+                    if images.send((k, image.clone(), write)).is_err() {
+                        return;
+                    }
+                }
             });
-            done(k, &image, write);
-        }
+            for (k, image, write) in finished.iter() {
+                done(k, &image, write);
+            }
+        });
         counts
     }
 
