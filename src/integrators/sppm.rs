@@ -737,9 +737,9 @@ struct PhotonRuns {
     fills: u32,
     /// Bit `d`: dimension `d` is filled from some photon on.
     filled: u32,
-    /// The first place in the chunk whose photon may still draw values: a
-    /// dimension is filled from there on.
-    low: usize,
+    /// The places in the chunk of the photons under way, one per lane
+    /// (`u32::MAX`: none): a dimension is filled from the first of them on.
+    under_way: [u32; LANES],
     values: Vec<f32>,
 }
 
@@ -765,7 +765,7 @@ impl PhotonRuns {
             len,
             fills,
             filled: 0,
-            low: 0,
+            under_way: [u32::MAX; LANES],
             values,
         }
     }
@@ -801,7 +801,7 @@ impl Halton<'_, '_> {
             if runs.filled & (1 << d) == 0 {
                 // The photons from the first that may still draw values
                 // to the chunk's end.
-                let low = runs.low.min(self.at);
+                let low = (runs.under_way.iter().copied().min().unwrap_or(u32::MAX) as usize).min(self.at);
                 let first = self.index - (self.at - low) as u64;
                 let row = &mut runs.values[d * runs.len..(d + 1) * runs.len];
                 self.bases[d].fill(first, &mut row[low..]);
@@ -848,8 +848,11 @@ impl Sppm {
         loop {
             for k in 0..LANES {
                 while lanes[k].is_none() && next < len {
-                    runs.low = lanes.iter().flatten().map(|l| l.at).fold(next, usize::min);
+                    runs.under_way[k] = next as u32;
                     lanes[k] = self.emit_photon(scene, (runs, bases), from + next as u64, next);
+                    if lanes[k].is_none() {
+                        runs.under_way[k] = u32::MAX;
+                    }
                     next += 1;
                 }
             }
@@ -863,7 +866,6 @@ impl Sppm {
             if n == 0 {
                 break;
             }
-            runs.low = lanes.iter().flatten().map(|l| l.at).fold(len, usize::min);
             counts.closest += n as u64;
             scene
                 .aggregate
@@ -877,6 +879,7 @@ impl Sppm {
                 places.resize(places.len() + recs.len() - before, l.at as u16);
                 if !goes_on {
                     lanes[k] = None;
+                    runs.under_way[k] = u32::MAX;
                 }
             }
         }
@@ -1376,7 +1379,10 @@ mod tests {
                         next += 1;
                     }
                     let k = r.uniform_u32_below(under_way.len() as u32) as usize;
-                    runs.low = under_way.iter().map(|u| u.0).min().unwrap();
+                    runs.under_way = [u32::MAX; LANES];
+                    for (slot, u) in runs.under_way.iter_mut().zip(&under_way) {
+                        *slot = u.0 as u32;
+                    }
                     let (at, dim, dims) = under_way[k];
                     let index = first + at as u64;
                     let mut h = Halton {
