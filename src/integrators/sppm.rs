@@ -846,11 +846,11 @@ impl Sppm {
         let mut hits = [None; LANES];
         let mut which = [0usize; LANES];
         loop {
-            for k in 0..LANES {
-                while lanes[k].is_none() && next < len {
+            for (k, lane) in lanes.iter_mut().enumerate() {
+                while lane.is_none() && next < len {
                     runs.under_way[k] = next as u32;
-                    lanes[k] = self.emit_photon(scene, (runs, bases), from + next as u64, next);
-                    if lanes[k].is_none() {
+                    *lane = self.emit_photon(scene, (runs, bases), from + next as u64, next);
+                    if lane.is_none() {
                         runs.under_way[k] = u32::MAX;
                     }
                     next += 1;
