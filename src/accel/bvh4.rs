@@ -468,48 +468,7 @@ impl Bvh4 {
                 let (t0, hit_box) = br.test(n, reach(t_max));
                 let mask = hit_box.bitmask();
                 if mask != 0 {
-                    // The nearest child next; the others stacked without
-                    // branches (every lane is written, the stack pointer
-                    // moves past the hit ones), culled by distance when
-                    // popped.
-                    let t0m = Vec4::select(hit_box, t0, Vec4::INFINITY);
-                    let near = (t0m.cmpeq(Vec4::splat(t0m.min_element())).bitmask() & mask)
-                        .trailing_zeros() as usize;
-                    let rest = mask & !(1 << near);
-                    let ts = t0.to_array();
-                    if rest & rest.wrapping_sub(1) == 0 {
-                        for (i, (&c, t)) in n.child.iter().zip(ts).enumerate() {
-                            stack[sp] = MaybeUninit::new((c, t));
-                            sp += ((rest >> i) & 1) as usize;
-                        }
-                    } else {
-                        // Two or three more: pushed far to near, so that the
-                        // nearer ones are popped first.
-                        let mut e = [(0u32, 0f32); 3];
-                        let mut k = 0;
-                        let mut m = rest;
-                        while m != 0 {
-                            let i = m.trailing_zeros() as usize;
-                            e[k] = (n.child[i], ts[i]);
-                            k += 1;
-                            m &= m - 1;
-                        }
-                        if e[0].1 < e[1].1 {
-                            e.swap(0, 1);
-                        }
-                        if k == 3 {
-                            if e[1].1 < e[2].1 {
-                                e.swap(1, 2);
-                            }
-                            if e[0].1 < e[1].1 {
-                                e.swap(0, 1);
-                            }
-                        }
-                        for (slot, &x) in stack[sp..sp + 3].iter_mut().zip(&e) {
-                            *slot = MaybeUninit::new(x);
-                        }
-                        sp += k;
-                    }
+                    let near = stack_children(n, (t0, hit_box, mask), stack, &mut sp);
                     cur = n.child[near];
                     continue;
                 }
@@ -541,18 +500,9 @@ impl Bvh4 {
                 }
             }
             // Next: the nearest stacked entry that can still be closer.
-            loop {
-                if sp == 0 {
-                    return found;
-                }
-                sp -= 1;
-                // SAFETY: entries below the stack pointer were written
-                // (the pointer only moves past written entries).
-                let (c, t0) = unsafe { stack[sp].assume_init() };
-                if t0 <= reach(t_max) {
-                    cur = c;
-                    break;
-                }
+            match pop_within(stack, &mut sp, t_max) {
+                Some(c) => cur = c,
+                None => return found,
             }
         }
     }
@@ -661,6 +611,80 @@ fn only_triangles(leaves: &[Leaf]) -> bool {
 /// are within far less than this margin of the exact distances, which are
 /// in that order). The boxes visited then do not depend on the order of
 /// the hits found before.
+/// A node's step of a closest-hit traversal, where the ray meets the boxes
+/// of `mask` (not empty) at entry distances `t0`: returns the slot of the
+/// nearest, to be visited next, and stacks the others without branches
+/// (every lane is written, the stack pointer `sp` moves past the hit
+/// ones; two or three more are stacked far to near, so that the nearer
+/// are popped first), to be culled by distance when popped.
+#[inline(always)]
+pub(super) fn stack_children(
+    n: &Node,
+    (t0, hit_box, mask): (Vec4, BVec4A, u32),
+    stack: &mut [MaybeUninit<(u32, f32)>],
+    sp: &mut usize,
+) -> usize {
+    let t0m = Vec4::select(hit_box, t0, Vec4::INFINITY);
+    let near =
+        (t0m.cmpeq(Vec4::splat(t0m.min_element())).bitmask() & mask).trailing_zeros() as usize;
+    let rest = mask & !(1 << near);
+    let ts = t0.to_array();
+    if rest & rest.wrapping_sub(1) == 0 {
+        for (i, (&c, t)) in n.child.iter().zip(ts).enumerate() {
+            stack[*sp] = MaybeUninit::new((c, t));
+            *sp += ((rest >> i) & 1) as usize;
+        }
+    } else {
+        let mut e = [(0u32, 0f32); 3];
+        let mut k = 0;
+        let mut m = rest;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            e[k] = (n.child[i], ts[i]);
+            k += 1;
+            m &= m - 1;
+        }
+        if e[0].1 < e[1].1 {
+            e.swap(0, 1);
+        }
+        if k == 3 {
+            if e[1].1 < e[2].1 {
+                e.swap(1, 2);
+            }
+            if e[0].1 < e[1].1 {
+                e.swap(0, 1);
+            }
+        }
+        for (slot, &x) in stack[*sp..*sp + 3].iter_mut().zip(&e) {
+            *slot = MaybeUninit::new(x);
+        }
+        *sp += k;
+    }
+    near
+}
+
+/// The nearest stacked entry (below `sp`) whose box can still hold a hit
+/// as near as `t_max`, if any; those past it are dropped.
+#[inline(always)]
+pub(super) fn pop_within(
+    stack: &[MaybeUninit<(u32, f32)>],
+    sp: &mut usize,
+    t_max: f32,
+) -> Option<u32> {
+    loop {
+        if *sp == 0 {
+            return None;
+        }
+        *sp -= 1;
+        // SAFETY: entries below the stack pointer were written (the
+        // pointer only moves past written entries).
+        let (c, t0) = unsafe { stack[*sp].assume_init() };
+        if t0 <= reach(t_max) {
+            return Some(c);
+        }
+    }
+}
+
 #[inline(always)]
 pub(super) fn reach(t_max: f32) -> f32 {
     t_max * (1.0 + 1.0 / 65536.0)

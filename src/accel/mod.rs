@@ -994,38 +994,33 @@ impl Aggregate {
     /// camera rays).
     #[inline(never)]
     pub fn intersect_packet(&self, rays: &[Ray], times: &[f32], out: &mut [Option<Hit>]) {
-        let n = rays.len();
-        match self.top.bvh.as_ref() {
-            Some(bvh) if bvh.traces_packets() && n <= PACKET_MAX => {
-                let mut found = [None; PACKET_MAX];
-                bvh.closest_packet(rays, &mut found[..n]);
-                for (o, f) in out[..n].iter_mut().zip(&found[..n]) {
-                    *o = f.map(|(pos, t, b)| {
-                        let prim = self.top.prims[pos as usize];
-                        prefetch_indices(&self.meshes, prim);
-                        triangle_hit(prim, t, b)
-                    });
-                }
-            }
-            _ => {
-                for ((r, &time), o) in rays.iter().zip(times).zip(out.iter_mut()) {
-                    self.intersect_into(r, time, o);
-                }
-            }
-        }
+        self.closest_together(rays, times, out, Bvh4::closest_packet);
     }
 
     /// The closest hits of incoherent `rays` (at scene times `times`) in
     /// `out`, each [`Aggregate::intersect_into`]'s: traced side by side
-    /// ([`stream`]) when the scene is triangles only and there are at most
-    /// [`stream::STREAM_MAX`], else ray by ray.
+    /// ([`stream`]) when the scene is triangles only (as for packets) and
+    /// there are at most [`PACKET_MAX`], else ray by ray.
     #[inline(never)]
     pub fn intersect_stream(&self, rays: &[Ray], times: &[f32], out: &mut [Option<Hit>]) {
+        self.closest_together(rays, times, out, Bvh4::closest_stream);
+    }
+
+    /// [`Aggregate::intersect_packet`] or [`Aggregate::intersect_stream`],
+    /// whose traversal `trace` is.
+    #[inline(always)]
+    fn closest_together(
+        &self,
+        rays: &[Ray],
+        times: &[f32],
+        out: &mut [Option<Hit>],
+        trace: impl Fn(&Bvh4, &[Ray], &mut [packet::PacketHit]),
+    ) {
         let n = rays.len();
         match self.top.bvh.as_ref() {
-            Some(bvh) if bvh.traces_streams() && n <= stream::STREAM_MAX => {
-                let mut found = [None; stream::STREAM_MAX];
-                bvh.closest_stream(rays, &mut found[..n]);
+            Some(bvh) if bvh.traces_packets() && n <= PACKET_MAX => {
+                let mut found = [None; PACKET_MAX];
+                trace(bvh, rays, &mut found[..n]);
                 for (o, f) in out[..n].iter_mut().zip(&found[..n]) {
                     *o = f.map(|(pos, t, b)| {
                         let prim = self.top.prims[pos as usize];

@@ -29,7 +29,7 @@ pub const PACKET_MAX: usize = 16;
 
 /// Stack entries a packet traversal has room for (a deeper tree is traced
 /// ray by ray).
-const STACK: usize = 64;
+pub(super) const STACK: usize = 64;
 
 /// A ray's closest triangle: (BVH position, t, barycentrics).
 pub(super) type PacketHit = Option<(u32, f32, [f32; 3])>;
@@ -340,6 +340,20 @@ pub(super) mod tests {
             .collect()
     }
 
+    /// A ray's closest triangle found by the single-ray traversal.
+    pub(in crate::accel) fn closest_alone(bvh: &Bvh4, r: &Ray) -> PacketHit {
+        match bvh.closest(r, r.t_max, |_, _| None) {
+            Closest::Triangle { pos, t, b } => Some((pos, t, b)),
+            Closest::Nothing => None,
+            Closest::Other => unreachable!("triangles only"),
+        }
+    }
+
+    /// A hit as bits, for exact comparisons.
+    pub(in crate::accel) fn hit_bits(h: &PacketHit) -> Option<(u32, u32, [u32; 3])> {
+        h.map(|(pos, t, b)| (pos, t.to_bits(), b.map(f32::to_bits)))
+    }
+
     /// Whether a ray meets the sphere (centre, radius) at a t in (0, t_max].
     fn meets_sphere(r: &Ray, (c, radius): (Vec3, f32)) -> bool {
         let oc = r.o - c;
@@ -425,15 +439,8 @@ pub(super) mod tests {
                 let mut out = [None; PACKET_MAX];
                 bvh.closest_packet(&rays, &mut out[..len]);
                 for (r, got) in rays.iter().zip(&out) {
-                    let alone = match bvh.closest(r, r.t_max, |_, _| None) {
-                        Closest::Triangle { pos, t, b } => Some((pos, t, b)),
-                        Closest::Nothing => None,
-                        Closest::Other => unreachable!("triangles only"),
-                    };
-                    let bits = |h: &PacketHit| {
-                        h.map(|(pos, t, b)| (pos, t.to_bits(), b.map(f32::to_bits)))
-                    };
-                    assert_eq!(bits(got), bits(&alone), "ray {r:?}");
+                    let alone = closest_alone(&bvh, r);
+                    assert_eq!(hit_bits(got), hit_bits(&alone), "ray {r:?}");
                     if let Some((_, t, _)) = alone {
                         hits += 1;
                         // Triangles hit at the very same distance: the

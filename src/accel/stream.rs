@@ -6,19 +6,18 @@
 //! finds what [`Bvh4::closest_hinted`] finds for it alone: the same
 //! arithmetic in the same order, ray by ray.
 
-use super::bvh4::{closer, lane_limit, reach, BoxRay, Bvh4, LEAF};
+use super::bvh4::{closer, lane_limit, pop_within, reach, stack_children, BoxRay, Bvh4, LEAF};
 use super::packet::PacketHit;
 use crate::geometry::Ray;
 use crate::shapes::TriangleRay4;
-use glam::Vec4;
 use std::mem::MaybeUninit;
 
 /// Most rays traced side by side.
-pub const STREAM_MAX: usize = 16;
+pub const STREAM_MAX: usize = super::packet::PACKET_MAX;
 
-/// Stack entries each ray has room for (a deeper tree is traced ray by
-/// ray).
-const STACK: usize = 64;
+/// Stack entries each ray has room for: a packet's ([`Bvh4::traces_packets`]
+/// says whether the tree fits).
+const STACK: usize = super::packet::STACK;
 
 struct Lane {
     br: BoxRay,
@@ -31,17 +30,12 @@ struct Lane {
 }
 
 impl Bvh4 {
-    /// Whether [`Bvh4::closest_stream`] can trace this tree (triangles
-    /// only, and a stack it has room for).
-    pub(super) fn traces_streams(&self) -> bool {
-        self.only_triangles && self.stack_need <= STACK
-    }
-
     /// The closest hit of each of `rays` (at most [`STREAM_MAX`]) with
-    /// `t <= ray.t_max`, in `out`. Only where [`Bvh4::traces_streams`].
+    /// `t <= ray.t_max`, in `out`. Only where [`Bvh4::traces_packets`] (triangles
+    /// only, and a stack of [`STACK`] entries is enough).
     pub(super) fn closest_stream(&self, rays: &[Ray], out: &mut [PacketHit]) {
         let n = rays.len();
-        assert!(n <= STREAM_MAX && out.len() == n && self.traces_streams());
+        assert!(n <= STREAM_MAX && out.len() == n && self.traces_packets());
         let mut lanes = [const { MaybeUninit::<Lane>::uninit() }; STREAM_MAX];
         for (i, r) in rays.iter().enumerate() {
             lanes[i].write(Lane {
@@ -67,55 +61,17 @@ impl Bvh4 {
         while active != 0 {
             let mut m = active;
             while m != 0 {
-                let j = m.trailing_zeros() as usize;
+                let i = m.trailing_zeros() as usize;
                 m &= m - 1;
-                let i = j;
                 let l = &mut lanes[i];
-                let stack = &mut stacks[j];
+                let stack = &mut stacks[i];
                 let cur = l.cur;
                 if cur & LEAF == 0 {
                     let n = &self.nodes[cur as usize];
                     let (t0, hit_box) = l.br.test(n, reach(l.t_max));
                     let mask = hit_box.bitmask();
                     if mask != 0 {
-                        let t0m = Vec4::select(hit_box, t0, Vec4::INFINITY);
-                        let near = (t0m.cmpeq(Vec4::splat(t0m.min_element())).bitmask() & mask)
-                            .trailing_zeros() as usize;
-                        let rest = mask & !(1 << near);
-                        let ts = t0.to_array();
-                        let mut sp = l.sp;
-                        if rest & rest.wrapping_sub(1) == 0 {
-                            for (i, (&c, t)) in n.child.iter().zip(ts).enumerate() {
-                                stack[sp] = MaybeUninit::new((c, t));
-                                sp += ((rest >> i) & 1) as usize;
-                            }
-                        } else {
-                            let mut e = [(0u32, 0f32); 3];
-                            let mut k = 0;
-                            let mut r = rest;
-                            while r != 0 {
-                                let i = r.trailing_zeros() as usize;
-                                e[k] = (n.child[i], ts[i]);
-                                k += 1;
-                                r &= r - 1;
-                            }
-                            if e[0].1 < e[1].1 {
-                                e.swap(0, 1);
-                            }
-                            if k == 3 {
-                                if e[1].1 < e[2].1 {
-                                    e.swap(1, 2);
-                                }
-                                if e[0].1 < e[1].1 {
-                                    e.swap(0, 1);
-                                }
-                            }
-                            for (slot, &x) in stack[sp..sp + 3].iter_mut().zip(&e) {
-                                *slot = MaybeUninit::new(x);
-                            }
-                            sp += k;
-                        }
-                        l.sp = sp;
+                        let near = stack_children(n, (t0, hit_box, mask), stack, &mut l.sp);
                         l.cur = n.child[near];
                         continue;
                     }
@@ -134,18 +90,9 @@ impl Bvh4 {
                         }
                     }
                 }
-                loop {
-                    if l.sp == 0 {
-                        active &= !(1 << j);
-                        break;
-                    }
-                    l.sp -= 1;
-                    // SAFETY: entries below the stack pointer were written.
-                    let (c, t0) = unsafe { stack[l.sp].assume_init() };
-                    if t0 <= reach(l.t_max) {
-                        l.cur = c;
-                        break;
-                    }
+                match pop_within(stack, &mut l.sp, l.t_max) {
+                    Some(c) => l.cur = c,
+                    None => active &= !(1 << i),
                 }
             }
         }
@@ -156,8 +103,7 @@ impl Bvh4 {
 mod tests {
     use super::*;
     use crate::accel::bvh4::tests::build;
-    use crate::accel::bvh4::Closest;
-    use crate::accel::packet::tests::{packet, point, scene};
+    use crate::accel::packet::tests::{closest_alone, hit_bits, packet, point, scene};
     use crate::sampling::rng::Pcg32;
 
     /// Rays of every kind mixed (a few of them from each of several
@@ -171,7 +117,7 @@ mod tests {
         for n in [1, 4, 20, 300, 3000] {
             let tris = scene(&mut rng, n);
             let (bvh, _) = build(&tris, &[]);
-            assert!(bvh.traces_streams());
+            assert!(bvh.traces_packets());
             for _ in 0..400 {
                 let len = 1 + rng.uniform_u32_below(STREAM_MAX as u32) as usize;
                 let mut rays = Vec::new();
@@ -187,15 +133,8 @@ mod tests {
                 let mut out = [Some((0, 0.0, [0.0; 3])); STREAM_MAX];
                 bvh.closest_stream(&rays, &mut out[..len]);
                 for (r, got) in rays.iter().zip(&out) {
-                    let alone = match bvh.closest(r, r.t_max, |_, _| None) {
-                        Closest::Triangle { pos, t, b } => Some((pos, t, b)),
-                        Closest::Nothing => None,
-                        Closest::Other => unreachable!("triangles only"),
-                    };
-                    let bits = |h: &PacketHit| {
-                        h.map(|(pos, t, b)| (pos, t.to_bits(), b.map(f32::to_bits)))
-                    };
-                    assert_eq!(bits(got), bits(&alone), "ray {r:?}");
+                    let alone = closest_alone(&bvh, r);
+                    assert_eq!(hit_bits(got), hit_bits(&alone), "ray {r:?}");
                     if alone.is_some() {
                         hits += 1;
                     } else {

@@ -320,6 +320,46 @@ pub struct SppmRun<'r> {
 /// Camera paths a row advances side by side.
 const LANES: usize = 16;
 
+/// The rays of the lanes under way, traced side by side.
+struct LaneRays {
+    rays: [Ray; LANES],
+    times: [f32; LANES],
+    /// Their closest hits, and the lane of each.
+    hits: [Option<Hit>; LANES],
+    which: [usize; LANES],
+}
+
+impl Default for LaneRays {
+    fn default() -> LaneRays {
+        LaneRays {
+            rays: [Ray::new(Vec3::ZERO, Vec3::Z); LANES],
+            times: [0.0; LANES],
+            hits: [None; LANES],
+            which: [0; LANES],
+        }
+    }
+}
+
+impl LaneRays {
+    /// Traces the ray (and time) `of` each lane under way together
+    /// (`Aggregate::intersect_stream`); returns how many there were: the
+    /// first that many `hits` and `which` are theirs.
+    fn trace<L>(&mut self, lanes: &[Option<L>], of: impl Fn(&L) -> (Ray, f32), scene: &RenderScene) -> usize {
+        let mut n = 0;
+        for (k, lane) in lanes.iter().enumerate() {
+            if let Some(l) = lane {
+                (self.rays[n], self.times[n]) = of(l);
+                self.which[n] = k;
+                n += 1;
+            }
+        }
+        scene
+            .aggregate
+            .intersect_stream(&self.rays[..n], &self.times[..n], &mut self.hits[..n]);
+        n
+    }
+}
+
 /// A camera path under way: the `pixel`th of its row, its next ray and
 /// what pbrt-v3's camera loop keeps.
 #[derive(Clone, Copy)]
@@ -485,31 +525,22 @@ impl Sppm {
                 lobes.clear();
                 let y = pb.min.y + row as i32;
                 let mut next = 0;
-                let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
-                let mut times = [0f32; LANES];
-                let mut hits = [None; LANES];
-                let mut which = [0usize; LANES];
+                let mut traced = LaneRays::default();
                 loop {
-                    let mut n = 0;
-                    for (k, (lane, sampler)) in lanes.iter_mut().zip(&mut samplers).enumerate() {
+                    for (lane, sampler) in lanes.iter_mut().zip(&mut samplers) {
                         while lane.is_none() && next < px.len() {
                             let pixel = IVec2::new(pb.min.x + next as i32, y);
                             sampler.start_pixel_sample(pixel, iter);
                             *lane = self.camera_lane(scene, sampler, pixel, next);
                             next += 1;
                         }
-                        if let Some(l) = lane {
-                            (rays[n], times[n], which[n]) = (l.ray, l.time, k);
-                            n += 1;
-                        }
                     }
+                    let n = traced.trace(&lanes, |l| (l.ray, l.time), scene);
                     if n == 0 {
                         break;
                     }
                     scratch.counts.closest += n as u64;
-                    scene
-                        .aggregate
-                        .intersect_stream(&rays[..n], &times[..n], &mut hits[..n]);
+                    let LaneRays { hits, which, .. } = &traced;
                     for (&k, hit) in which[..n].iter().zip(&hits[..n]) {
                         let Some(l) = lanes[k].as_mut() else {
                             continue;
@@ -841,10 +872,7 @@ impl Sppm {
         let mut places: Vec<u16> = Vec::new();
         let mut mine = Vec::new();
         let mut next = 0;
-        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
-        let mut times = [0f32; LANES];
-        let mut hits = [None; LANES];
-        let mut which = [0usize; LANES];
+        let mut traced = LaneRays::default();
         loop {
             for (k, lane) in lanes.iter_mut().enumerate() {
                 while lane.is_none() && next < len {
@@ -856,20 +884,12 @@ impl Sppm {
                     next += 1;
                 }
             }
-            let mut n = 0;
-            for (k, lane) in lanes.iter().enumerate() {
-                if let Some(l) = lane {
-                    (rays[n], times[n], which[n]) = (l.ray, l.time, k);
-                    n += 1;
-                }
-            }
+            let n = traced.trace(&lanes, |l| (l.ray, l.time), scene);
             if n == 0 {
                 break;
             }
             counts.closest += n as u64;
-            scene
-                .aggregate
-                .intersect_stream(&rays[..n], &times[..n], &mut hits[..n]);
+            let LaneRays { hits, which, .. } = &traced;
             for (&k, hit) in which[..n].iter().zip(&hits[..n]) {
                 let Some(l) = lanes[k].as_mut() else {
                     continue;
