@@ -482,6 +482,10 @@ impl Sppm {
                     }
                 }
             });
+            // Moved in too: if `done` panics, the receiver is dropped on the
+            // way out, so the iterations' job stops at its next send
+            // instead of waiting for room.
+            let finished = finished;
             for (k, image, write) in finished.iter() {
                 done(k, &image, write);
             }
