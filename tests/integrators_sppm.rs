@@ -29,6 +29,26 @@ fn caustic(iterations: u32) -> SceneDescription {
     d
 }
 
+/// The Cornell box (`cornell-path`) at `w`×`h` pixels.
+fn cornell(w: u32, h: u32) -> SceneDescription {
+    let mut d = load("scenes/cornell-path.pbrt");
+    d.film.xresolution = w;
+    d.film.yresolution = h;
+    d
+}
+
+/// `sppm` with these iterations, photons per iteration, maximum depth and
+/// radius.
+fn sppm(iterations: u32, photons: u32, max_depth: u32, radius: f32) -> IntegratorSettings {
+    IntegratorSettings::Sppm(SppmSettings {
+        iterations,
+        photons_per_iteration: photons,
+        max_depth,
+        radius,
+        write_frequency: 0,
+    })
+}
+
 #[test]
 fn the_image_does_not_depend_on_the_thread_count() {
     let mut d = caustic(6);
@@ -47,16 +67,8 @@ fn the_image_does_not_depend_on_the_thread_count() {
 /// pixels and chunks of 256 photons end with partly filled lanes).
 #[test]
 fn side_by_side_paths_do_not_depend_on_the_thread_count() {
-    let mut d = load("scenes/cornell-path.pbrt");
-    d.film.xresolution = 20;
-    d.film.yresolution = 12;
-    d.integrator = IntegratorSettings::Sppm(SppmSettings {
-        iterations: 4,
-        photons_per_iteration: 3000,
-        max_depth: 5,
-        radius: 0.1,
-        write_frequency: 0,
-    });
+    let mut d = cornell(20, 12);
+    d.integrator = sppm(4, 3000, 5, 0.1);
     let a = render_threads(&d, 1);
     let b = render_threads(&d, 2);
     assert!(mean(&a) > 0.0);
@@ -95,18 +107,10 @@ fn the_caustic_path_cannot_find_is_there() {
 /// by the image mean and 4×4 block means.
 #[test]
 fn on_a_diffuse_scene_sppm_converges_to_path() {
-    let mut d = load("scenes/cornell-path.pbrt");
-    d.film.xresolution = 16;
-    d.film.yresolution = 16;
+    let mut d = cornell(16, 16);
     let mut p = d.clone();
     p.sampler.pixel_samples = 4096;
-    d.integrator = IntegratorSettings::Sppm(SppmSettings {
-        iterations: 256,
-        photons_per_iteration: 16384,
-        max_depth: 8,
-        radius: 0.04,
-        write_frequency: 0,
-    });
+    d.integrator = sppm(256, 16384, 8, 0.04);
     let sppm = render_threads(&d, 2);
     let path = render_threads(&p, 2);
     let (ms, mp) = (mean(&sppm), mean(&path));
