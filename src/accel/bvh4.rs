@@ -604,13 +604,6 @@ fn only_triangles(leaves: &[Leaf]) -> bool {
     leaves.iter().all(|l| l.triangles == (1 << l.count) - 1)
 }
 
-/// How far a closest-hit query still looks for boxes when the closest hit
-/// so far is at `t_max`: a little farther, so that a triangle as near as
-/// that hit (which may win by the tie rule) is not lost to its box's
-/// entry distance rounding to more than the triangle's own distance (both
-/// are within far less than this margin of the exact distances, which are
-/// in that order). The boxes visited then do not depend on the order of
-/// the hits found before.
 /// A node's step of a closest-hit traversal, where the ray meets the boxes
 /// of `mask` (not empty) at entry distances `t0`: returns the slot of the
 /// nearest, to be visited next, and stacks the others without branches
@@ -685,6 +678,13 @@ pub(super) fn pop_within(
     }
 }
 
+/// How far a closest-hit query still looks for boxes when the closest hit
+/// so far is at `t_max`: a little farther, so that a triangle as near as
+/// that hit (which may win by the tie rule) is not lost to its box's
+/// entry distance rounding to more than the triangle's own distance (both
+/// are within far less than this margin of the exact distances, which are
+/// in that order). The boxes visited then do not depend on the order of
+/// the hits found before.
 #[inline(always)]
 pub(super) fn reach(t_max: f32) -> f32 {
     t_max * (1.0 + 1.0 / 65536.0)

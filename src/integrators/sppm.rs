@@ -874,7 +874,6 @@ impl Sppm {
         let mut lanes: [Option<PhotonLane>; LANES] = [None; LANES];
         // Each record's photon (its place in the chunk).
         let mut places: Vec<u16> = Vec::new();
-        let mut mine = Vec::new();
         let mut next = 0;
         let mut traced = LaneRays::default();
         loop {
@@ -916,13 +915,13 @@ impl Sppm {
         for i in 0..len {
             start[i + 1] += start[i];
         }
-        mine.resize(recs.len(), (0u32, Vec3::ZERO));
+        let mut sorted = vec![(0u32, Vec3::ZERO); recs.len()];
         for (&p, &r) in places.iter().zip(recs.iter()) {
             let slot = &mut start[p as usize];
-            mine[*slot as usize] = r;
+            sorted[*slot as usize] = r;
             *slot += 1;
         }
-        std::mem::swap(recs, &mut mine);
+        *recs = sorted;
     }
 
     /// A photon's emission (the chunk's `at`th, index `index`): `None` if
