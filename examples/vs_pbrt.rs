@@ -55,6 +55,12 @@ fn parse() -> Result<Opts, String> {
     if o.pbrt.as_os_str().is_empty() {
         return Err("--pbrt PBRT_BINARY is required".into());
     }
+    // Runs start in each scene's folder: a path to the binary is made
+    // absolute first (a bare name is looked up in PATH).
+    if o.pbrt.components().count() > 1 {
+        o.pbrt =
+            std::fs::canonicalize(&o.pbrt).map_err(|e| format!("{}: {e}", o.pbrt.display()))?;
+    }
     if o.scenes.is_empty() {
         return Err("no scene given".into());
     }
