@@ -68,12 +68,12 @@ fn parse() -> Result<Opts, String> {
 }
 
 fn main() {
-    let mut argv = std::env::args_os();
-    if std::env::args_os().nth(1).is_some_and(|a| a == AS_PBRS) {
-        let rest: Vec<OsString> = std::iter::once(OsString::from("pbrs"))
-            .chain(argv.by_ref().skip(2))
-            .collect();
-        std::process::exit(pbrs::cli::run(rest));
+    let mut argv: Vec<OsString> = std::env::args_os().collect();
+    if argv.get(1).is_some_and(|a| a == AS_PBRS) {
+        // pbrs's command line: its program name, then the rest.
+        argv.drain(..2);
+        argv.insert(0, OsString::from("pbrs"));
+        std::process::exit(pbrs::cli::run(argv));
     }
     let o = match parse() {
         Ok(o) => o,

@@ -551,20 +551,18 @@ impl Sppm {
                         };
                         let i = l.pixel;
                         let out = (&mut px[i], &mut vp[i], &mut bsdf);
-                        match self.camera_step(scene, l, hit, &mut samplers[k], &mut scratch, out) {
-                            None => {}
-                            Some(made) => {
-                                if made {
-                                    let vp = &mut vp[i];
-                                    vp.row = row as u32;
-                                    vp.first = lobes.len() as u32;
-                                    vp.n = bsdf.lobes().len() as u32;
-                                    vp.bsdf = bsdf.head();
-                                    lobes.extend_from_slice(bsdf.lobes());
-                                }
-                                lanes[k] = None;
-                            }
+                        let Some(made) = self.camera_step(scene, l, hit, &mut samplers[k], &mut scratch, out) else {
+                            continue;
+                        };
+                        if made {
+                            let vp = &mut vp[i];
+                            vp.row = row as u32;
+                            vp.first = lobes.len() as u32;
+                            vp.n = bsdf.lobes().len() as u32;
+                            vp.bsdf = bsdf.head();
+                            lobes.extend_from_slice(bsdf.lobes());
                         }
+                        lanes[k] = None;
                     }
                 }
                 scratch.counts()
