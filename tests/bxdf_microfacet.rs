@@ -140,13 +140,22 @@ fn chi2_lobe(name: &str, b: &Bxdf, wo: Vec3, seed: u64) -> f64 {
     accepted
 }
 
-/// Sampled value and density agree with `f` and `pdf`, and `f_pdf` with both.
+/// Sampled value and density agree with `f` and `pdf`, and `f_pdf` with
+/// both; `sample_wi` gives `sample_f`'s direction, density and flags bit for
+/// bit (and fails where it fails).
 fn check_sampled_f(name: &str, b: &Bxdf, wo: Vec3) {
     let mut rng = Pcg32::with_sequence(11);
     let mut n = 0;
     for _ in 0..5_000 {
         let u = Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-        let Some(s) = b.sample_f(wo, u) else { continue };
+        let sampled = b.sample_f(wo, u);
+        let only_wi = b.sample_wi(wo, u);
+        assert_eq!(
+            sampled.map(|s| (s.wi.to_array().map(f32::to_bits), s.pdf.to_bits(), s.flags)),
+            only_wi.map(|s| (s.wi.to_array().map(f32::to_bits), s.pdf.to_bits(), s.flags)),
+            "{name}: sample_wi against sample_f at wo {wo}, u {u}"
+        );
+        let Some(s) = sampled else { continue };
         if s.pdf == 0.0 {
             continue;
         }

@@ -287,7 +287,13 @@ impl<'a> Bsdf<'a> {
         if wo.z == 0.0 {
             return None;
         }
-        let s = lobe.bxdf.sample_f(wo, u_remapped)?;
+        // A non-specular lobe's value is summed again below with the
+        // others' at the direction: only its density is needed here.
+        let s = if lobe.flags.is_specular() {
+            lobe.bxdf.sample_f(wo, u_remapped)?
+        } else {
+            lobe.bxdf.sample_wi(wo, u_remapped)?
+        };
         if s.pdf == 0.0 || s.pdf.is_nan() {
             return None;
         }
@@ -296,21 +302,28 @@ impl<'a> Bsdf<'a> {
         let mut pdf = s.pdf;
         let mut f = s.f * lobe.scale;
         if !lobe_flags.is_specular() {
-            if matching > 1 {
-                for (i, l) in self.lobes.iter().enumerate() {
-                    if i != index && l.flags.matches(flags) {
-                        pdf += l.bxdf.pdf(wo, s.wi);
-                    }
-                }
-            }
+            // The other lobes' densities and every lobe's value on the
+            // side `wi` is on, each summed in the lobes' order; a lobe
+            // that contributes both gives them from one `f_pdf` (its terms
+            // computed once, the same values as `f` and `pdf`).
             let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
             f = Vec3::ZERO;
-            for l in &self.lobes {
+            for (i, l) in self.lobes.iter().enumerate() {
                 let lf = l.flags;
-                if lf.matches(flags)
-                    && ((reflect && lf.is_reflection()) || (!reflect && lf.is_transmission()))
-                {
-                    f += l.bxdf.f(wo, s.wi) * l.scale;
+                if !lf.matches(flags) {
+                    continue;
+                }
+                let side = (reflect && lf.is_reflection()) || (!reflect && lf.is_transmission());
+                if i == index {
+                    if side {
+                        f += l.bxdf.f(wo, s.wi) * l.scale;
+                    }
+                } else if side {
+                    let (lobe_f, lobe_pdf) = l.bxdf.f_pdf(wo, s.wi);
+                    pdf += lobe_pdf;
+                    f += lobe_f * l.scale;
+                } else {
+                    pdf += l.bxdf.pdf(wo, s.wi);
                 }
             }
         }

@@ -92,6 +92,35 @@ impl BxdfModel for MicrofacetReflection {
     }
     #[inline]
     fn sample_f(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
+        let (wi, wh) = self.sample_wi_wh(wo, u)?;
+        let (f, pdf) = self.eval(wo, wi, wh);
+        Some(BxdfSample {
+            f,
+            wi,
+            pdf,
+            flags: self.flags(),
+        })
+    }
+    /// `sample_f` without the value: the density needs D(wh) and Λ(wo)
+    /// only (the same bits as `eval`'s), not G's Λ(wi) or the Fresnel term.
+    #[inline]
+    fn sample_wi(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
+        let (wi, wh) = self.sample_wi_wh(wo, u)?;
+        let pdf_wh = self.distribution.d_g_pdf(wo, None, wh).2;
+        Some(BxdfSample {
+            f: Vec3::ZERO,
+            wi,
+            pdf: pdf_wh / (4.0 * wo.dot(wh)),
+            flags: self.flags(),
+        })
+    }
+}
+
+impl MicrofacetReflection {
+    /// A facet normal sampled for `wo` and the direction it reflects `wo`
+    /// to, `None` where either is on the wrong side.
+    #[inline]
+    fn sample_wi_wh(&self, wo: Vec3, u: Vec2) -> Option<(Vec3, Vec3)> {
         if wo.z == 0.0 {
             return None;
         }
@@ -103,13 +132,7 @@ impl BxdfModel for MicrofacetReflection {
         if !same_hemisphere(wo, wi) {
             return None;
         }
-        let (f, pdf) = self.eval(wo, wi, wh);
-        Some(BxdfSample {
-            f,
-            wi,
-            pdf,
-            flags: self.flags(),
-        })
+        Some((wi, wh))
     }
 }
 

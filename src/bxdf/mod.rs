@@ -126,6 +126,13 @@ pub trait BxdfModel {
             flags: self.flags(),
         })
     }
+    /// `sample_f`'s direction, density and flags, its value left to the
+    /// lobe (zero or the value): for callers that evaluate the value again
+    /// (a BSDF of several lobes sums every lobe's `f` at the direction).
+    #[inline(always)]
+    fn sample_wi(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
+        self.sample_f(wo, u)
+    }
     /// Density of `sample_f` by solid angle (zero for specular lobes).
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -170,6 +177,10 @@ macro_rules! bxdfs {
             #[inline]
             fn sample_f(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
                 match self { $(Bxdf::$variant(b) => b.sample_f(wo, u),)* }
+            }
+            #[inline]
+            fn sample_wi(&self, wo: Vec3, u: Vec2) -> Option<BxdfSample> {
+                match self { $(Bxdf::$variant(b) => b.sample_wi(wo, u),)* }
             }
             #[inline]
             fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
