@@ -118,6 +118,8 @@ pub struct Builder<'s, 'c> {
     /// machine's memory at each mesh.
     scene_triangles: u64,
     render_bytes: u64,
+    /// When the machine's memory is next read for them.
+    budget: crate::scene::memory::BudgetWatch,
     /// A mesh was refused for the scene's size (reported once; the later
     /// ones are refused without another error).
     too_big: bool,
@@ -193,6 +195,7 @@ impl<'s, 'c> Builder<'s, 'c> {
             meshes: HashMap::new(),
             scene_triangles: 0,
             render_bytes: 0,
+            budget: Default::default(),
             too_big: false,
             texture_state: TextureState::default(),
             after_warned: false,

@@ -188,11 +188,13 @@ impl<'s, 'c> Builder<'s, 'c> {
             return false;
         }
         let bvh = crate::accel::bvh_memory_estimate(self.scene_triangles);
-        let what = format!(
-            "rendering the scene's {} triangles so far (BVH and world-space copies, estimated)",
-            self.scene_triangles
-        );
-        match crate::scene::memory::check_budget(&what, bvh + self.render_bytes) {
+        let triangles = self.scene_triangles;
+        let what = || {
+            format!(
+                "rendering the scene's {triangles} triangles so far (BVH and world-space copies, estimated)"
+            )
+        };
+        match self.budget.check(bvh + self.render_bytes, what) {
             Ok(()) => true,
             Err(why) => {
                 self.too_big = true;
