@@ -219,6 +219,7 @@ impl Analytic for Disk {
 
     /// pbrt-v3's `Disk::Sample(u)`: concentric over the whole disk, density
     /// 1 / area (see the module notes for partial disks).
+    #[inline]
     fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let pd = concentric_sample_disk(u).as_dvec2() * self.radius;
         let p_obj = DVec3::new(pd.x, pd.y, self.height);

@@ -388,6 +388,7 @@ impl Analytic for Sphere {
 }
 
 /// Convert an area sample to a solid-angle density as seen from `p`.
+#[inline(always)]
 pub fn to_solid_angle(p: Vec3, mut s: ShapeSample) -> Option<ShapeSample> {
     s.pdf = area_to_solid_angle(p, s.point.p, s.point.n, s.pdf);
     (s.pdf > 0.0).then_some(s)
