@@ -16,6 +16,12 @@ pub mod verdict;
 /// file's declared size before anything is allocated.
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 27;
 
+/// `v / 255` for every byte value: what the 8-bit readers make of a byte
+/// (and what the inverse sRGB curve's table is keyed on).
+pub fn unorm8_table() -> [f32; 256] {
+    std::array::from_fn(|i| i as f32 / 255.0)
+}
+
 /// A linear RGB image: `data` holds `width * height` RGB triples, rows from
 /// top to bottom.
 #[derive(Clone, Debug, PartialEq)]

@@ -358,11 +358,6 @@ fn check_size(w: u64, h: u64) -> Result<(), String> {
     }
 }
 
-/// `v / 255` for every byte value.
-fn unorm8_table() -> [f32; 256] {
-    std::array::from_fn(|i| i as f32 / 255.0)
-}
-
 fn decode_with_image_crate(bytes: &[u8], format: image::ImageFormat) -> Result<RgbImage, String> {
     use image::{DynamicImage, ImageDecoder};
     let mut reader = image::ImageReader::with_format(Cursor::new(bytes), format);
@@ -375,7 +370,7 @@ fn decode_with_image_crate(bytes: &[u8], format: image::ImageFormat) -> Result<R
     check_claim(w as u64, h as u64, bytes.len())?;
     let img = DynamicImage::from_decoder(decoder).map_err(|e| e.to_string())?;
     let n = w as usize * h as usize;
-    let lut = unorm8_table();
+    let lut = crate::image::unorm8_table();
     let (pixels, depth): (Vec<Vec3>, SampleDepth) = match &img {
         DynamicImage::ImageRgb32F(b) => (
             b.as_raw()

@@ -36,13 +36,22 @@ fn gib(b: u64) -> f64 {
 /// available".
 pub fn check_budget(what: &str, need: u64) -> Result<(), String> {
     match available_memory_bytes() {
-        Some(avail) if need > avail / 10 * 9 => Err(format!(
-            "{what} needs {:.1} GiB, more than 90% of the {:.1} GiB of memory available",
-            gib(need),
-            gib(avail)
-        )),
+        Some(avail) if need > budget(avail) => Err(refusal(what, need, avail)),
         _ => Ok(()),
     }
+}
+
+/// The most a need may be: 90% of the memory available.
+fn budget(avail: u64) -> u64 {
+    avail / 10 * 9
+}
+
+fn refusal(what: &str, need: u64, avail: u64) -> String {
+    format!(
+        "{what} needs {:.1} GiB, more than 90% of the {:.1} GiB of memory available",
+        gib(need),
+        gib(avail)
+    )
 }
 
 /// [`check_budget`] for a need that grows in many small steps (a scene's
@@ -58,9 +67,9 @@ pub struct BudgetWatch {
 }
 
 impl BudgetWatch {
-    /// Ok if `need` bytes fit (as [`check_budget`], which it calls when the
-    /// need has outgrown the last reading's margin); `what` names the need
-    /// in the error.
+    /// Ok if `need` bytes fit (as [`check_budget`], whose reading it takes
+    /// again once the need has outgrown the last reading's margin); `what`
+    /// names the need in the error.
     pub fn check(&mut self, need: u64, what: impl FnOnce() -> String) -> Result<(), String> {
         if need < self.fits_below {
             return Ok(());
@@ -70,9 +79,9 @@ impl BudgetWatch {
             self.fits_below = u64::MAX;
             return Ok(());
         };
-        let limit = avail / 10 * 9;
+        let limit = budget(avail);
         if need > limit {
-            return check_budget(&what(), need);
+            return Err(refusal(&what(), need, avail));
         }
         self.fits_below = need + (limit - need) / 8;
         Ok(())
@@ -94,7 +103,7 @@ mod watch_tests {
         let mut w = BudgetWatch::default();
         assert_eq!(w.fits_below, 0);
         assert!(w.check(1000, || "small".into()).is_ok());
-        let limit_then = avail / 10 * 9;
+        let limit_then = budget(avail);
         assert!(w.fits_below > 1000 && w.fits_below <= 1000 + limit_then / 8 + 1);
         let margin = w.fits_below;
         assert!(w.check(margin - 1, || unreachable!()).is_ok());

@@ -6,8 +6,8 @@
 
 use std::sync::OnceLock;
 
-/// The 8-bit codes as the image readers make them (`k as f32 / 255.0`) and
-/// their linear values.
+/// The 8-bit codes as the image readers make them
+/// ([`crate::image::unorm8_table`]) and their linear values.
 struct Srgb8Table {
     code: [f32; 256],
     linear: [f32; 256],
@@ -16,7 +16,7 @@ struct Srgb8Table {
 fn table() -> &'static Srgb8Table {
     static TABLE: OnceLock<Srgb8Table> = OnceLock::new();
     TABLE.get_or_init(|| {
-        let code: [f32; 256] = std::array::from_fn(|k| k as f32 / 255.0);
+        let code = crate::image::unorm8_table();
         Srgb8Table {
             code,
             linear: code.map(super::inverse_gamma_computed),
@@ -50,8 +50,7 @@ mod tests {
             f32::NEG_INFINITY,
             f32::MIN_POSITIVE,
         ]);
-        for k in 0..256u32 {
-            let v = k as f32 / 255.0;
+        for (k, v) in crate::image::unorm8_table().into_iter().enumerate() {
             assert!(of_8bit_code(v).is_some(), "code {k}");
             assert!(of_8bit_code(v.next_up()).is_none(), "past code {k}");
             values.extend([v, v.next_up(), v.next_down(), -v, v * 0.5]);
