@@ -178,9 +178,7 @@ fn skip_table(
         steps.past[scrambles - 1].apply(rng);
     } else {
         rng.advance(scrambles as i64);
-        for _ in 0..spp {
-            draws.skip(rng, &steps.jumps, per_sample);
-        }
+        draws.skip_runs(rng, &steps.jumps, spp, per_sample);
     }
     draws.skip(rng, &steps.jumps, spp);
 }

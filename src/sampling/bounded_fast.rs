@@ -66,8 +66,10 @@ impl BoundedDraws {
     }
 }
 
-/// Draws computed side by side by [`BoundedDraws::skip`].
-const LANES: usize = 8;
+/// Draws computed side by side by [`BoundedDraws::skip_runs`] (the 64-bit
+/// state arithmetic vectorised by the compiler): one minimum, one branch
+/// and one step of the state per 32 draws.
+const LANES: usize = 32;
 
 /// The states `k = 0..=LANES` steps after a state `s`, as `a[k]·s + c[k]`
 /// (mod 2^64) on one stream.
@@ -117,30 +119,39 @@ impl Stride {
 impl BoundedDraws {
     /// Steps `rng` (whose stream `jumps` describes) past the draws of
     /// `below(rng, count - i)` for `i` in `0..count` (a shuffle of `count`
-    /// values) without making them: eight draws at a time, computed side by
-    /// side from the state, are one step each when none of them is rejected,
-    /// which holds when none is below `count` (every threshold is below its
-    /// bound, at most `count`); a block where one is goes draw by draw.
+    /// values) without making them.
+    #[inline]
     pub fn skip(&self, rng: &mut Pcg32, jumps: &Jumps, count: usize) {
-        let mut i = 0;
-        while i + LANES <= count {
+        self.skip_runs(rng, jumps, 1, count);
+    }
+
+    /// Steps `rng` (whose stream `jumps` describes) past the draws of
+    /// `runs` shuffles of `per_run` values each, one after the other (draw
+    /// `j` below `per_run - j % per_run`), without making them: [`LANES`]
+    /// draws at a time, computed side by side from the state, are one step
+    /// each when none of them is rejected, which holds when none is below
+    /// `per_run` (every threshold is below its bound, at most `per_run`);
+    /// a block where one is goes draw by draw.
+    pub fn skip_runs(&self, rng: &mut Pcg32, jumps: &Jumps, runs: usize, per_run: usize) {
+        let count = runs * per_run;
+        let mut j = 0;
+        while j < count {
+            let m = (count - j).min(LANES);
             let s = rng.parts().0;
             let mut least = u32::MAX;
             for k in 0..LANES {
                 let sk = jumps.a[k].wrapping_mul(s).wrapping_add(jumps.c[k]);
-                least = least.min(Pcg32::output(sk));
+                let o = Pcg32::output(sk);
+                least = least.min(if k < m { o } else { u32::MAX });
             }
-            if least as usize >= count {
-                rng.set_state(jumps.a[LANES].wrapping_mul(s).wrapping_add(jumps.c[LANES]));
+            if least as usize >= per_run {
+                rng.set_state(jumps.a[m].wrapping_mul(s).wrapping_add(jumps.c[m]));
             } else {
-                for k in 0..LANES {
-                    self.below(rng, (count - i - k) as u32);
+                for k in j..j + m {
+                    self.below(rng, (per_run - k % per_run) as u32);
                 }
             }
-            i += LANES;
-        }
-        for k in i..count {
-            self.below(rng, (count - k) as u32);
+            j += m;
         }
     }
 }
@@ -258,6 +269,57 @@ mod tests {
                 plain.uniform_u32_below((count - i) as u32);
             }
             assert_eq!(fast, plain, "from state 0, count {count}");
+        }
+    }
+
+    /// `runs` shuffles of `per_run` values, draw by draw.
+    fn plain_runs(rng: &mut Pcg32, runs: usize, per_run: usize) {
+        for _ in 0..runs {
+            for i in 0..per_run {
+                rng.uniform_u32_below((per_run - i) as u32);
+            }
+        }
+    }
+
+    #[test]
+    fn skip_runs_equals_plain_draws() {
+        let draws = BoundedDraws::new(64);
+        for seq in 0..100u64 {
+            let mut fast = Pcg32::with_sequence(seq);
+            let jumps = Jumps::of(&fast);
+            let mut plain = fast;
+            for runs in [1usize, 2, 3, 64] {
+                for per_run in [1usize, 2, 3, 9, 16, 31, 32, 33, 64] {
+                    draws.skip_runs(&mut fast, &jumps, runs, per_run);
+                    plain_runs(&mut plain, runs, per_run);
+                    assert_eq!(fast, plain, "sequence {seq}, {runs} runs of {per_run}");
+                }
+            }
+        }
+        // Draw `k` made from state 0 (output 0) or 3·2^27 (output 3), so
+        // that it is rejected (its bound, `per_run - k % per_run`, has a
+        // threshold above the output: 2^32 mod 7 = 4) in the middle of a
+        // later block, or taken (a power of two, or a threshold below it).
+        for (state, k, per_run) in [
+            (0u64, 40usize, 9usize),
+            (0, 70, 9),
+            (0, 33, 7),
+            (0, 5, 6),
+            (0, 95, 32),
+            (0, 100, 33),
+            (3 << 27, 35, 7),
+            (3 << 27, 36, 7),
+            (3 << 27, 64, 64),
+        ] {
+            let mut fast = Pcg32::with_sequence(11);
+            fast.set_state(state);
+            fast.advance(-(k as i64));
+            let jumps = Jumps::of(&fast);
+            let mut plain = fast;
+            let runs = k / per_run + 2;
+            draws.skip_runs(&mut fast, &jumps, runs, per_run);
+            plain_runs(&mut plain, runs, per_run);
+            assert_eq!(fast, plain, "state {state} at draw {k}, runs of {per_run}");
         }
     }
 }
