@@ -373,6 +373,11 @@ pub(super) fn sample_one_light(
     else {
         return Vec3::ZERO;
     };
+    if !bsdf.has_component(BxdfFlags::NON_SPECULAR) {
+        // The estimate is 0, as in `sample_all_lights`.
+        sampler.skip_2d();
+        return Vec3::ZERO / pmf;
+    }
     let u_scatter = sampler.get_2d();
     estimate_direct(scene, s, bsdf, wo, light, u_light, u_scatter, sampler, scratch) / pmf
 }
@@ -390,6 +395,22 @@ pub(super) fn sample_all_lights(
     let mut l = Vec3::ZERO;
     let mut u_light = std::mem::take(&mut scratch.u_light);
     let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
+    if !bsdf.has_component(BxdfFlags::NON_SPECULAR) {
+        // A specular (or lobe-less) BSDF: every light sample's BSDF value
+        // and every BSDF sample is 0 (pbrt-v3 computes the estimates to
+        // that), so the samples are only consumed as the estimates would.
+        for &n in n_light_samples {
+            let got_light = sampler.skip_2d_array(n, &mut u_light);
+            let got_scatter = sampler.skip_2d_array(n, &mut u_scatter);
+            if !(got_light && got_scatter) {
+                sampler.skip_2d();
+                sampler.skip_2d();
+            }
+        }
+        scratch.u_light = u_light;
+        scratch.u_scatter = u_scatter;
+        return l;
+    }
     for (j, &n) in n_light_samples.iter().enumerate() {
         let light = j as u32;
         // Both arrays are always asked for, as pbrt-v3 does; a delta
