@@ -480,3 +480,70 @@ fn split_glass_and_mirror_throughputs_are_fresnel_weighted_colours() {
         assert!(m.sample(wo, u, BxdfFlags::NON_SPECULAR).is_none());
     }
 }
+
+/// `Bsdf::reaches` (which lets light sampling skip the lobes) is false only
+/// where `f_pdf`'s value is exactly zero, and is false somewhere when the
+/// lobes the flags select (all of them, or the non-specular ones) all
+/// reflect or all transmit.
+#[test]
+fn reaches_is_false_only_where_the_value_is_zero() {
+    // The material, and whether its selected lobes are on one side only
+    // for flags ALL and NON_SPECULAR.
+    let materials = [
+        (
+            "\"plastic\" \"rgb Kd\" [0.5 0.3 0.8] \"float roughness\" 0.1",
+            [true, true],
+        ),
+        ("\"matte\" \"rgb Kd\" [0.5 0.5 0.5]", [true, true]),
+        (
+            "\"matte\" \"rgb Kd\" [0.5 0.5 0.5] \"float sigma\" 20",
+            [true, true],
+        ),
+        ("\"metal\" \"float roughness\" 0.05", [true, true]),
+        (
+            "\"substrate\" \"float uroughness\" 0.2 \"float vroughness\" 0.05",
+            [true, true],
+        ),
+        (
+            "\"glass\" \"float uroughness\" 0.2 \"float vroughness\" 0.2",
+            [false, false],
+        ),
+        // Smooth glass: no non-specular lobe at all.
+        ("\"glass\"", [false, true]),
+        (
+            "\"translucent\" \"rgb Kd\" [0.5 0.5 0.5] \"rgb Ks\" [0.3 0.3 0.3]",
+            [false, false],
+        ),
+        // The pass-through lobe is specular.
+        ("\"uber\" \"rgb opacity\" [0.5 0.5 0.5]", [false, true]),
+    ];
+    let mut rng = Pcg32::with_sequence(7);
+    let mut dir = || {
+        let z = 2.0 * rng.uniform_f32() - 1.0;
+        let phi = std::f32::consts::TAU * rng.uniform_f32();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    for (decl, one_side) in materials {
+        let b = material_bsdf(decl, true);
+        for (flags, one_side) in [BxdfFlags::ALL, BxdfFlags::NON_SPECULAR]
+            .into_iter()
+            .zip(one_side)
+        {
+            let mut skipped = 0;
+            for _ in 0..4000 {
+                let (wo, wi) = (dir(), dir());
+                let (f, _) = b.f_pdf(wo, wi, flags);
+                if !b.reaches(wo, wi, flags) {
+                    skipped += 1;
+                    assert_eq!(f, Vec3::ZERO, "{decl}, {flags:?}: wo {wo}, wi {wi}");
+                }
+            }
+            assert_eq!(
+                skipped > 0,
+                one_side,
+                "{decl}, {flags:?}: {skipped} skipped"
+            );
+        }
+    }
+}

@@ -207,6 +207,18 @@ impl<'a> Bsdf<'a> {
         self.f_pdf(wo_w, wi_w, flags).0
     }
 
+    /// Whether a lobe matching `flags` is on `wi_w`'s side of the surface
+    /// (by the geometric normal, as [`Bsdf::f_pdf`] decides it): if not,
+    /// `f_pdf`'s value is exactly zero.
+    #[inline]
+    pub fn reaches(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> bool {
+        let reflect = wi_w.dot(self.ng) * wo_w.dot(self.ng) > 0.0;
+        self.lobes.iter().any(|l| {
+            l.flags.matches(flags)
+                && ((reflect && l.flags.is_reflection()) || (!reflect && l.flags.is_transmission()))
+        })
+    }
+
     /// `(f, pdf)` for a pair of world directions in one pass.
     #[inline]
     pub fn f_pdf(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> (Vec3, f32) {

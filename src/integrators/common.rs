@@ -260,6 +260,8 @@ pub(super) fn choose_light(
 /// the value (with the cosine, for a surface) and the density of
 /// scattering from `wi` to `wo`.
 pub(super) trait Scatter {
+    /// The value and density; the density is read only where the value is
+    /// not zero.
     fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32);
 }
 
@@ -274,7 +276,13 @@ pub(super) struct SurfaceScatter<'b, 'a> {
 impl Scatter for SurfaceScatter<'_, '_> {
     #[inline(always)]
     fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        let (f, pdf) = self.bsdf.f_pdf(wo, wi, self.flags);
+        // No lobe on `wi`'s side (light behind a reflecting surface): the
+        // value is zero without evaluating the lobes.
+        let (f, pdf) = if self.bsdf.reaches(wo, wi, self.flags) {
+            self.bsdf.f_pdf(wo, wi, self.flags)
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
         (f * wi.dot(self.ns).abs(), pdf)
     }
 }
