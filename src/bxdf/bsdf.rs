@@ -219,6 +219,19 @@ impl<'a> Bsdf<'a> {
         })
     }
 
+    /// Whether every lobe matching `flags` reflects only (and one does).
+    #[inline]
+    pub fn reflects_only(&self, flags: BxdfFlags) -> bool {
+        let mut any = false;
+        for l in self.lobes.iter().filter(|l| l.flags.matches(flags)) {
+            if l.flags.is_transmission() {
+                return false;
+            }
+            any = true;
+        }
+        any
+    }
+
     /// `(f, pdf)` for a pair of world directions in one pass.
     #[inline]
     pub fn f_pdf(&self, wo_w: Vec3, wi_w: Vec3, flags: BxdfFlags) -> (Vec3, f32) {

@@ -19,7 +19,7 @@ use super::direct_lanes;
 use super::specular::{specular_tree_li, tree_lanes, tree_li, First, SpecularTree};
 use super::{Integrate, IntegratorKind, IntegratorSettings, Scratch, MAX_DEPTH, PIXEL_BOUNDS};
 use crate::accel::SurfaceHit;
-use crate::geometry::{spawn_ray, Ray, RayDiff};
+use crate::geometry::{spawn_ray, Bounds3, Ray, RayDiff};
 use crate::lights::{pack_triangle_lights, LightSampler, TriangleLightPack};
 use crate::materials::{Bsdf, BxdfFlags};
 use crate::samplers::Sampler;
@@ -108,6 +108,11 @@ pub struct DirectLighting {
     settings: DirectLightingSettings,
     lights: LightSampler,
     n_light_samples: Vec<u32>,
+    /// Each area light's world bounds (`None` for the other lights), for
+    /// strategy "all": see [`sample_all_lights`]. Empty with the options'
+    /// `scalar` switch (which gives the same image).
+    light_boxes: Vec<Option<Bounds3>>,
+    scalar: bool,
     /// The lights four to a pack, for strategy "all" when every light is
     /// a triangle of constant normal with one sample (else empty).
     packs: Vec<TriangleLightPack>,
@@ -117,13 +122,16 @@ pub struct DirectLighting {
 }
 
 impl DirectLighting {
-    /// `scalar` (the options' switch) leaves out the four-lane packs (which give the same image).
+    /// `scalar` (the options' switch) leaves out the four-lane packs and
+    /// the lights' boxes (which give the same image).
     pub fn new(settings: &DirectLightingSettings, scene: &RenderScene, scalar: bool) -> DirectLighting {
         DirectLighting {
             settings: *settings,
             // pbrt-v3's directlighting chooses uniformly for strategy "one".
             lights: light_sampler(LightSampleStrategy::Uniform, scene),
             n_light_samples: Vec::new(),
+            light_boxes: Vec::new(),
+            scalar,
             packs: match settings.strategy {
                 DirectStrategy::All if !scalar => {
                     pack_triangle_lights(&scene.lights).unwrap_or_default()
@@ -148,6 +156,20 @@ impl Integrate for DirectLighting {
             .iter()
             .map(|l| sampler.round_count(l.n_samples()))
             .collect();
+        self.light_boxes = if self.scalar {
+            Vec::new()
+        } else {
+            scene
+                .lights
+                .iter()
+                .map(|l| {
+                    if l.is_delta() || l.is_infinite() {
+                        return None;
+                    }
+                    l.bounds(&scene.aggregate).map(|b| b.bounds)
+                })
+                .collect()
+        };
         if self.n_light_samples.iter().any(|&n| n != 1) {
             self.packs.clear();
         }
@@ -165,14 +187,22 @@ impl Integrate for DirectLighting {
     }
 
     fn notes(&self) -> Vec<String> {
-        if self.packs.is_empty() {
-            return Vec::new();
+        let mut notes = Vec::new();
+        let boxes = self.light_boxes.iter().flatten().count();
+        if boxes > 0 {
+            notes.push(format!(
+                "directlighting \"all\": {boxes} area lights bounded (no estimates of one wholly behind a surface that only reflects)"
+            ));
         }
-        vec![format!(
+        if self.packs.is_empty() {
+            return notes;
+        }
+        notes.push(format!(
             "directlighting \"all\": {} triangle lights in {} four-lane packs (Lambertian vertices sample four lights at once)",
             self.packs.iter().map(|p| p.count).sum::<usize>(),
             self.packs.len()
-        )]
+        ));
+        notes
     }
 
     fn light_sampler(&self) -> Option<&LightSampler> {
@@ -259,6 +289,7 @@ impl SpecularTree for DirectLighting {
                     sampler,
                     scratch,
                     &self.n_light_samples,
+                    &self.light_boxes,
                 ),
                 (DirectStrategy::One, _) => {
                     sample_one_light(scene, s, bsdf, wo, sampler, scratch, &self.lights)
@@ -383,6 +414,7 @@ pub(super) fn sample_one_light(
 }
 
 /// pbrt-v3's UniformSampleAllLights with per-pixel sample arrays.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn sample_all_lights(
     scene: &RenderScene,
     s: &SurfaceHit,
@@ -391,6 +423,7 @@ pub(super) fn sample_all_lights(
     sampler: &mut Sampler,
     scratch: &mut Scratch,
     n_light_samples: &[u32],
+    light_boxes: &[Option<Bounds3>],
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
     let mut u_light = std::mem::take(&mut scratch.u_light);
@@ -411,8 +444,31 @@ pub(super) fn sample_all_lights(
         scratch.u_scatter = u_scatter;
         return l;
     }
+    // With reflection lobes only, an area light wholly behind the surface
+    // (by the geometric normal, on the other side than `wo`) gets every
+    // estimate 0: its light samples are on the side no lobe reaches, and
+    // the BSDF's samples with a value are on `wo`'s side (`Bsdf::sample`
+    // gives the others none, as pbrt-v3), leaving away from it.
+    let reflecting = bsdf.reflects_only(BxdfFlags::NON_SPECULAR);
+    let (p, ng) = (s.point.p, s.point.n);
     for (j, &n) in n_light_samples.iter().enumerate() {
         let light = j as u32;
+        if reflecting
+            && light_boxes
+                .get(j)
+                .copied()
+                .flatten()
+                .is_some_and(|b| wholly_behind(&b, p, ng, wo))
+        {
+            let got_light = sampler.skip_2d_array(n, &mut u_light);
+            let got_scatter = sampler.skip_2d_array(n, &mut u_scatter);
+            if !(got_light && got_scatter) {
+                sampler.skip_2d();
+                sampler.skip_2d();
+            }
+            l += Vec3::ZERO;
+            continue;
+        }
         // Both arrays are always asked for, as pbrt-v3 does; a delta
         // light reads neither (its sample has no random values and its
         // light takes no BSDF sample), so their values are not made.
@@ -447,6 +503,23 @@ pub(super) fn sample_all_lights(
     scratch.u_light = u_light;
     scratch.u_scatter = u_scatter;
     l
+}
+
+/// Whether box `b` lies wholly on the other side of the plane through `p`
+/// with normal `n` than direction `wo`, by a margin of a thousandth of the
+/// coordinates' size (far beyond the rounding of the points sampled on it
+/// and of the rays' origins).
+#[inline]
+fn wholly_behind(b: &Bounds3, p: Vec3, n: Vec3, wo: Vec3) -> bool {
+    let side = wo.dot(n);
+    if side == 0.0 || !side.is_finite() {
+        return false;
+    }
+    let (c, h) = (b.center(), 0.5 * b.diagonal());
+    let d = (c - p).dot(n) * side.signum();
+    let r = n.abs().dot(h);
+    let margin = 1e-3 * (c.abs().max_element() + p.abs().max_element() + h.max_element());
+    d + r < -margin
 }
 
 /// pbrt-v3's EstimateDirect: one light sample and one BSDF sample combined
