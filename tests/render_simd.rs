@@ -89,8 +89,9 @@ WorldEnd
 }
 
 /// directlighting "all" skips the estimates of an area light wholly behind
-/// a surface (by its geometric normal) whose lobes only reflect: the image
-/// is the scalar code's, which computes every estimate. A disk, a sphere
+/// a surface (by its geometric normal) whose lobes only reflect, and the
+/// BSDF samples outside the cone of the sphere around a light's box: the
+/// image is the scalar code's, which computes every estimate. A disk, a sphere
 /// and a two-sided quad light with several samples each, over plastic,
 /// metal, substrate, bump-mapped plastic and meshes whose shading normals
 /// lean away from their faces (plastic, matte and metal; one tilted

@@ -410,7 +410,7 @@ pub(super) fn sample_one_light(
         return Vec3::ZERO / pmf;
     }
     let u_scatter = sampler.get_2d();
-    estimate_direct(scene, s, bsdf, wo, light, u_light, u_scatter, sampler, scratch) / pmf
+    estimate_direct(scene, s, bsdf, wo, light, None, u_light, u_scatter, sampler, scratch) / pmf
 }
 
 /// pbrt-v3's UniformSampleAllLights with per-pixel sample arrays.
@@ -453,13 +453,8 @@ pub(super) fn sample_all_lights(
     let (p, ng) = (s.point.p, s.point.n);
     for (j, &n) in n_light_samples.iter().enumerate() {
         let light = j as u32;
-        if reflecting
-            && light_boxes
-                .get(j)
-                .copied()
-                .flatten()
-                .is_some_and(|b| wholly_behind(&b, p, ng, wo))
-        {
+        let light_box = light_boxes.get(j).copied().flatten();
+        if reflecting && light_box.is_some_and(|b| wholly_behind(&b, p, ng, wo)) {
             let got_light = sampler.skip_2d_array(n, &mut u_light);
             let got_scatter = sampler.skip_2d_array(n, &mut u_scatter);
             if !(got_light && got_scatter) {
@@ -482,6 +477,7 @@ pub(super) fn sample_all_lights(
         };
         let got_light = take(&mut u_light);
         let got_scatter = take(&mut u_scatter);
+        let reach = light_box.and_then(|b| Reach::new(&b, p));
         let ld = if got_light && got_scatter {
             let mut sum = Vec3::ZERO;
             for k in 0..n as usize {
@@ -490,19 +486,52 @@ pub(super) fn sample_all_lights(
                 } else {
                     (u_light[k], u_scatter[k])
                 };
-                sum += estimate_direct(scene, s, bsdf, wo, light, ul, us, sampler, scratch);
+                sum += estimate_direct(scene, s, bsdf, wo, light, reach, ul, us, sampler, scratch);
             }
             sum / n as f32
         } else {
             let ul = sampler.get_2d();
             let us = sampler.get_2d();
-            estimate_direct(scene, s, bsdf, wo, light, ul, us, sampler, scratch)
+            estimate_direct(scene, s, bsdf, wo, light, reach, ul, us, sampler, scratch)
         };
         l += ld;
     }
     scratch.u_light = u_light;
     scratch.u_scatter = u_scatter;
     l
+}
+
+/// The sphere around an area light's box as seen from a point outside it:
+/// directions outside its cone miss the light.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Reach {
+    /// From the point to the sphere's centre.
+    v: Vec3,
+    /// `|v|² − r²` for the sphere's radius `r`, grown by a thousandth and
+    /// by three thousandths of the coordinates' size: far beyond the
+    /// rounding of the directions' lengths, of rays' origins and of this
+    /// test.
+    lim: f32,
+}
+
+impl Reach {
+    /// `None` when `p` is within the sphere (every direction may hit).
+    #[inline]
+    fn new(b: &Bounds3, p: Vec3) -> Option<Reach> {
+        let (c, h) = (b.center(), 0.5 * b.diagonal());
+        let r = h.length();
+        let r = 1.001 * r + 3e-3 * (c.abs().max_element() + p.abs().max_element());
+        let v = c - p;
+        let lim = v.length_squared() - r * r;
+        (lim > 0.0 && lim.is_finite()).then_some(Reach { v, lim })
+    }
+
+    /// Whether unit direction `w` is within the cone.
+    #[inline]
+    fn may_hit(&self, w: Vec3) -> bool {
+        let t = w.dot(self.v);
+        !(t < 0.0 || t * t < self.lim)
+    }
 }
 
 /// Whether box `b` lies wholly on the other side of the plane through `p`
@@ -532,6 +561,7 @@ pub(super) fn estimate_direct(
     bsdf: &Bsdf,
     wo: Vec3,
     light_index: u32,
+    reach: Option<Reach>,
     u_light: Vec2,
     u_scatter: Vec2,
     sampler: &mut Sampler,
@@ -561,7 +591,9 @@ pub(super) fn estimate_direct(
     if !light.is_delta() {
         if let Some(bs) = bsdf.sample(wo, u_scatter, BxdfFlags::NON_SPECULAR) {
             let f = bs.f * bs.wi.dot(ns).abs();
-            if f != Vec3::ZERO && bs.pdf > 0.0 {
+            // A direction that misses the light's bounding sphere finds no
+            // light (its density is 0, or its ray hits something else).
+            if f != Vec3::ZERO && bs.pdf > 0.0 && reach.is_none_or(|r| r.may_hit(bs.wi)) {
                 let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                 let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
