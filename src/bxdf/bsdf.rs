@@ -285,9 +285,23 @@ impl<'a> Bsdf<'a> {
 
     /// Samples an incident direction (pbrt-v3's `BSDF::Sample_f`): `u.x`
     /// chooses among the lobes matching `flags` and is then remapped.
+    #[inline]
     pub fn sample(&self, wo_w: Vec3, u: Vec2, flags: BxdfFlags) -> Option<BsdfSample> {
+        self.sample_if(wo_w, u, flags, |_| true)
+    }
+
+    /// [`Bsdf::sample`], `None` as soon as the sampled direction (world
+    /// space) is one `keep` refuses, before the lobes' values and densities
+    /// there are computed.
+    pub fn sample_if(
+        &self,
+        wo_w: Vec3,
+        u: Vec2,
+        flags: BxdfFlags,
+        keep: impl Fn(Vec3) -> bool,
+    ) -> Option<BsdfSample> {
         if let [lobe] = self.lobes.as_slice() {
-            return self.sample_one(lobe, wo_w, u, flags);
+            return self.sample_one(lobe, wo_w, u, flags, keep);
         }
         let matching = self.num_components(flags);
         if matching == 0 {
@@ -323,6 +337,9 @@ impl<'a> Bsdf<'a> {
             return None;
         }
         let wi_w = self.frame.from_local(s.wi);
+        if !keep(wi_w) {
+            return None;
+        }
         let lobe_flags = lobe.flags;
         let mut pdf = s.pdf;
         let mut f = s.f * lobe.scale;
@@ -375,6 +392,7 @@ impl<'a> Bsdf<'a> {
         wo_w: Vec3,
         u: Vec2,
         flags: BxdfFlags,
+        keep: impl Fn(Vec3) -> bool,
     ) -> Option<BsdfSample> {
         if !lobe.flags.matches(flags) {
             return None;
@@ -391,6 +409,9 @@ impl<'a> Bsdf<'a> {
             return None;
         }
         let wi_w = self.frame.from_local(s.wi);
+        if !keep(wi_w) {
+            return None;
+        }
         let f = if lobe.flags.is_specular() {
             s.f * lobe.scale
         } else {

@@ -589,11 +589,13 @@ pub(super) fn estimate_direct(
         scratch,
     );
     if !light.is_delta() {
-        if let Some(bs) = bsdf.sample(wo, u_scatter, BxdfFlags::NON_SPECULAR) {
+        // A direction that misses the light's bounding sphere finds no light
+        // (its density is 0, or its ray hits something else): its value
+        // and density are not computed.
+        let aimed = |wi: Vec3| reach.is_none_or(|r| r.may_hit(wi));
+        if let Some(bs) = bsdf.sample_if(wo, u_scatter, BxdfFlags::NON_SPECULAR, aimed) {
             let f = bs.f * bs.wi.dot(ns).abs();
-            // A direction that misses the light's bounding sphere finds no
-            // light (its density is 0, or its ray hits something else).
-            if f != Vec3::ZERO && bs.pdf > 0.0 && reach.is_none_or(|r| r.may_hit(bs.wi)) {
+            if f != Vec3::ZERO && bs.pdf > 0.0 {
                 let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                 let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
