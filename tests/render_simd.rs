@@ -5,7 +5,7 @@
 mod common;
 
 use pbrs::loader::load_scene_str;
-use pbrs::render::driver::{render, RenderOptions, RenderStats};
+use pbrs::render::driver::RenderStats;
 use pbrs::scene::SceneDescription;
 
 fn both_ways(desc: &SceneDescription, what: &str) {
@@ -173,27 +173,7 @@ WorldEnd
         Ok(l) => l.scene,
         Err(f) => panic!("{:?}", f.errors),
     };
-    let run = |scalar: bool| {
-        render(
-            &desc,
-            &RenderOptions {
-                threads: Some(2),
-                scalar,
-                ..Default::default()
-            },
-            &|_, _| {},
-        )
-        .expect("render failed")
-    };
-    let ((fast, fast_stats), (slow, slow_stats)) = (run(false), run(true));
-    let differ = fast
-        .data
-        .iter()
-        .zip(&slow.data)
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
-    assert_eq!(differ, 0, "{differ} values differ from the scalar code");
-    assert!(fast.data.iter().any(|&v| v > 0.0));
+    let (fast_stats, slow_stats) = common::assert_fast_image_is_scalar(&desc, "lights behind");
     // The skipped BSDF samples towards the sphere light trace no rays (its
     // density is the cone's, whatever the direction; the scalar code traces
     // them and finds something else first): fewer closest hits, the same
