@@ -428,39 +428,28 @@ pub(super) fn sample_all_lights(
     let mut l = Vec3::ZERO;
     let mut u_light = std::mem::take(&mut scratch.u_light);
     let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
-    if !bsdf.has_component(BxdfFlags::NON_SPECULAR) {
-        // A specular (or lobe-less) BSDF: every light sample's BSDF value
-        // and every BSDF sample is 0 (pbrt-v3 computes the estimates to
-        // that), so the samples are only consumed as the estimates would.
-        for &n in n_light_samples {
-            let got_light = sampler.skip_2d_array(n, &mut u_light);
-            let got_scatter = sampler.skip_2d_array(n, &mut u_scatter);
-            if !(got_light && got_scatter) {
-                sampler.skip_2d();
-                sampler.skip_2d();
-            }
-        }
-        scratch.u_light = u_light;
-        scratch.u_scatter = u_scatter;
-        return l;
-    }
-    // With reflection lobes only, an area light wholly behind the surface
-    // (by the geometric normal, on the other side than `wo`) gets every
-    // estimate 0: its light samples are on the side no lobe reaches, and
-    // the BSDF's samples with a value are on `wo`'s side (`Bsdf::sample`
-    // gives the others none, as pbrt-v3), leaving away from it.
-    let reflecting = bsdf.reflects_only(BxdfFlags::NON_SPECULAR);
+    // Estimates known to be 0 (pbrt-v3 computes them to that) are left out,
+    // their samples only consumed as the estimates would: every light's at
+    // a specular (or lobe-less) BSDF, whose light samples and BSDF samples
+    // have no value; and with reflection lobes only, those of an area light
+    // wholly behind the surface (by the geometric normal, on the other side
+    // than `wo`): its light samples are on the side no lobe reaches, and the
+    // BSDF's samples with a value are on `wo`'s side (`Bsdf::sample` gives
+    // the others none, as pbrt-v3), leaving away from it.
+    let lit = bsdf.has_component(BxdfFlags::NON_SPECULAR);
+    let reflecting = lit && bsdf.reflects_only(BxdfFlags::NON_SPECULAR);
     let (p, ng) = (s.point.p, s.point.n);
     for (j, &n) in n_light_samples.iter().enumerate() {
         let light = j as u32;
         let light_box = light_boxes.get(j).copied().flatten();
-        if reflecting && light_box.is_some_and(|b| wholly_behind(&b, p, ng, wo)) {
+        if !lit || (reflecting && light_box.is_some_and(|b| wholly_behind(&b, p, ng, wo))) {
             let got_light = sampler.skip_2d_array(n, &mut u_light);
             let got_scatter = sampler.skip_2d_array(n, &mut u_scatter);
             if !(got_light && got_scatter) {
                 sampler.skip_2d();
                 sampler.skip_2d();
             }
+            // The sum of the estimates.
             l += Vec3::ZERO;
             continue;
         }
