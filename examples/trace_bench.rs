@@ -5,7 +5,8 @@
 //! cargo run --release --example trace_bench -- [SCENE] [N]
 //!
 //! Prints ns per closest-hit ray (one at a time, and 16 side by side), ns
-//! per shadow ray and per surface lookup, single-threaded. Compare two builds by running both in turn.
+//! per shadow ray (one at a time, and 16 side by side) and per surface
+//! lookup, single-threaded. Compare two builds by running both in turn.
 
 use glam::Vec3;
 use pbrs::accel::{Aggregate, Hit};
@@ -90,10 +91,14 @@ fn main() {
         let blocked = shadow_all(g, &shadow);
         let occl = t.elapsed().as_secs_f64() * 1e9 / n as f64;
         let t = Instant::now();
+        let blocked_stream = shadow_stream(g, &shadow);
+        let occl_stream = t.elapsed().as_secs_f64() * 1e9 / n as f64;
+        assert_eq!(blocked_stream, blocked);
+        let t = Instant::now();
         let acc = surface_all(g, &hits);
         let surf = t.elapsed().as_secs_f64() * 1e9 / hits.len().max(1) as f64;
         println!(
-            "round {round}: closest {closest:.1} ns/ray ({} hits), {SIDE_BY_SIDE} side by side {stream:.1} ns/ray, shadow {occl:.1} ns/ray ({blocked} blocked), surface {surf:.1} ns ({acc:.0})",
+            "round {round}: closest {closest:.1} ns/ray ({} hits), {SIDE_BY_SIDE} side by side {stream:.1} ns/ray, shadow {occl:.1} ns/ray ({blocked} blocked), {SIDE_BY_SIDE} side by side {occl_stream:.1} ns/ray, surface {surf:.1} ns ({acc:.0})",
             hits.len()
         );
     }
@@ -128,6 +133,18 @@ fn closest_stream(g: &Aggregate, rays: &[Ray]) -> usize {
 #[inline(never)]
 fn shadow_all(g: &Aggregate, rays: &[Ray]) -> usize {
     rays.iter().filter(|r| g.occluded(r)).count()
+}
+
+#[inline(never)]
+fn shadow_stream(g: &Aggregate, rays: &[Ray]) -> usize {
+    let times = [0.0f32; SIDE_BY_SIDE];
+    let mut out = [false; SIDE_BY_SIDE];
+    let mut blocked = 0;
+    for c in rays.chunks(SIDE_BY_SIDE) {
+        g.occluded_stream(c, &times[..c.len()], &mut out[..c.len()]);
+        blocked += out[..c.len()].iter().filter(|&&b| b).count();
+    }
+    blocked
 }
 
 #[inline(never)]

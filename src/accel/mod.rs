@@ -1037,6 +1037,18 @@ impl Aggregate {
         }
     }
 
+    /// Whether something blocks each of incoherent `rays` (at scene times
+    /// `times`) before its `t_max`, in `out`, each
+    /// [`Aggregate::occluded_at`]'s answer: traced side by side
+    /// ([`stream`]) when there are at most [`PACKET_MAX`] (and the tree is
+    /// not deeper than a packet's stack), the primitives other than plain
+    /// triangles tested as a packet tests them, else ray by ray. For the
+    /// shadow rays of a batch's paths.
+    #[inline(never)]
+    pub fn occluded_stream(&self, rays: &[Ray], times: &[f32], out: &mut [bool]) {
+        self.occluded_together::<true>(rays, times, out);
+    }
+
     /// Whether something blocks each of `rays` (at scene times `times`)
     /// before its `t_max`, in `out`, each [`Aggregate::occluded_at`]'s
     /// answer: traced as one packet when there are at most [`PACKET_MAX`]
@@ -1045,10 +1057,17 @@ impl Aggregate {
     /// them, else ray by ray. For coherent rays (from one point).
     #[inline(never)]
     pub fn occluded_packet(&self, rays: &[Ray], times: &[f32], out: &mut [bool]) {
+        self.occluded_together::<false>(rays, times, out);
+    }
+
+    /// [`Aggregate::occluded_packet`] (`STREAM` false) or
+    /// [`Aggregate::occluded_stream`].
+    #[inline(always)]
+    fn occluded_together<const STREAM: bool>(&self, rays: &[Ray], times: &[f32], out: &mut [bool]) {
         match self.top.bvh.as_ref() {
             Some(bvh) if bvh.any_packets_fit() && rays.len() <= PACKET_MAX => {
                 let top = self.shapes();
-                let blocked = bvh.any_packet(rays, |i, pos| {
+                let blocks = |i: usize, pos| {
                     let ray = &rays[i];
                     top.blocks(
                         ray,
@@ -1056,7 +1075,12 @@ impl Aggregate {
                         &mut |k| self.instance_occluded(ray, k),
                         &mut |k| self.moving_occluded(ray, times[i], k),
                     )
-                });
+                };
+                let blocked = if STREAM {
+                    bvh.any_stream(rays, blocks)
+                } else {
+                    bvh.any_packet(rays, blocks)
+                };
                 for (i, o) in out[..rays.len()].iter_mut().enumerate() {
                     *o = blocked >> i & 1 == 1;
                 }

@@ -376,7 +376,22 @@ pub(super) mod tests {
     /// ray gets what `Bvh4::any` answers for it alone.
     #[test]
     fn each_ray_of_a_packet_gets_its_own_occlusion() {
-        let mut rng = Pcg32::with_sequence(11);
+        each_ray_gets_its_own_occlusion(11, packet, |bvh, rays, blocks| {
+            bvh.any_packet(rays, blocks)
+        });
+    }
+
+    /// Up to [`PACKET_MAX`] rays made by `rays(rng, len)`, some of them
+    /// shadow rays of limited reach, traced by `trace` over random
+    /// triangles alone and mixed with spheres (tested by the callback it is
+    /// given): each ray's bit is what `Bvh4::any` answers for it alone, and
+    /// no bit is set past the rays.
+    pub(in crate::accel) fn each_ray_gets_its_own_occlusion(
+        seed: u64,
+        rays: fn(&mut Pcg32, usize) -> Vec<Ray>,
+        trace: impl Fn(&Bvh4, &[Ray], &dyn Fn(usize, u32) -> bool) -> u32,
+    ) {
+        let mut rng = Pcg32::with_sequence(seed);
         let (mut blocked, mut open, mut by_spheres) = (0, 0, 0);
         for n in [4, 20, 300, 3000] {
             for n_spheres in [0, 1, 3, n / 4] {
@@ -394,7 +409,7 @@ pub(super) mod tests {
                 let sphere_at = |pos: u32| spheres[order[pos as usize] as usize - tris.len()];
                 for _ in 0..200 {
                     let len = 1 + rng.uniform_u32_below(PACKET_MAX as u32) as usize;
-                    let mut rays = packet(&mut rng, len);
+                    let mut rays = rays(&mut rng, len);
                     // Shadow rays of limited reach too, some ending on the
                     // grid (at a vertex or edge) or just short of it.
                     for r in rays.iter_mut() {
@@ -402,8 +417,9 @@ pub(super) mod tests {
                             r.t_max = rng.uniform_f32() * 8.0;
                         }
                     }
-                    let got =
-                        bvh.any_packet(&rays, |i, pos| meets_sphere(&rays[i], sphere_at(pos)));
+                    let got = trace(&bvh, &rays, &|i, pos| {
+                        meets_sphere(&rays[i], sphere_at(pos))
+                    });
                     for (i, r) in rays.iter().enumerate() {
                         let alone = bvh.any(r, r.t_max, |pos| meets_sphere(r, sphere_at(pos)));
                         assert_eq!(got >> i & 1 == 1, alone, "ray {r:?}");
@@ -414,7 +430,7 @@ pub(super) mod tests {
                             open += 1;
                         }
                     }
-                    assert_eq!(got >> len, 0, "bits past the packet");
+                    assert_eq!(got >> len, 0, "bits past the rays");
                 }
             }
         }

@@ -4,7 +4,9 @@
 //! steps (a node's loads, its box test, the choice of the next child)
 //! overlaps the others' instead of the processor waiting on it. Each ray
 //! finds what [`Bvh4::closest_hinted`] finds for it alone: the same
-//! arithmetic in the same order, ray by ray.
+//! arithmetic in the same order, ray by ray. Shadow rays from different
+//! points ([`Bvh4::any_stream`]) walk side by side the same way, each
+//! stopping at the first thing that blocks it.
 
 use super::bvh4::{closer, lane_limit, pop_within, reach, stack_children, BoxRay, Bvh4, LEAF};
 use super::packet::PacketHit;
@@ -99,12 +101,129 @@ impl Bvh4 {
     }
 }
 
+/// A shadow ray's walk: [`Bvh4::any`]'s state.
+struct AnyLane {
+    br: BoxRay,
+    tr: TriangleRay4,
+    t_max: f32,
+    cur: u32,
+    sp: usize,
+}
+
+impl Bvh4 {
+    /// Whether something blocks each of incoherent `rays` (at most
+    /// [`STREAM_MAX`]) with `t <= ray.t_max`: bit `i` for `rays[i]`, each
+    /// [`Bvh4::any`]'s answer for the ray alone, `blocks(i, position)`
+    /// deciding a leaf's primitives other than plain triangles for ray `i`
+    /// as `any`'s callback does. Each ray tests the boxes against its own
+    /// fixed `t_max`, so it meets the leaves its own traversal meets, and
+    /// whether any of their primitives blocks it does not depend on the
+    /// order they are visited in. Only where [`Bvh4::any_packets_fit`].
+    pub(super) fn any_stream(
+        &self,
+        rays: &[Ray],
+        mut blocks: impl FnMut(usize, u32) -> bool,
+    ) -> u32 {
+        let n = rays.len();
+        assert!(n <= STREAM_MAX && self.any_packets_fit());
+        let mut lanes = [const { MaybeUninit::<AnyLane>::uninit() }; STREAM_MAX];
+        for (i, r) in rays.iter().enumerate() {
+            lanes[i].write(AnyLane {
+                br: BoxRay::new(r),
+                tr: TriangleRay4::new(r.o, r.d),
+                t_max: r.t_max,
+                cur: 0,
+                sp: 0,
+            });
+        }
+        // SAFETY: the first `n` lanes were written.
+        let lanes =
+            unsafe { &mut *(&mut lanes[..n] as *mut [MaybeUninit<AnyLane>] as *mut [AnyLane]) };
+        let mut stacks = [[MaybeUninit::<u32>::uninit(); STACK]; STREAM_MAX];
+        let mut active: u32 = (1u32 << n) - 1;
+        let mut blocked = 0u32;
+        while active != 0 {
+            let mut m = active;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let l = &mut lanes[i];
+                let stack = &mut stacks[i];
+                let cur = l.cur;
+                if cur & LEAF == 0 {
+                    let node = &self.nodes[cur as usize];
+                    let mask = l.br.test(node, l.t_max).1.bitmask();
+                    if mask != 0 {
+                        // The first child met next, the others stacked
+                        // (every slot written, the pointer moved past the
+                        // met ones).
+                        let first = mask.trailing_zeros() as usize;
+                        let rest = mask & !(1 << first);
+                        for c in 0..4 {
+                            stack[l.sp] = MaybeUninit::new(node.child[c]);
+                            l.sp += ((rest >> c) & 1) as usize;
+                        }
+                        l.cur = node.child[first];
+                        continue;
+                    }
+                } else {
+                    let leaf = &self.leaves[(cur & !LEAF) as usize];
+                    let mut hit =
+                        leaf.triangles != 0 && l.tr.any4_any_axis(&leaf.v, l.t_max, leaf.triangles);
+                    let mut others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
+                    while !hit && others != 0 {
+                        hit = blocks(i, leaf.first + others.trailing_zeros());
+                        others &= others - 1;
+                    }
+                    if hit {
+                        blocked |= 1 << i;
+                        active &= !(1 << i);
+                        continue;
+                    }
+                }
+                if l.sp == 0 {
+                    active &= !(1 << i);
+                } else {
+                    l.sp -= 1;
+                    // SAFETY: entries below the pointer were written.
+                    l.cur = unsafe { stack[l.sp].assume_init() };
+                }
+            }
+        }
+        blocked
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::accel::bvh4::tests::build;
-    use crate::accel::packet::tests::{closest_alone, hit_bits, packet, point, scene};
+    use crate::accel::packet::tests::{
+        closest_alone, each_ray_gets_its_own_occlusion, hit_bits, packet, point, scene,
+    };
     use crate::sampling::rng::Pcg32;
+
+    /// Shadow rays side by side, over triangles alone and mixed with
+    /// spheres (the callback's): each gets what `Bvh4::any` answers for it
+    /// alone.
+    #[test]
+    fn each_ray_side_by_side_gets_its_own_occlusion() {
+        each_ray_gets_its_own_occlusion(13, mixed, |bvh, rays, blocks| {
+            bvh.any_stream(rays, blocks)
+        });
+    }
+
+    /// `len` rays from several packets (coherent, aimed at grid vertices
+    /// and edges, anywhere, some of limited reach), so that rays side by
+    /// side go different ways and have different axes.
+    fn mixed(rng: &mut Pcg32, len: usize) -> Vec<Ray> {
+        let mut rays = Vec::new();
+        while rays.len() < len {
+            let k = 1 + rng.uniform_u32_below(4) as usize;
+            rays.extend(packet(rng, k.min(len - rays.len())));
+        }
+        rays
+    }
 
     /// Rays of every kind mixed (a few of them from each of several
     /// packets: coherent, aimed at grid vertices and edges, anywhere, some
@@ -120,11 +239,7 @@ mod tests {
             assert!(bvh.traces_packets());
             for _ in 0..400 {
                 let len = 1 + rng.uniform_u32_below(STREAM_MAX as u32) as usize;
-                let mut rays = Vec::new();
-                while rays.len() < len {
-                    let k = 1 + rng.uniform_u32_below(4) as usize;
-                    rays.extend(packet(&mut rng, k.min(len - rays.len())));
-                }
+                let mut rays = mixed(&mut rng, len);
                 if rng.uniform_u32_below(8) == 0 {
                     // A ray starting on a triangle of the scene.
                     let v = tris[rng.uniform_u32_below(tris.len() as u32) as usize];

@@ -535,6 +535,17 @@ impl TriangleRay4 {
         }
     }
 
+    /// [`TriangleRay4::any4`] with the ray's own axis read at run time (as
+    /// [`TriangleRay4::intersect4_any_axis`]): for shadow rays traced side
+    /// by side.
+    #[inline(always)]
+    pub fn any4_any_axis(&self, v: &TrianglePack, t_max: f32, lanes: u32) -> bool {
+        match self.lanes_kz(self.scalar.kz as usize, v, t_max, lanes) {
+            Some(r) => r.mask != 0,
+            None => self.scalar.intersect4_scalar(v, t_max, lanes).is_some(),
+        }
+    }
+
     /// The four-lane body of `intersect_k` for the ray's axis `kz`. `None` if a lane in `lanes` has
     /// an edge value of exactly zero (the caller then decides lane by lane).
     #[inline(always)]
