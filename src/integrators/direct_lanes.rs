@@ -4,8 +4,9 @@
 //! light's EstimateDirect (a light sample and a BSDF sample weighted by the
 //! power heuristic) is computed four lanes at a time: triangle sampling, the
 //! solid-angle densities, the BSDF values, the cosine-weighted directions
-//! and the BSDF rays' tests against the lights' triangles. Rays are then
-//! traced one by one, for the lanes that still contribute.
+//! and the BSDF rays' tests against the lights' triangles. Then the lanes'
+//! shadow rays are traced side by side ([`crate::accel::Aggregate::occluded_stream`]),
+//! and the BSDF rays that can still reach the light one by one.
 //!
 //! The lanes are either four lights at one vertex
 //! ([`sample_all_lights_packed`], for one sample at a time) or one light at
@@ -265,9 +266,71 @@ fn estimate4(
     }
 }
 
-/// Lane `lane` of `e` finished at vertex `v`: its shadow ray and BSDF ray
-/// traced, the light's contribution (EstimateDirect's `Ld`). The light is
+/// The shadow ray of lane `lane` of `e` at vertex `v`, if it is traced
+/// (the light sample has a value).
+#[inline(always)]
+fn lane_shadow(
+    e: &Estimate4,
+    lane: usize,
+    pack: &TriangleLightPack,
+    v: &LambertVertex,
+) -> Option<Ray> {
+    let bit = 1 << lane;
+    if e.try_l & bit == 0 || v.f * e.abs_cos_l[lane] == Vec3::ZERO {
+        return None;
+    }
+    let pf = if e.down_l & bit != 0 {
+        v.o_down
+    } else {
+        v.o_up
+    };
+    Some(spawn_ray_from_to(
+        pf,
+        lane3(&e.q, lane),
+        lane3(&e.q_error, lane),
+        lane3(&pack.n, lane),
+    ))
+}
+
+/// The lanes of `e` whose shadow rays (at the vertex `v(lane)`) nothing
+/// blocks, as bits: the rays traced side by side, and counted.
+#[inline(always)]
+fn open_lanes<'v>(
+    scene: &RenderScene,
+    e: &Estimate4,
+    pack: &TriangleLightPack,
+    v: impl Fn(usize) -> &'v LambertVertex,
+    scratch: &mut Scratch,
+) -> u32 {
+    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); 4];
+    let mut times = [0f32; 4];
+    let mut lanes = [0usize; 4];
+    let mut n = 0;
+    for lane in 0..4 {
+        if let Some(r) = lane_shadow(e, lane, pack, v(lane)) {
+            rays[n] = r;
+            times[n] = v(lane).time;
+            lanes[n] = lane;
+            n += 1;
+        }
+    }
+    scratch.counts.shadow += n as u64;
+    let mut blocked = [false; 4];
+    scene
+        .aggregate
+        .occluded_stream(&rays[..n], &times[..n], &mut blocked[..n]);
+    let mut open = 0;
+    for (&lane, &b) in lanes[..n].iter().zip(&blocked[..n]) {
+        open |= u32::from(!b) << lane;
+    }
+    open
+}
+
+/// Lane `lane` of `e` finished at vertex `v`: its BSDF ray traced, the
+/// light's contribution (EstimateDirect's `Ld`), the light sample counted
+/// if its shadow ray is `open` (see [`open_lanes`]). The light is
 /// `light_index`, lane `lane` of `pack`.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn lane_ld(
     scene: &RenderScene,
@@ -276,31 +339,16 @@ fn lane_ld(
     light_index: u32,
     pack: &TriangleLightPack,
     v: &LambertVertex,
+    open: u32,
     scratch: &mut Scratch,
 ) -> Vec3 {
     let bit = 1 << lane;
     let mut ld = Vec3::ZERO;
-    if e.try_l & bit != 0 {
+    if open & bit != 0 {
         let f = v.f * e.abs_cos_l[lane];
-        if f != Vec3::ZERO {
-            scratch.counts.shadow += 1;
-            let pf = if e.down_l & bit != 0 {
-                v.o_down
-            } else {
-                v.o_up
-            };
-            let shadow = spawn_ray_from_to(
-                pf,
-                lane3(&e.q, lane),
-                lane3(&e.q_error, lane),
-                lane3(&pack.n, lane),
-            );
-            if !scene.aggregate.occluded_at(&shadow, v.time) {
-                let li = lane3(&pack.l, lane);
-                let light_pdf = 1.0 * e.pdf_l[lane];
-                ld = f * li * power_heuristic(1, light_pdf, 1, e.scatter_pdf_l[lane]) / light_pdf;
-            }
-        }
+        let li = lane3(&pack.l, lane);
+        let light_pdf = 1.0 * e.pdf_l[lane];
+        ld = f * li * power_heuristic(1, light_pdf, 1, e.scatter_pdf_l[lane]) / light_pdf;
     }
     if e.try_b & bit != 0 {
         let f = v.f * e.abs_cos_b[lane];
@@ -363,8 +411,18 @@ pub(super) fn sample_all_lights_packed(
         let u = draw_samples(sampler, pack.count);
         let lanes = |k: usize| x4(|i| u.get(2 * i + k).copied().unwrap_or_default());
         let e = estimate4(pack, &v4, lanes(0), lanes(1), first_lanes(pack.count));
+        let open = open_lanes(scene, &e, pack, |_| &v, scratch);
         for lane in 0..pack.count {
-            l += lane_ld(scene, &e, lane, (4 * k + lane) as u32, pack, &v, scratch);
+            l += lane_ld(
+                scene,
+                &e,
+                lane,
+                (4 * k + lane) as u32,
+                pack,
+                &v,
+                open,
+                scratch,
+            );
         }
     }
     l
@@ -391,8 +449,9 @@ pub(super) fn sample_all_lights_lanes(
         for (i, light) in lights.iter().enumerate() {
             let lanes = |k: usize| x4(|lane| u[(first + lane.min(n - 1)) * stride + 2 * i + k]);
             let e = estimate4(light, &v4, lanes(0), lanes(1), active);
+            let open = open_lanes(scene, &e, light, |lane| &group[lane.min(n - 1)], scratch);
             for (lane, v) in group.iter().enumerate() {
-                out[first + lane] += lane_ld(scene, &e, lane, i as u32, light, v, scratch);
+                out[first + lane] += lane_ld(scene, &e, lane, i as u32, light, v, open, scratch);
             }
         }
     }
