@@ -59,43 +59,55 @@ impl Bvh4 {
     #[inline(always)]
     fn stream(&self, lanes: &mut [Lane], out: &mut [PacketHit]) {
         let mut stacks = [[MaybeUninit::<(u32, f32)>::uninit(); STACK]; STREAM_MAX];
-        let mut active: u32 = (1u32 << lanes.len()) - 1;
-        while active != 0 {
-            let mut m = active;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let l = &mut lanes[i];
-                let stack = &mut stacks[i];
-                let cur = l.cur;
-                if cur & LEAF == 0 {
-                    let n = &self.nodes[cur as usize];
-                    let (t0, hit_box) = l.br.test(n, reach(l.t_max));
-                    let mask = hit_box.bitmask();
-                    if mask != 0 {
-                        let near = stack_children(n, (t0, hit_box, mask), stack, &mut l.sp);
-                        l.cur = n.child[near];
-                        continue;
-                    }
-                } else {
-                    let leaf = &self.leaves[(cur & !LEAF) as usize];
-                    if let Some((lane, t, b)) = l.tr.intersect4_any_axis(
-                        &leaf.v,
-                        lane_limit(l.t_max, l.limit),
-                        leaf.triangles,
-                    ) {
-                        let pos = leaf.first + lane;
-                        if closer(t, pos, l.t_max, l.best_pos) {
-                            l.t_max = t;
-                            l.best_pos = pos;
-                            out[i] = Some((pos, t, b));
-                        }
+        in_turn(lanes.len(), |i| {
+            let l = &mut lanes[i];
+            let stack = &mut stacks[i];
+            let cur = l.cur;
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (t0, hit_box) = l.br.test(n, reach(l.t_max));
+                let mask = hit_box.bitmask();
+                if mask != 0 {
+                    let near = stack_children(n, (t0, hit_box, mask), stack, &mut l.sp);
+                    l.cur = n.child[near];
+                    return true;
+                }
+            } else {
+                let leaf = &self.leaves[(cur & !LEAF) as usize];
+                if let Some((lane, t, b)) =
+                    l.tr.intersect4_any_axis(&leaf.v, lane_limit(l.t_max, l.limit), leaf.triangles)
+                {
+                    let pos = leaf.first + lane;
+                    if closer(t, pos, l.t_max, l.best_pos) {
+                        l.t_max = t;
+                        l.best_pos = pos;
+                        out[i] = Some((pos, t, b));
                     }
                 }
-                match pop_within(stack, &mut l.sp, l.t_max) {
-                    Some(c) => l.cur = c,
-                    None => active &= !(1 << i),
+            }
+            match pop_within(stack, &mut l.sp, l.t_max) {
+                Some(c) => {
+                    l.cur = c;
+                    true
                 }
+                None => false,
+            }
+        });
+    }
+}
+
+/// The first `n` lanes stepped in turn, one step of each per round, until
+/// `step(lane)` has answered false (the lane's walk is over) for every one.
+#[inline(always)]
+fn in_turn(n: usize, mut step: impl FnMut(usize) -> bool) {
+    let mut active: u32 = (1u32 << n) - 1;
+    while active != 0 {
+        let mut m = active;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if !step(i) {
+                active &= !(1 << i);
             }
         }
     }
@@ -140,56 +152,48 @@ impl Bvh4 {
         let lanes =
             unsafe { &mut *(&mut lanes[..n] as *mut [MaybeUninit<AnyLane>] as *mut [AnyLane]) };
         let mut stacks = [[MaybeUninit::<u32>::uninit(); STACK]; STREAM_MAX];
-        let mut active: u32 = (1u32 << n) - 1;
         let mut blocked = 0u32;
-        while active != 0 {
-            let mut m = active;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let l = &mut lanes[i];
-                let stack = &mut stacks[i];
-                let cur = l.cur;
-                if cur & LEAF == 0 {
-                    let node = &self.nodes[cur as usize];
-                    let mask = l.br.test(node, l.t_max).1.bitmask();
-                    if mask != 0 {
-                        // The first child met next, the others stacked
-                        // (every slot written, the pointer moved past the
-                        // met ones).
-                        let first = mask.trailing_zeros() as usize;
-                        let rest = mask & !(1 << first);
-                        for c in 0..4 {
-                            stack[l.sp] = MaybeUninit::new(node.child[c]);
-                            l.sp += ((rest >> c) & 1) as usize;
-                        }
-                        l.cur = node.child[first];
-                        continue;
+        in_turn(n, |i| {
+            let l = &mut lanes[i];
+            let stack = &mut stacks[i];
+            let cur = l.cur;
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let mask = l.br.test(node, l.t_max).1.bitmask();
+                if mask != 0 {
+                    // The first child met next, the others stacked (every
+                    // slot written, the pointer moved past the met ones).
+                    let first = mask.trailing_zeros() as usize;
+                    let rest = mask & !(1 << first);
+                    for c in 0..4 {
+                        stack[l.sp] = MaybeUninit::new(node.child[c]);
+                        l.sp += ((rest >> c) & 1) as usize;
                     }
-                } else {
-                    let leaf = &self.leaves[(cur & !LEAF) as usize];
-                    let mut hit =
-                        leaf.triangles != 0 && l.tr.any4_any_axis(&leaf.v, l.t_max, leaf.triangles);
-                    let mut others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
-                    while !hit && others != 0 {
-                        hit = blocks(i, leaf.first + others.trailing_zeros());
-                        others &= others - 1;
-                    }
-                    if hit {
-                        blocked |= 1 << i;
-                        active &= !(1 << i);
-                        continue;
-                    }
+                    l.cur = node.child[first];
+                    return true;
                 }
-                if l.sp == 0 {
-                    active &= !(1 << i);
-                } else {
-                    l.sp -= 1;
-                    // SAFETY: entries below the pointer were written.
-                    l.cur = unsafe { stack[l.sp].assume_init() };
+            } else {
+                let leaf = &self.leaves[(cur & !LEAF) as usize];
+                let mut hit =
+                    leaf.triangles != 0 && l.tr.any4_any_axis(&leaf.v, l.t_max, leaf.triangles);
+                let mut others = ((1u32 << leaf.count) - 1) & !leaf.triangles;
+                while !hit && others != 0 {
+                    hit = blocks(i, leaf.first + others.trailing_zeros());
+                    others &= others - 1;
+                }
+                if hit {
+                    blocked |= 1 << i;
+                    return false;
                 }
             }
-        }
+            if l.sp == 0 {
+                return false;
+            }
+            l.sp -= 1;
+            // SAFETY: entries below the pointer were written.
+            l.cur = unsafe { stack[l.sp].assume_init() };
+            true
+        });
         blocked
     }
 }
