@@ -189,3 +189,56 @@ WorldEnd
     assert!(culls(&fast_stats), "{:?}", fast_stats.notes);
     assert!(!culls(&slow_stats), "{:?}", slow_stats.notes);
 }
+
+/// directlighting traces a many-sample light's shadow rays side by side
+/// (up to sixteen at a time, then adds each estimate in order): the image
+/// is the one-by-one code's bit for bit, with the same rays. An
+/// environment light of 37 samples (two full runs and a part-full one), a
+/// disk light of 5 and a point light of 3 over triangles and spheres that
+/// block some of the rays (the spheres answered by the any-hit callback),
+/// plastic, matte and a mirror.
+#[test]
+fn many_sample_lights_shadow_rays_together_are_the_scalar_image() {
+    let text = r#"
+LookAt 0 3 -6  0 0.5 0  0 1 0
+Camera "perspective" "float fov" [45]
+Film "image" "integer xresolution" [32] "integer yresolution" [24]
+Sampler "halton" "integer pixelsamples" [4]
+Integrator "directlighting" "integer maxdepth" [3]
+WorldBegin
+LightSource "infinite" "rgb L" [0.5 0.6 0.8] "integer nsamples" [37]
+LightSource "point" "point from" [1 3 -1] "rgb I" [4 4 4] "integer nsamples" [3]
+AttributeBegin
+  AreaLightSource "area" "rgb L" [5 4 3] "integer nsamples" [5]
+  Translate -1 2.5 0.5
+  Rotate 90 1 0 0
+  Shape "disk" "float radius" [0.5]
+AttributeEnd
+Material "plastic" "rgb Kd" [0.5 0.4 0.3] "float roughness" [0.1]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point P" [-4 0 -4  4 0 -4  4 0 4  -4 0 4]
+AttributeBegin
+  Material "matte" "rgb Kd" [0.3 0.6 0.3]
+  Translate -0.7 0.6 0
+  Shape "sphere" "float radius" [0.6]
+AttributeEnd
+AttributeBegin
+  Material "mirror"
+  Translate 0.9 0.4 -0.5
+  Shape "sphere" "float radius" [0.4]
+AttributeEnd
+AttributeBegin
+  Material "matte" "rgb Kd" [0.7 0.7 0.7]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [0 1.2 0  1.5 1.2 0  1.5 1.2 1.5  0 1.2 1.5]
+AttributeEnd
+WorldEnd
+"#;
+    let desc = match load_scene_str(text, std::path::Path::new("many.pbrt")) {
+        Ok(l) => l.scene,
+        Err(f) => panic!("{:?}", f.errors),
+    };
+    let (fast_stats, slow_stats) = common::assert_fast_image_is_scalar(&desc, "many samples");
+    assert_eq!(fast_stats.rays.shadow, slow_stats.rays.shadow);
+    assert_eq!(fast_stats.rays.closest, slow_stats.rays.closest);
+}

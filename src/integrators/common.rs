@@ -17,6 +17,7 @@ use crate::sampling::power_heuristic;
 use crate::scene::LightSampleStrategy;
 use crate::shapes::{DiffGeom, SurfacePoint};
 use glam::{Vec2, Vec3};
+use std::cell::Cell;
 
 /// The differential geometry of `hit` at `s`, with the screen-space
 /// derivatives of ray differentials `d`.
@@ -333,6 +334,34 @@ impl ShadowRay for Unoccluded {
     ) -> Option<Vec3> {
         scratch.counts.shadow += 1;
         (!scene.aggregate.occluded_at(shadow, time)).then_some(f)
+    }
+}
+
+/// A shadow ray that is not traced here: it is written to `ray` and
+/// `kept` is set, and the sample's value is what it is if nothing blocks
+/// the ray (the caller traces it, side by side with others, and keeps the
+/// value only if it is clear).
+#[derive(Clone, Copy)]
+pub(super) struct KeepShadow<'c> {
+    pub(super) ray: &'c Cell<Ray>,
+    pub(super) kept: &'c Cell<bool>,
+}
+
+impl ShadowRay for KeepShadow<'_> {
+    #[inline(always)]
+    fn through(
+        &self,
+        _: &RenderScene,
+        shadow: &Ray,
+        _: f32,
+        _: Vec3,
+        f: Vec3,
+        _: &mut Sampler,
+        _: &mut Scratch,
+    ) -> Option<Vec3> {
+        self.ray.set(*shadow);
+        self.kept.set(true);
+        Some(f)
     }
 }
 

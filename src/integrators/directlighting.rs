@@ -13,7 +13,7 @@
 use super::batch::{trace_camera_rays, Batch};
 use super::common::{
     choose_light, emitted, light_along, light_sampler, light_strategy, shade_geom, with_diff,
-    LightSampleFirst, SurfaceScatter, Unoccluded,
+    KeepShadow, LightSampleFirst, ShadowRay, SurfaceScatter, Unoccluded,
 };
 use super::direct_lanes;
 use super::specular::{specular_tree_li, tree_lanes, tree_li, First, SpecularTree};
@@ -28,6 +28,7 @@ use crate::integrators::RenderScene;
 use crate::scene::kind::{Report, Support};
 use crate::scene::{DirectStrategy, LightSampleStrategy, ParamSpec, ParamValues};
 use glam::{Vec2, Vec3};
+use std::cell::Cell;
 
 pub const PARAMS: &[ParamSpec] = &[
     MAX_DEPTH,
@@ -290,6 +291,7 @@ impl SpecularTree for DirectLighting {
                     scratch,
                     &self.n_light_samples,
                     &self.light_boxes,
+                    !self.scalar,
                 ),
                 (DirectStrategy::One, _) => {
                     sample_one_light(scene, s, bsdf, wo, sampler, scratch, &self.lights)
@@ -413,7 +415,9 @@ pub(super) fn sample_one_light(
     estimate_direct(scene, s, bsdf, wo, light, None, u_light, u_scatter, sampler, scratch) / pmf
 }
 
-/// pbrt-v3's UniformSampleAllLights with per-pixel sample arrays.
+/// pbrt-v3's UniformSampleAllLights with per-pixel sample arrays; with
+/// `together`, a many-sample light's shadow rays are traced side by side
+/// ([`estimates_together`], the same values; off under the scalar switch).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn sample_all_lights(
     scene: &RenderScene,
@@ -424,6 +428,7 @@ pub(super) fn sample_all_lights(
     scratch: &mut Scratch,
     n_light_samples: &[u32],
     light_boxes: &[Option<Bounds3>],
+    together: bool,
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
     let mut u_light = std::mem::take(&mut scratch.u_light);
@@ -468,14 +473,31 @@ pub(super) fn sample_all_lights(
         let got_scatter = take(&mut u_scatter);
         let reach = light_box.and_then(|b| Reach::new(&b, p));
         let ld = if got_light && got_scatter {
-            let mut sum = Vec3::ZERO;
-            for k in 0..n as usize {
-                let (ul, us) = if delta {
+            let u = |k: usize| {
+                if delta {
                     (Vec2::ZERO, Vec2::ZERO)
                 } else {
                     (u_light[k], u_scatter[k])
-                };
-                sum += estimate_direct(scene, s, bsdf, wo, light, reach, ul, us, sampler, scratch);
+                }
+            };
+            let mut sum = Vec3::ZERO;
+            if together && n > 1 {
+                // Their shadow rays traced side by side, a run at a time.
+                let mut first = 0;
+                while first < n as usize {
+                    let count = (n as usize - first).min(SHADOW_RUN);
+                    estimates_together(
+                        scene, s, bsdf, wo, light, reach, first, count, &u, &mut sum, sampler,
+                        scratch,
+                    );
+                    first += count;
+                }
+            } else {
+                for k in 0..n as usize {
+                    let (ul, us) = u(k);
+                    sum +=
+                        estimate_direct(scene, s, bsdf, wo, light, reach, ul, us, sampler, scratch);
+                }
             }
             sum / n as f32
         } else {
@@ -540,6 +562,79 @@ fn wholly_behind(b: &Bounds3, p: Vec3, n: Vec3, wo: Vec3) -> bool {
     d + r < -margin
 }
 
+/// A many-sample light's estimates whose shadow rays are traced together.
+const SHADOW_RUN: usize = crate::accel::PACKET_MAX;
+
+/// `count` of a many-sample light's estimates (samples `first` onwards,
+/// `u(k)` giving sample `k`'s light and BSDF values) added to `sum` in
+/// order, each [`estimate_direct`]'s value bit for bit: their shadow rays are
+/// kept and traced side by side ([`crate::accel::Aggregate::occluded_stream`]),
+/// then each estimate is its light strategy's value if its ray is clear
+/// (0 otherwise) plus its BSDF strategy's, as `estimate_direct` adds them.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn estimates_together(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    light_index: u32,
+    reach: Option<Reach>,
+    first: usize,
+    count: usize,
+    u: &impl Fn(usize) -> (Vec2, Vec2),
+    sum: &mut Vec3,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) {
+    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); SHADOW_RUN];
+    let mut which = [0usize; SHADOW_RUN];
+    let mut parts = [(Vec3::ZERO, None); SHADOW_RUN];
+    let mut n_rays = 0;
+    for (i, part) in parts[..count].iter_mut().enumerate() {
+        let (ul, us) = u(first + i);
+        let kept = Cell::new(false);
+        let shadow = KeepShadow {
+            ray: Cell::from_mut(&mut rays[n_rays]),
+            kept: &kept,
+        };
+        *part = estimate_parts(
+            scene,
+            s,
+            bsdf,
+            wo,
+            light_index,
+            reach,
+            ul,
+            us,
+            shadow,
+            sampler,
+            scratch,
+        );
+        if kept.get() {
+            which[n_rays] = i;
+            n_rays += 1;
+        }
+    }
+    scratch.counts.shadow += n_rays as u64;
+    let times = [s.time; SHADOW_RUN];
+    let mut blocked = [false; SHADOW_RUN];
+    scene
+        .aggregate
+        .occluded_stream(&rays[..n_rays], &times[..n_rays], &mut blocked[..n_rays]);
+    let mut clear = [false; SHADOW_RUN];
+    for (&i, &b) in which[..n_rays].iter().zip(&blocked[..n_rays]) {
+        clear[i] = !b;
+    }
+    for (&(light, by_bsdf), &clear) in parts[..count].iter().zip(&clear[..count]) {
+        let mut ld = if clear { light } else { Vec3::ZERO };
+        if let Some(b) = by_bsdf {
+            ld += b;
+        }
+        *sum += ld;
+    }
+}
+
 /// pbrt-v3's EstimateDirect: one light sample and one BSDF sample combined
 /// with the power heuristic; the BSDF sample is skipped for delta lights.
 #[allow(clippy::too_many_arguments)]
@@ -556,6 +651,43 @@ pub(super) fn estimate_direct(
     sampler: &mut Sampler,
     scratch: &mut Scratch,
 ) -> Vec3 {
+    let (mut ld, by_bsdf) = estimate_parts(
+        scene,
+        s,
+        bsdf,
+        wo,
+        light_index,
+        reach,
+        u_light,
+        u_scatter,
+        Unoccluded,
+        sampler,
+        scratch,
+    );
+    if let Some(b) = by_bsdf {
+        ld += b;
+    }
+    ld
+}
+
+/// [`estimate_direct`]'s two strategies with the light sample's shadow ray
+/// through `shadow`: the light sample's value, and the BSDF sample's when
+/// it is added.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn estimate_parts(
+    scene: &RenderScene,
+    s: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    light_index: u32,
+    reach: Option<Reach>,
+    u_light: Vec2,
+    u_scatter: Vec2,
+    shadow: impl ShadowRay,
+    sampler: &mut Sampler,
+    scratch: &mut Scratch,
+) -> (Vec3, Option<Vec3>) {
     let light = &scene.lights[light_index as usize];
     let geom = &scene.aggregate;
     let ns = s.point.ns;
@@ -564,7 +696,7 @@ pub(super) fn estimate_direct(
         ns,
         flags: BxdfFlags::NON_SPECULAR,
     };
-    let mut ld = light_strategy(
+    let ld = light_strategy(
         scene,
         &s.point,
         s.time,
@@ -573,7 +705,7 @@ pub(super) fn estimate_direct(
         light_index,
         u_light,
         1.0,
-        Unoccluded,
+        shadow,
         sampler,
         scratch,
     );
@@ -588,13 +720,13 @@ pub(super) fn estimate_direct(
                 let ray = spawn_ray(s.point.p, s.point.p_error, s.point.n, bs.wi);
                 let light_pdf = light.pdf_li_ray(&s.point, &ray, geom);
                 if light_pdf == 0.0 {
-                    return ld;
+                    return (ld, None);
                 }
                 let weight = power_heuristic(1, bs.pdf, 1, light_pdf);
                 let li = light_along(scene, &ray, bs.wi, s.time, light_index, scratch);
-                ld += f * li * weight / bs.pdf;
+                return (ld, Some(f * li * weight / bs.pdf));
             }
         }
     }
-    ld
+    (ld, None)
 }
