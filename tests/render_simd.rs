@@ -169,10 +169,7 @@ AttributeBegin
 AttributeEnd
 WorldEnd
 "#;
-    let desc = match load_scene_str(text, std::path::Path::new("behind.pbrt")) {
-        Ok(l) => l.scene,
-        Err(f) => panic!("{:?}", f.errors),
-    };
+    let desc = common::load_text(text).scene;
     let (fast_stats, slow_stats) = common::assert_fast_image_is_scalar(&desc, "lights behind");
     // The skipped BSDF samples towards the sphere light trace no rays (its
     // density is the cone's, whatever the direction; the scalar code traces
@@ -234,10 +231,7 @@ AttributeBegin
 AttributeEnd
 WorldEnd
 "#;
-    let desc = match load_scene_str(text, std::path::Path::new("many.pbrt")) {
-        Ok(l) => l.scene,
-        Err(f) => panic!("{:?}", f.errors),
-    };
+    let desc = common::load_text(text).scene;
     let (fast_stats, slow_stats) = common::assert_fast_image_is_scalar(&desc, "many samples");
     assert_eq!(fast_stats.rays.shadow, slow_stats.rays.shadow);
     assert_eq!(fast_stats.rays.closest, slow_stats.rays.closest);
