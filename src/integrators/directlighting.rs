@@ -627,11 +627,7 @@ fn estimates_together(
         clear[i] = !b;
     }
     for (&(light, by_bsdf), &clear) in parts[..count].iter().zip(&clear[..count]) {
-        let mut ld = if clear { light } else { Vec3::ZERO };
-        if let Some(b) = by_bsdf {
-            ld += b;
-        }
-        *sum += ld;
+        *sum += both_strategies(if clear { light } else { Vec3::ZERO }, by_bsdf);
     }
 }
 
@@ -651,7 +647,7 @@ pub(super) fn estimate_direct(
     sampler: &mut Sampler,
     scratch: &mut Scratch,
 ) -> Vec3 {
-    let (mut ld, by_bsdf) = estimate_parts(
+    let (light, by_bsdf) = estimate_parts(
         scene,
         s,
         bsdf,
@@ -664,6 +660,14 @@ pub(super) fn estimate_direct(
         sampler,
         scratch,
     );
+    both_strategies(light, by_bsdf)
+}
+
+/// EstimateDirect's sum: the light strategy's value, plus the BSDF
+/// strategy's when it has one (added to it, as pbrt-v3's `Ld +=`).
+#[inline(always)]
+fn both_strategies(light: Vec3, by_bsdf: Option<Vec3>) -> Vec3 {
+    let mut ld = light;
     if let Some(b) = by_bsdf {
         ld += b;
     }
