@@ -193,6 +193,27 @@ impl Sphere {
         let cos_max = (1.0 - sin2).max(0.0).sqrt();
         Some((c, r, cos_max))
     }
+
+    /// The quadratic's roots t0 ≤ t1 for an object-space ray with a = |d|²,
+    /// b = 2 d·o and c = |o|² − r² (`None` when it misses the sphere).
+    #[inline(always)]
+    fn roots(&self, oo: DVec3, od: DVec3, a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+        // Stable quadratic (pbrt-v4): discriminant from the closest approach.
+        let v = oo - (b / (2.0 * a)) * od;
+        let len = v.length();
+        let disc = 4.0 * a * (self.radius + len) * (self.radius - len);
+        if disc < 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        let q = if b < 0.0 {
+            -0.5 * (b - root)
+        } else {
+            -0.5 * (b + root)
+        };
+        let (t0, t1) = (q / a, if q != 0.0 { c / q } else { q / a });
+        Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
+    }
 }
 
 impl Analytic for Sphere {
@@ -224,31 +245,16 @@ impl Analytic for Sphere {
         if a == 0.0 {
             return None;
         }
-        // Stable quadratic (pbrt-v4): discriminant from the closest approach.
         let b = 2.0 * od.dot(oo);
-        let v = oo - (b / (2.0 * a)) * od;
-        let len = v.length();
-        let disc = 4.0 * a * (self.radius + len) * (self.radius - len);
-        if disc < 0.0 {
+        let c = oo.length_squared() - self.radius * self.radius;
+        // Outside and moving away (every ray leaving the sphere's outer
+        // side): both roots are ≤ 0 (q < 0 or -0, so t0 = q/a ≤ 0 and
+        // t1 = c/q < 0), so no hit; decided before the square roots and
+        // divisions of `roots`, from the same b and c.
+        if b > 0.0 && c > 0.0 {
             return None;
         }
-        let root = disc.sqrt();
-        let q = if b < 0.0 {
-            -0.5 * (b - root)
-        } else {
-            -0.5 * (b + root)
-        };
-        let (mut t0, mut t1) = (
-            q / a,
-            if q != 0.0 {
-                (oo.length_squared() - self.radius * self.radius) / q
-            } else {
-                q / a
-            },
-        );
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
+        let (t0, t1) = self.roots(oo, od, a, b, c)?;
         let t_max = t_max as f64;
         for t in [t0, t1] {
             if !(t > 0.0 && t < t_max && t as f32 > 0.0) {
@@ -459,5 +465,46 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The early miss of rays outside the sphere and moving away agrees
+    /// with the quadratic: for such rays `roots` has no root above 0, at
+    /// any scale and for rays just off the surface as well as far away.
+    #[test]
+    fn outside_and_moving_away_has_no_positive_root() {
+        let mut rng = crate::sampling::rng::Pcg32::new();
+        let mut checked = 0;
+        for scale in [1e-4f64, 1.0, 1e5] {
+            let s = Sphere::new(Placed::new(
+                (1.3, -1.3, 1.3, 360.0),
+                DMat4::from_scale(DVec3::splat(scale)),
+                false,
+                0,
+            ));
+            for _ in 0..20000 {
+                let dir = |r: &mut crate::sampling::rng::Pcg32| {
+                    DVec3::new(
+                        r.uniform_f32() as f64 - 0.5,
+                        r.uniform_f32() as f64 - 0.5,
+                        r.uniform_f32() as f64 - 0.5,
+                    )
+                };
+                // Points near the surface (either side) and far out.
+                let radial = [1.0 + 1e-12, 1.0 + 1e-7, 1.0 - 1e-9, 1.5, 40.0]
+                    [rng.uniform_u32_below(5) as usize];
+                let oo = dir(&mut rng).normalize() * s.radius * radial;
+                let od = dir(&mut rng) * [1e-3, 1.0, 1e3][rng.uniform_u32_below(3) as usize];
+                let (a, b) = (od.length_squared(), 2.0 * od.dot(oo));
+                let c = oo.length_squared() - s.radius * s.radius;
+                if a == 0.0 || !(b > 0.0 && c > 0.0) {
+                    continue;
+                }
+                checked += 1;
+                if let Some((t0, t1)) = s.roots(oo, od, a, b, c) {
+                    assert!(t0 <= 0.0 && t1 <= 0.0, "{oo} {od}: {t0} {t1}");
+                }
+            }
+        }
+        assert!(checked > 10000);
     }
 }
