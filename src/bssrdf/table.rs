@@ -33,7 +33,10 @@ use crate::bxdf::fr_dielectric;
 use crate::media::phase_hg;
 use crate::sampling::interpolation::{integrate_catmull_rom, invert_catmull_rom};
 use glam::Vec3;
+use rayon::prelude::*;
+use std::collections::HashMap;
 use std::f32::consts::PI;
+use std::sync::{Arc, Mutex, Weak};
 
 const INV_4PI: f32 = 1.0 / (4.0 * PI);
 
@@ -127,15 +130,25 @@ impl Dipole {
     }
 }
 
+/// `ln(1 − (i + ½)/n)` for the beam integrals' depth samples `i` (the
+/// same for every albedo and radius, so made once per table).
+fn depth_logs() -> [f32; DEPTH_SAMPLES] {
+    std::array::from_fn(|i| (1.0 - (i as f32 + 0.5) / DEPTH_SAMPLES as f32).ln())
+}
+
 /// pbrt-v3's `BeamDiffusionMS`: the multiple-scattering profile at radius
 /// `r` of a medium with `sigma_s`, `sigma_a`, HG `g` and boundary `eta`,
 /// integrating dipoles along the refracted beam (sources at depths
 /// sampled by the reduced extinction).
 pub fn beam_diffusion_ms(sigma_s: f32, sigma_a: f32, g: f32, eta: f32, r: f32) -> f32 {
-    let dip = Dipole::new(sigma_s, sigma_a, g, eta);
+    ms_with(&Dipole::new(sigma_s, sigma_a, g, eta), &depth_logs(), r)
+}
+
+/// [`beam_diffusion_ms`] from the medium's dipole and [`depth_logs`].
+fn ms_with(dip: &Dipole, logs: &[f32; DEPTH_SAMPLES], r: f32) -> f32 {
     let mut ed = 0.0f32;
-    for i in 0..DEPTH_SAMPLES {
-        let zr = -(1.0 - (i as f32 + 0.5) / DEPTH_SAMPLES as f32).ln() / dip.sigmap_t;
+    for &log in logs {
+        let zr = -log / dip.sigmap_t;
         let dr = (r * r + zr * zr).sqrt();
         let kappa = 1.0 - (-2.0 * dip.sigmap_t * (dr + zr)).exp();
         ed += kappa * dip.rhop * dip.rhop * dip.exitance(zr, r);
@@ -147,12 +160,24 @@ pub fn beam_diffusion_ms(sigma_s: f32, sigma_a: f32, g: f32, eta: f32, r: f32) -
 /// (scattering once along the refracted beam below the critical angle and
 /// leaving through the Fresnel boundary).
 pub fn beam_diffusion_ss(sigma_s: f32, sigma_a: f32, g: f32, eta: f32, r: f32) -> f32 {
+    ss_with(sigma_s, sigma_a, g, eta, &depth_logs(), r)
+}
+
+/// [`beam_diffusion_ss`] with [`depth_logs`].
+fn ss_with(
+    sigma_s: f32,
+    sigma_a: f32,
+    g: f32,
+    eta: f32,
+    logs: &[f32; DEPTH_SAMPLES],
+    r: f32,
+) -> f32 {
     let sigma_t = sigma_a + sigma_s;
     let rho = sigma_s / sigma_t;
     let t_crit = r * (eta * eta - 1.0).max(0.0).sqrt();
     let mut ess = 0.0f32;
-    for i in 0..DEPTH_SAMPLES {
-        let ti = t_crit - (1.0 - (i as f32 + 0.5) / DEPTH_SAMPLES as f32).ln() / sigma_t;
+    for &log in logs {
+        let ti = t_crit - log / sigma_t;
         let d = (r * r + ti * ti).sqrt();
         let cos_o = ti / d;
         ess += rho * (-sigma_t * (d + t_crit)).exp() / (d * d)
@@ -162,6 +187,9 @@ pub fn beam_diffusion_ss(sigma_s: f32, sigma_a: f32, g: f32, eta: f32, r: f32) -
     }
     ess / DEPTH_SAMPLES as f32
 }
+
+/// The tables materials hold, by the bits of their `g` and `eta`.
+type LiveTables = HashMap<(u32, u32), Weak<BssrdfTable>>;
 
 /// pbrt-v3's `BSSRDFTable`, filled by `ComputeBeamDiffusionBSSRDF`.
 #[derive(Clone, Debug)]
@@ -192,21 +220,24 @@ impl BssrdfTable {
         let mut profile = vec![0.0f32; n_rho * n_r];
         let mut profile_cdf = vec![0.0f32; n_rho * n_r];
         let mut rho_eff = vec![0.0f32; n_rho];
-        for (i, &rho) in rho_samples.iter().enumerate() {
-            let row = &mut profile[i * n_r..(i + 1) * n_r];
-            for (p, &r) in row.iter_mut().zip(&radius_samples) {
-                *p = 2.0
-                    * PI
-                    * r
-                    * (beam_diffusion_ss(rho, 1.0 - rho, g, eta, r)
-                        + beam_diffusion_ms(rho, 1.0 - rho, g, eta, r));
-            }
-            rho_eff[i] = integrate_catmull_rom(
-                &radius_samples,
-                row,
-                &mut profile_cdf[i * n_r..(i + 1) * n_r],
-            );
-        }
+        // The rows (albedos) are independent: filled side by side, each
+        // with pbrt-v3's operations, its dipole made once for its radii.
+        let logs = depth_logs();
+        profile
+            .par_chunks_mut(n_r)
+            .zip(profile_cdf.par_chunks_mut(n_r))
+            .zip(rho_eff.par_iter_mut())
+            .zip(rho_samples.par_iter())
+            .for_each(|(((row, cdf), eff), &rho)| {
+                let dip = Dipole::new(rho, 1.0 - rho, g, eta);
+                for (p, &r) in row.iter_mut().zip(&radius_samples) {
+                    *p = 2.0
+                        * PI
+                        * r
+                        * (ss_with(rho, 1.0 - rho, g, eta, &logs, r) + ms_with(&dip, &logs, r));
+                }
+                *eff = integrate_catmull_rom(&radius_samples, row, cdf);
+            });
         BssrdfTable {
             rho_samples,
             radius_samples,
@@ -214,6 +245,30 @@ impl BssrdfTable {
             profile_cdf,
             rho_eff,
         }
+    }
+
+    /// [`BssrdfTable::beam_diffusion`]`(g, eta)`, shared with every other
+    /// live material of the same `g` and `eta` (bit for bit), so that a
+    /// scene's materials of one medium kind compute it once.
+    pub fn shared(g: f32, eta: f32) -> Arc<BssrdfTable> {
+        static LIVE: Mutex<Option<LiveTables>> = Mutex::new(None);
+        let key = (g.to_bits(), eta.to_bits());
+        let lock = || LIVE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(table) = lock().as_ref().and_then(|live| live.get(&key)?.upgrade()) {
+            return table;
+        }
+        // Computed without the lock held (its rows run on the thread pool);
+        // a table another thread made meanwhile is taken instead.
+        let table = Arc::new(BssrdfTable::beam_diffusion(g, eta));
+        let mut live = lock();
+        let live = live.get_or_insert_with(HashMap::new);
+        if let Some(other) = live.get(&key).and_then(Weak::upgrade) {
+            return other;
+        }
+        // Only the tables some material still holds are remembered.
+        live.retain(|_, t| t.strong_count() > 0);
+        live.insert(key, Arc::downgrade(&table));
+        table
     }
 
     /// The tabulated `2π r S` at albedo index `rho_index`, radius index
@@ -248,6 +303,56 @@ mod tests {
     fn table() -> &'static BssrdfTable {
         static T: OnceLock<BssrdfTable> = OnceLock::new();
         T.get_or_init(|| BssrdfTable::beam_diffusion(0.0, 1.33))
+    }
+
+    /// The rows filled side by side (each with its dipole and the depth
+    /// samples' logarithms made once) hold, entry by entry, pbrt-v3's
+    /// `2π r (BeamDiffusionSS + BeamDiffusionMS)` at their albedo and
+    /// radius, and their integrals, bit for bit.
+    #[test]
+    fn parallel_rows_are_the_entries_one_by_one() {
+        for (g, eta) in [(0.0, 1.33), (0.7, 1.5), (-0.3, 1.0)] {
+            let t = BssrdfTable::beam_diffusion(g, eta);
+            let n_r = t.radius_samples.len();
+            for (i, &rho) in t.rho_samples.iter().enumerate() {
+                let row: Vec<f32> = t
+                    .radius_samples
+                    .iter()
+                    .map(|&r| {
+                        2.0 * PI
+                            * r
+                            * (beam_diffusion_ss(rho, 1.0 - rho, g, eta, r)
+                                + beam_diffusion_ms(rho, 1.0 - rho, g, eta, r))
+                    })
+                    .collect();
+                let mut cdf = vec![0.0; n_r];
+                let eff = integrate_catmull_rom(&t.radius_samples, &row, &mut cdf);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(&t.profile[i * n_r..(i + 1) * n_r]),
+                    bits(&row),
+                    "g {g} row {i}"
+                );
+                assert_eq!(bits(&t.profile_cdf[i * n_r..(i + 1) * n_r]), bits(&cdf));
+                assert_eq!(t.rho_eff[i].to_bits(), eff.to_bits());
+            }
+        }
+    }
+
+    /// Materials of one medium kind (`g`, `eta`) share one table; another
+    /// kind gets its own; a table no material holds any more is not kept.
+    #[test]
+    fn shared_tables_one_per_medium_while_held() {
+        let (g, eta) = (0.25, 1.41);
+        let a = BssrdfTable::shared(g, eta);
+        let b = BssrdfTable::shared(g, eta);
+        assert!(Arc::ptr_eq(&a, &b));
+        let c = BssrdfTable::shared(g, 1.4);
+        assert!(!Arc::ptr_eq(&a, &c));
+        assert_eq!(a.profile, BssrdfTable::beam_diffusion(g, eta).profile);
+        let weak = Arc::downgrade(&a);
+        drop((a, b));
+        assert!(weak.upgrade().is_none());
     }
 
     /// Numerical integral of `f` over r in [0, r_max] on a geometric grid.

@@ -109,7 +109,7 @@ impl Boundary {
             scale: p.float("scale"),
             g,
             eta,
-            table: Arc::new(BssrdfTable::beam_diffusion(g, eta)),
+            table: BssrdfTable::shared(g, eta),
         }
     }
 
