@@ -18,6 +18,7 @@ mod distribution;
 pub mod env_batch;
 pub mod goniometric;
 pub mod infinite;
+mod infinite_lanes;
 mod pack;
 pub mod point;
 pub mod projection;
