@@ -144,21 +144,8 @@ impl Analytic for Cylinder {
         let b = 2.0 * (od.x * oo.x + od.y * oo.y);
         let (vx, vy) = (oo.x - b / (2.0 * a) * od.x, oo.y - b / (2.0 * a) * od.y);
         let len = (vx * vx + vy * vy).sqrt();
-        let disc = 4.0 * a * (self.radius + len) * (self.radius - len);
-        if disc < 0.0 {
-            return None;
-        }
-        let root = disc.sqrt();
-        let q = if b < 0.0 {
-            -0.5 * (b - root)
-        } else {
-            -0.5 * (b + root)
-        };
         let c = oo.x * oo.x + oo.y * oo.y - self.radius * self.radius;
-        let (mut t0, mut t1) = (q / a, if q != 0.0 { c / q } else { q / a });
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
+        let (t0, t1) = super::stable_roots(a, b, c, self.radius, len)?;
         let t_max = t_max as f64;
         for t in [t0, t1] {
             if !(t > 0.0 && t < t_max && t as f32 > 0.0) {

@@ -350,6 +350,26 @@ impl DiffGeom {
     }
 }
 
+/// The roots t0 ≤ t1 of a·t² + b·t + c for a ray against a quadric of
+/// radius `radius` whose closest approach to the centre (or the axis) is
+/// `len`: pbrt-v4's stable quadratic, its discriminant 4a(r + len)(r − len)
+/// from that approach (`None` when the ray misses).
+#[inline(always)]
+fn stable_roots(a: f64, b: f64, c: f64, radius: f64, len: f64) -> Option<(f64, f64)> {
+    let disc = 4.0 * a * (radius + len) * (radius - len);
+    if disc < 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    let q = if b < 0.0 {
+        -0.5 * (b - root)
+    } else {
+        -0.5 * (b + root)
+    };
+    let (t0, t1) = (q / a, if q != 0.0 { c / q } else { q / a });
+    Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
+}
+
 /// pbrt-v3's `SolveLinearSystem2x2`.
 #[inline]
 fn solve_2x2(a: [[f32; 2]; 2], b: [f32; 2]) -> Option<(f32, f32)> {

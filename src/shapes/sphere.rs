@@ -198,21 +198,9 @@ impl Sphere {
     /// b = 2 d·o and c = |o|² − r² (`None` when it misses the sphere).
     #[inline(always)]
     fn roots(&self, oo: DVec3, od: DVec3, a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
-        // Stable quadratic (pbrt-v4): discriminant from the closest approach.
+        // The discriminant from the closest approach to the centre.
         let v = oo - (b / (2.0 * a)) * od;
-        let len = v.length();
-        let disc = 4.0 * a * (self.radius + len) * (self.radius - len);
-        if disc < 0.0 {
-            return None;
-        }
-        let root = disc.sqrt();
-        let q = if b < 0.0 {
-            -0.5 * (b - root)
-        } else {
-            -0.5 * (b + root)
-        };
-        let (t0, t1) = (q / a, if q != 0.0 { c / q } else { q / a });
-        Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
+        super::stable_roots(a, b, c, self.radius, v.length())
     }
 }
 
