@@ -271,10 +271,10 @@ impl Level {
     }
 
     /// `luminance(bilerp((u + ½)/n, vp)) · scale` for `u` in `0..n`
-    /// (`out.len()` = n): a row of the sampling distribution, with the
-    /// row's texel rows and offset found once and each entry computed by
-    /// `bilerp`'s operations in its order, so the values are its bit for
-    /// bit (eight at a time in AVX2 lanes where the build has AVX2).
+    /// (`out.len()` = n): a row of the sampling distribution, eight entries
+    /// at a time in AVX2 lanes (the row's texel rows and offset found once,
+    /// each lane `bilerp`'s operations in its order, so the values are its
+    /// bit for bit) where the build has AVX2, the others by `bilerp`.
     pub(super) fn luminance_row(&self, vp: f32, scale: f32, out: &mut [f32]) {
         let t = vp * self.h as f32 - 0.5;
         let t0 = t.floor();
@@ -282,18 +282,7 @@ impl Level {
         let rows = (ra * self.w, rb * self.w);
         let dt = t - t0;
         let n = out.len() as f32;
-        let entry = |u: usize| {
-            let s = (u as f32 + 0.5) / n * self.w as f32 - 0.5;
-            let s0 = s.floor();
-            let (sa, sb) = wrap_pair(s0 as i64, self.w);
-            let ds = s - s0;
-            let tx = &self.texels;
-            let c = (1.0 - ds) * (1.0 - dt) * tx[rows.0 + sa]
-                + (1.0 - ds) * dt * tx[rows.1 + sa]
-                + ds * (1.0 - dt) * tx[rows.0 + sb]
-                + ds * dt * tx[rows.1 + sb];
-            luminance(c) * scale
-        };
+        let entry = |u: usize| luminance(self.bilerp(Vec2::new((u as f32 + 0.5) / n, vp))) * scale;
         super::infinite_lanes::luminance_row(&self.texels, self.w, rows, dt, scale, out, entry);
     }
 
