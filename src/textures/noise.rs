@@ -11,7 +11,7 @@ use glam::Vec3;
 /// stores it twice; pbrs indexes it modulo 256 instead). Data from
 /// mmp/pbrt-v3 @13d871f, src/core/texture.cpp.
 #[rustfmt::skip]
-const PERM: [u8; 256] = [
+pub(super) const PERM: [u8; 256] = [
     151, 160, 137, 91, 90, 15, 131, 13, 201, 95, 96, 53, 194, 233, 7, 225,
     140, 36, 103, 30, 69, 142, 8, 99, 37, 240, 21, 10, 23, 190, 6, 148,
     247, 120, 234, 75, 0, 26, 197, 62, 94, 252, 219, 203, 117, 35, 11, 32,
@@ -52,7 +52,7 @@ pub(super) fn weight(t: f32) -> f32 {
 }
 
 #[inline(always)]
-fn lerp(t: f32, a: f32, b: f32) -> f32 {
+pub(super) fn lerp(t: f32, a: f32, b: f32) -> f32 {
     (1.0 - t) * a + t * b
 }
 
@@ -133,9 +133,23 @@ fn octaves(dpdx: Vec3, dpdy: Vec3, max_octaves: i32) -> (f32, i32) {
 }
 
 /// pbrt-v3's `FBm`: octaves of noise with frequency ×1.99 and amplitude
-/// ×`omega` each, the last one faded in.
+/// ×`omega` each, the last one faded in. The octaves' noise values are
+/// computed eight at a time ([`super::noise_lanes`]), bit for bit
+/// [`fbm_plain`]'s.
+#[inline]
 pub fn fbm(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: i32) -> f32 {
     let (n, n_int) = octaves(dpdx, dpdy, max_octaves);
+    super::noise_lanes::fbm(p, omega, n, n_int)
+}
+
+/// [`fbm`] octave by octave, as pbrt-v3 writes it (the reference).
+pub fn fbm_plain(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: i32) -> f32 {
+    let (n, n_int) = octaves(dpdx, dpdy, max_octaves);
+    fbm_sum(p, omega, n, n_int)
+}
+
+/// `fbm`'s sum for `n` octaves (`n_int` whole ones), octave by octave.
+pub(super) fn fbm_sum(p: Vec3, omega: f32, n: f32, n_int: i32) -> f32 {
     let (mut sum, mut lambda, mut o) = (0.0f32, 1.0f32, 1.0f32);
     for _ in 0..n_int {
         sum += o * noise3(lambda * p);
@@ -149,9 +163,23 @@ pub fn fbm(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: i32) -> f32
 
 /// pbrt-v3's `Turbulence`: as [`fbm`] with |noise|, the clamped octaves
 /// replaced by their average 0.2 (pbrt-v3 does not advance the amplitude
-/// after the partial octave; neither does pbrs).
+/// after the partial octave; neither does pbrs). The noise values are
+/// computed eight at a time, bit for bit [`turbulence_plain`]'s.
+#[inline]
 pub fn turbulence(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: i32) -> f32 {
     let (n, n_int) = octaves(dpdx, dpdy, max_octaves);
+    super::noise_lanes::turbulence(p, omega, n, n_int, max_octaves)
+}
+
+/// [`turbulence`] octave by octave, as pbrt-v3 writes it (the reference).
+pub fn turbulence_plain(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: i32) -> f32 {
+    let (n, n_int) = octaves(dpdx, dpdy, max_octaves);
+    turbulence_sum(p, omega, n, n_int, max_octaves)
+}
+
+/// `turbulence`'s sum for `n` octaves (`n_int` whole ones) of at most
+/// `max_octaves`, octave by octave.
+pub(super) fn turbulence_sum(p: Vec3, omega: f32, n: f32, n_int: i32, max_octaves: i32) -> f32 {
     let (mut sum, mut lambda, mut o) = (0.0f32, 1.0f32, 1.0f32);
     for _ in 0..n_int {
         sum += o * noise3(lambda * p).abs();
@@ -213,6 +241,58 @@ mod tests {
         for v in [0.0, -0.0, 255.5, 256.0, -1e-30, f32::NAN, f32::INFINITY] {
             check(v, 0.25, -v);
         }
+    }
+
+    /// The sums with their octaves' noise in lanes are the octave-by-octave
+    /// sums bit for bit: footprints from none (every octave) to wider than
+    /// the texture (no whole octave), octave limits from −2 to 128 (several
+    /// vectors of octaves, the partial octave in each lane position), points
+    /// near the origin, far out (some octaves' points past 2³¹, which the
+    /// lanes leave to the plain noise), on the lattice, ±∞ and NaN.
+    #[test]
+    fn octave_lanes_equal_the_plain_sums() {
+        let mut rng = crate::sampling::rng::Pcg32::with_sequence(11);
+        let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        let mut counts = [0u32; 3];
+        for k in 0..120_000 {
+            let scale = [1.0, 10.0, 300.0, 1e6, 1e9][k % 5];
+            let mut c = || (rng.uniform_f32() - 0.5) * 2.0 * scale;
+            let mut p = Vec3::new(c(), c(), c());
+            match k % 97 {
+                0 => p = p.floor(),
+                1 => p.y = f32::NAN,
+                2 => p.x = f32::INFINITY,
+                3 => p = Vec3::ZERO,
+                _ => {}
+            }
+            // Footprint lengths 2^-40 .. 2^4, or none.
+            let e = rng.uniform_f32() * 44.0 - 40.0;
+            let len = if k % 11 == 0 { 0.0 } else { e.exp2() };
+            let dpdx = Vec3::new(len, 0.0, 0.0);
+            let dpdy = Vec3::new(0.0, 0.5 * len, 0.0);
+            let max_octaves = [8, 3, 6, 16, 1, 0, -2, 9, 17, 40, 128][k % 11];
+            let omega = [0.5, 0.75, 1.0, 0.1, 1.7][k % 5];
+            let (n, n_int) = octaves(dpdx, dpdy, max_octaves);
+            counts[(n_int.max(0) as usize / 8).min(2)] += 1;
+            let (a, b) = (
+                fbm(p, dpdx, dpdy, omega, max_octaves),
+                fbm_plain(p, dpdx, dpdy, omega, max_octaves),
+            );
+            assert!(
+                same(a, b),
+                "fbm {p} {len} {max_octaves} {omega} ({n}): {a} against {b}"
+            );
+            let (a, b) = (
+                turbulence(p, dpdx, dpdy, omega, max_octaves),
+                turbulence_plain(p, dpdx, dpdy, omega, max_octaves),
+            );
+            assert!(
+                same(a, b),
+                "turbulence {p} {len} {max_octaves} {omega} ({n}): {a} against {b}"
+            );
+        }
+        // Sums of one vector of octaves, of two, and of more.
+        assert!(counts.iter().all(|&c| c > 1000), "{counts:?}");
     }
 }
 
