@@ -14,6 +14,7 @@ mod disney;
 mod fourier;
 mod fresnel;
 mod fresnel_blend;
+mod glossy_lanes;
 pub mod hair;
 mod lambertian;
 pub(crate) mod microfacet;
@@ -31,6 +32,7 @@ pub use disney::{
 pub use fourier::FourierBsdf;
 pub use fresnel::{fr_conductor, fr_dielectric, Fresnel};
 pub use fresnel_blend::FresnelBlend;
+pub use glossy_lanes::{GlossyPair, GLOSSY_LANES};
 pub use hair::HairBsdf;
 pub use lambertian::{LambertianReflection, LambertianTransmission};
 pub use microfacet::{
