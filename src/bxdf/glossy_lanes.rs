@@ -38,6 +38,10 @@ pub struct GlossyPair {
     ay: f32,
     /// `(eta_i, eta_t)` of the dielectric Fresnel term; `None` for none.
     eta: Option<(f32, f32)>,
+    /// The flags the pair was read with (the scalar code's, which the
+    /// lanes need not read: the pair's lobes are the ones they match).
+    #[cfg_attr(all(target_arch = "x86_64", not(test)), allow(dead_code))]
+    flags: BxdfFlags,
 }
 
 impl GlossyPair {
@@ -71,6 +75,7 @@ impl GlossyPair {
             ax: tr.alpha_x,
             ay: tr.alpha_y,
             eta,
+            flags,
         })
     }
 
@@ -92,12 +97,12 @@ impl GlossyPair {
         }
     }
 
-    /// One direction's value by the scalar code (other architectures).
-    #[cfg(not(target_arch = "x86_64"))]
+    /// One direction's value by the scalar code: `SurfaceScatter`'s (other
+    /// architectures, and the tests' reference).
+    #[cfg(any(test, not(target_arch = "x86_64")))]
     fn f_plain(&self, bsdf: &Bsdf, ns: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
-        let flags = BxdfFlags::NON_SPECULAR;
-        let f = if bsdf.reaches(wo, wi, flags) {
-            bsdf.f_pdf(wo, wi, flags).0
+        let f = if bsdf.reaches(wo, wi, self.flags) {
+            bsdf.f_pdf(wo, wi, self.flags).0
         } else {
             Vec3::ZERO
         };
@@ -276,16 +281,6 @@ mod tests {
     use crate::geometry::Frame;
     use crate::sampling::rng::Pcg32;
 
-    fn scalar(bsdf: &Bsdf, ns: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
-        let flags = BxdfFlags::NON_SPECULAR;
-        let f = if bsdf.reaches(wo, wi, flags) {
-            bsdf.f_pdf(wo, wi, flags).0
-        } else {
-            Vec3::ZERO
-        };
-        f * wi.dot(ns).abs()
-    }
-
     fn bits(v: Vec3) -> [u32; 3] {
         [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]
     }
@@ -381,7 +376,7 @@ mod tests {
             let mut out = [Vec3::splat(-7.0); GLOSSY_LANES];
             pair.f(&bsdf, ns, wo, &wi[..count], &mut out[..count]);
             for j in 0..count {
-                let want = scalar(&bsdf, ns, wo, wi[j]);
+                let want = pair.f_plain(&bsdf, ns, wo, wi[j]);
                 let got = out[j];
                 let same = bits(got) == bits(want)
                     || (0..3).all(|c| {
