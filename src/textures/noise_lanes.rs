@@ -143,43 +143,31 @@ fn octave_noises(p: Vec3, first: usize, live: usize, out: &mut [f32; 8]) {
     }
 }
 
-/// Calls `term(k, noise)` for octaves `k = 0..=whole` in order, their
-/// noise values computed eight at a time; false (nothing called) if there
-/// are more octaves than the frequency table holds.
-#[inline(always)]
-fn each_octave(p: Vec3, whole: usize, mut term: impl FnMut(usize, f32)) -> bool {
+/// [`super::noise::fbm`]'s sum for `n` octaves, `n_int` of them whole.
+/// (This loop and [`turbulence`]'s are written out in each: one loop
+/// shared through a closure took 1.05 of the time on rs_pbrt's `fbm`.)
+#[inline]
+pub fn fbm(p: Vec3, omega: f32, n: f32, n_int: i32) -> f32 {
+    let whole = n_int.max(0) as usize;
     if whole + 1 > LAMBDAS - 7 {
-        return false;
+        return super::noise::fbm_sum(p, omega, n, n_int);
     }
+    let (mut sum, mut o) = (0.0f32, 1.0f32);
     let mut values = [0.0f32; 8];
     let mut first = 0;
     while first <= whole {
         let live = (whole + 1 - first).min(8);
         octave_noises(p, first, live, &mut values);
         for (k, &v) in (first..).zip(&values[..live]) {
-            term(k, v);
+            if k < whole {
+                sum += o * v;
+                o *= omega;
+            } else {
+                let partial = n - n_int as f32;
+                sum += o * smooth_step(0.3, 0.7, partial) * v;
+            }
         }
         first += 8;
-    }
-    true
-}
-
-/// [`super::noise::fbm`]'s sum for `n` octaves, `n_int` of them whole.
-#[inline]
-pub fn fbm(p: Vec3, omega: f32, n: f32, n_int: i32) -> f32 {
-    let whole = n_int.max(0) as usize;
-    let (mut sum, mut o) = (0.0f32, 1.0f32);
-    let summed = each_octave(p, whole, |k, v| {
-        if k < whole {
-            sum += o * v;
-            o *= omega;
-        } else {
-            let partial = n - n_int as f32;
-            sum += o * smooth_step(0.3, 0.7, partial) * v;
-        }
-    });
-    if !summed {
-        return super::noise::fbm_sum(p, omega, n, n_int);
     }
     sum
 }
@@ -189,18 +177,25 @@ pub fn fbm(p: Vec3, omega: f32, n: f32, n_int: i32) -> f32 {
 #[inline]
 pub fn turbulence(p: Vec3, omega: f32, n: f32, n_int: i32, max_octaves: i32) -> f32 {
     let whole = n_int.max(0) as usize;
-    let (mut sum, mut o) = (0.0f32, 1.0f32);
-    let summed = each_octave(p, whole, |k, v| {
-        if k < whole {
-            sum += o * v.abs();
-            o *= omega;
-        } else {
-            let partial = n - n_int as f32;
-            sum += o * lerp(smooth_step(0.3, 0.7, partial), 0.2, v.abs());
-        }
-    });
-    if !summed {
+    if whole + 1 > LAMBDAS - 7 {
         return super::noise::turbulence_sum(p, omega, n, n_int, max_octaves);
+    }
+    let (mut sum, mut o) = (0.0f32, 1.0f32);
+    let mut values = [0.0f32; 8];
+    let mut first = 0;
+    while first <= whole {
+        let live = (whole + 1 - first).min(8);
+        octave_noises(p, first, live, &mut values);
+        for (k, &v) in (first..).zip(&values[..live]) {
+            if k < whole {
+                sum += o * v.abs();
+                o *= omega;
+            } else {
+                let partial = n - n_int as f32;
+                sum += o * lerp(smooth_step(0.3, 0.7, partial), 0.2, v.abs());
+            }
+        }
+        first += 8;
     }
     for _ in n_int..max_octaves {
         sum += o * 0.2;
