@@ -125,17 +125,18 @@ impl GlossyPair {
             |m: __m128, a: __m128, b: __m128| _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b));
         let abs = |v: __m128| _mm_andnot_ps(s(-0.0), v);
         // v·a in glam's order, (x·a.x + y·a.y) + z·a.z.
-        let dot = |x: __m128, y: __m128, z: __m128, a: Vec3| {
-            add(add(mul(x, s(a.x)), mul(y, s(a.y))), mul(z, s(a.z)))
-        };
+        let dot =
+            |x: __m128, y: __m128, z: __m128, a: Vec3| dot_lanes(x, y, z, s(a.x), s(a.y), s(a.z));
         let (zero, one) = (_mm_setzero_ps(), s(1.0));
         let frame = &bsdf.frame;
         // Scalar parts, once: wo in the frame, wo·ng.
         let wo = frame.to_local(wo_w);
         let wo_ng = wo_w.dot(bsdf.ng);
         // reflect = wi·ng · wo·ng > 0 (the lobes are reflections: with
-        // `reaches` false the value is zero either way).
+        // `reaches` false the value is zero either way); with wo.z = 0 no
+        // lobe has a value either.
         let reflect = _mm_cmpgt_ps(mul(dot(wx, wy, wz, bsdf.ng), s(wo_ng)), zero);
+        let valued = if wo.z == 0.0 { zero } else { reflect };
         let cos_ns = abs(dot(wx, wy, wz, ns));
         let (ix, iy, iz) = (
             dot(wx, wy, wz, frame.s),
@@ -234,7 +235,7 @@ impl GlossyPair {
             let lobe = select(spec_off, zero, mul(mul(fr, s(r)), k));
             // (0 + diffuse) + lobe·scale where wi is on wo's side.
             let f = add(add(zero, s(diffuse)), mul(lobe, s(scale)));
-            mul(select(reflect, f, zero), cos_ns)
+            mul(select(valued, f, zero), cos_ns)
         };
         let fx = channel(self.spec_r.x, self.spec_scale.x, self.diffuse.x);
         let fy = channel(self.spec_r.y, self.spec_scale.y, self.diffuse.y);
@@ -244,12 +245,7 @@ impl GlossyPair {
         _mm_storeu_ps(y.as_mut_ptr(), fy);
         _mm_storeu_ps(z.as_mut_ptr(), fz);
         for (k, o) in out[..n].iter_mut().enumerate() {
-            *o = if wo.z == 0.0 {
-                // No lobe has a value: zero times the cosine.
-                Vec3::ZERO * wi[k].dot(ns).abs()
-            } else {
-                Vec3::new(x[k], y[k], z[k])
-            };
+            *o = Vec3::new(x[k], y[k], z[k]);
         }
     }
 }

@@ -121,6 +121,10 @@ pub struct DirectLighting {
     /// Light `i` of `packs` in all four lanes, for the camera vertices of
     /// a batch (one light at four vertices).
     uniform: Vec<TriangleLightPack>,
+    /// Strategy "all" with two to four lights, all delta lights of one
+    /// sample (and not the scalar switch): a plastic-like BSDF's values
+    /// for all of them are then computed at once ([`delta_lights_glossy`]).
+    delta_lanes: bool,
 }
 
 impl DirectLighting {
@@ -141,6 +145,17 @@ impl DirectLighting {
                 _ => Vec::new(),
             },
             uniform: Vec::new(),
+            delta_lanes: false,
+        }
+    }
+
+    /// The BSDF's [`GlossyPair`] where [`delta_lights_glossy`] applies.
+    #[inline]
+    fn glossy_pair(&self, bsdf: &Bsdf) -> Option<GlossyPair> {
+        if self.delta_lanes {
+            GlossyPair::of(bsdf, BxdfFlags::NON_SPECULAR)
+        } else {
+            None
         }
     }
 }
@@ -175,6 +190,10 @@ impl Integrate for DirectLighting {
         if self.n_light_samples.iter().any(|&n| n != 1) {
             self.packs.clear();
         }
+        self.delta_lanes = !self.scalar
+            && (2..=GLOSSY_LANES).contains(&scene.lights.len())
+            && self.n_light_samples.iter().all(|&n| n == 1)
+            && scene.lights.iter().all(|l| l.is_delta());
         self.uniform = self
             .packs
             .iter()
@@ -283,17 +302,22 @@ impl SpecularTree for DirectLighting {
                         &self.packs,
                     )
                 }
-                (DirectStrategy::All, _) => sample_all_lights(
-                    scene,
-                    s,
-                    bsdf,
-                    wo,
-                    sampler,
-                    scratch,
-                    &self.n_light_samples,
-                    &self.light_boxes,
-                    !self.scalar,
-                ),
+                (DirectStrategy::All, _) => match self.glossy_pair(bsdf) {
+                    Some(pair) => {
+                        delta_lights_glossy(scene, s, bsdf, &pair, wo, sampler, scratch)
+                    }
+                    None => sample_all_lights(
+                        scene,
+                        s,
+                        bsdf,
+                        wo,
+                        sampler,
+                        scratch,
+                        &self.n_light_samples,
+                        &self.light_boxes,
+                        !self.scalar,
+                    ),
+                },
                 (DirectStrategy::One, _) => {
                     sample_one_light(scene, s, bsdf, wo, sampler, scratch, &self.lights)
                 }
@@ -431,25 +455,6 @@ pub(super) fn sample_all_lights(
     light_boxes: &[Option<Bounds3>],
     together: bool,
 ) -> Vec3 {
-    if together
-        && (2..=GLOSSY_LANES).contains(&n_light_samples.len())
-        && n_light_samples.iter().all(|&n| n == 1)
-        && scene.lights.iter().all(|l| l.is_delta())
-    {
-        if let Some(pair) = GlossyPair::of(bsdf, BxdfFlags::NON_SPECULAR) {
-            return delta_lights_glossy(
-                scene,
-                s,
-                bsdf,
-                &pair,
-                wo,
-                sampler,
-                scratch,
-                n_light_samples.len(),
-                light_boxes,
-            );
-        }
-    }
     let mut l = Vec3::ZERO;
     let mut u_light = std::mem::take(&mut scratch.u_light);
     let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
@@ -534,12 +539,12 @@ pub(super) fn sample_all_lights(
 
 /// [`sample_all_lights`] for two to four delta lights of one sample each
 /// at a plastic-like BSDF ([`GlossyPair`]): the lights are sampled in
-/// order (their arrays skipped as the loop there skips them), the BSDF's
-/// values for all of their directions are computed in one pass of lanes,
-/// then each light's estimate is finished in order as `estimate_direct`
+/// order (their arrays skipped as the loop there skips them: a delta light
+/// reads neither, and has no box, so none is left out), the BSDF's values
+/// for all of their directions are computed in one pass of lanes, then
+/// each light's estimate is finished in order as `estimate_direct`
 /// finishes it (no value, no density or a blocked shadow ray give 0, else
 /// f·Li / pdf), and summed as there. Bit for bit `sample_all_lights`' sum.
-#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn delta_lights_glossy(
     scene: &RenderScene,
@@ -549,31 +554,16 @@ fn delta_lights_glossy(
     wo: Vec3,
     sampler: &mut Sampler,
     scratch: &mut Scratch,
-    count: usize,
-    light_boxes: &[Option<Bounds3>],
 ) -> Vec3 {
+    let count = scene.lights.len().min(GLOSSY_LANES);
     let mut u_light = std::mem::take(&mut scratch.u_light);
     let mut u_scatter = std::mem::take(&mut scratch.u_scatter);
-    let (p, ng) = (s.point.p, s.point.n);
     let mut samples = [None; GLOSSY_LANES];
     // Whether light j's arrays were there (its estimate is then summed as
-    // one sample's, else taken as it is), and whether it is left out.
+    // one sample's, else taken as it is).
     let mut arrays = [false; GLOSSY_LANES];
-    let mut skipped = [false; GLOSSY_LANES];
     let mut wi = [Vec3::Z; GLOSSY_LANES];
     for j in 0..count {
-        let light_box = light_boxes.get(j).copied().flatten();
-        // The BSDF reflects only (a glossy pair's lobes are reflections).
-        if light_box.is_some_and(|b| wholly_behind(&b, p, ng, wo)) {
-            let got_light = sampler.skip_2d_array(1, &mut u_light);
-            let got_scatter = sampler.skip_2d_array(1, &mut u_scatter);
-            if !(got_light && got_scatter) {
-                sampler.skip_2d();
-                sampler.skip_2d();
-            }
-            skipped[j] = true;
-            continue;
-        }
         let got_light = sampler.skip_2d_array(1, &mut u_light);
         let got_scatter = sampler.skip_2d_array(1, &mut u_scatter);
         arrays[j] = got_light && got_scatter;
@@ -595,11 +585,6 @@ fn delta_lights_glossy(
     pair.f(bsdf, s.point.ns, wo, &wi[..count], &mut f[..count]);
     let mut l = Vec3::ZERO;
     for j in 0..count {
-        if skipped[j] {
-            // The sum of the estimates.
-            l += Vec3::ZERO;
-            continue;
-        }
         let ld = match &samples[j] {
             Some(ls) if !(ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.li == Vec3::ZERO) => {
                 if f[j] == Vec3::ZERO {

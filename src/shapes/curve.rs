@@ -421,8 +421,9 @@ impl Curve {
                 reach: 0.0,
             };
             let cp = c.control_points();
-            c.reach = chord_distance(cp[1] - cp[0], cp[3] - cp[0])
-                .max(chord_distance(cp[2] - cp[0], cp[3] - cp[0]));
+            c.reach = segment_distance2(cp[1] - cp[0], cp[3] - cp[0])
+                .max(segment_distance2(cp[2] - cp[0], cp[3] - cp[0]))
+                .sqrt();
             c
         })
     }
@@ -439,14 +440,7 @@ impl Curve {
     fn passes_wide(&self, o: Vec3, dir: Vec3, a: Vec3, b: Vec3) -> bool {
         let (qa, qb) = (a - o, b - o);
         let (pa, pb) = (qa - qa.dot(dir) * dir, qb - qb.dot(dir) * dir);
-        let e = pb - pa;
-        let ee = e.length_squared();
-        let u = if ee > 0.0 {
-            (-pa.dot(e) / ee).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let dist2 = (pa + u * e).length_squared();
+        let dist2 = segment_distance2(-pa, pb - pa);
         let far = qa.abs().max_element() + qb.abs().max_element();
         let lim = (self.reach + 0.5 * self.max_width()) * 1.001 + 2e-5 * far;
         dist2 > lim * lim
@@ -687,15 +681,16 @@ fn overlaps(cp: &[Vec3; 4], width: f32, z_max: f32) -> bool {
         || lo.z - h > z_max)
 }
 
-/// The distance of `p` from the segment from the origin to `b`.
-fn chord_distance(p: Vec3, b: Vec3) -> f32 {
+/// The squared distance of `p` from the segment from the origin to `b`.
+#[inline]
+fn segment_distance2(p: Vec3, b: Vec3) -> f32 {
     let bb = b.length_squared();
     let u = if bb > 0.0 {
         (p.dot(b) / bb).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    (p - u * b).length()
+    (p - u * b).length_squared()
 }
 
 /// log2 rounded to nearest from the float's bits; 0 below 1 (pbrt-v3's).

@@ -123,7 +123,10 @@ static LAMBDA: [f32; LAMBDAS] = {
     }
     t
 };
-const LAMBDAS: usize = super::noise::MAX_OCTAVES as usize + 1 + 7;
+const LAMBDAS: usize = SUMMED + 7;
+/// The most octaves a sum reads: [`super::noise::MAX_OCTAVES`] and the
+/// partial one.
+const SUMMED: usize = super::noise::MAX_OCTAVES as usize + 1;
 
 /// The noise of octaves `first..first + 8` of `p` (octave k at
 /// `LAMBDA[k] · p`) into `out`, those from `first + live` on left as they
@@ -149,7 +152,7 @@ fn octave_noises(p: Vec3, first: usize, live: usize, out: &mut [f32; 8]) {
 #[inline]
 pub fn fbm(p: Vec3, omega: f32, n: f32, n_int: i32) -> f32 {
     let whole = n_int.max(0) as usize;
-    if whole + 1 > LAMBDAS - 7 {
+    if whole + 1 > SUMMED {
         return super::noise::fbm_sum(p, omega, n, n_int);
     }
     let (mut sum, mut o) = (0.0f32, 1.0f32);
@@ -177,7 +180,7 @@ pub fn fbm(p: Vec3, omega: f32, n: f32, n_int: i32) -> f32 {
 #[inline]
 pub fn turbulence(p: Vec3, omega: f32, n: f32, n_int: i32, max_octaves: i32) -> f32 {
     let whole = n_int.max(0) as usize;
-    if whole + 1 > LAMBDAS - 7 {
+    if whole + 1 > SUMMED {
         return super::noise::turbulence_sum(p, omega, n, n_int, max_octaves);
     }
     let (mut sum, mut o) = (0.0f32, 1.0f32);
